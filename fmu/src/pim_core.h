@@ -1,0 +1,71 @@
+/*
+ * pimodel C core: play and Prandtl-Ishlinskii (PI) operators on sampled inputs.
+ *
+ * One implementation shared by the Python package (through ctypes) and the FMUs.
+ * Discrete-time semantics (NOTES.md, paper eqs. 1-7), for play i with radius r_i:
+ *
+ *     z_i[k] = max(v[k] - r_i, min(v[k] + r_i, z_i[k-1])),   z_i[-1] = initial state
+ *     y[k]   = sum_i p_i z_i[k]
+ *
+ * so y[k] depends on v[0..k] only (no delay).  The time-dependent form replaces r_i by
+ * rhat_i[k] at step k.  All arrays are caller-owned; state arrays `z` (length n) are updated in
+ * place so that a run can be continued by another call.  No function allocates memory.
+ * Units: v and r share the input unit, y is in the output unit, p is output unit per input unit.
+ */
+#ifndef PIM_CORE_H
+#define PIM_CORE_H
+
+#include <stddef.h>
+
+#if defined(_WIN32)
+#define PIM_API __declspec(dllexport)
+#else
+#define PIM_API __attribute__((visibility("default")))
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Largest number of plays the fixed-size users (FMUs) accept; the array functions take any n. */
+#define PIM_MAX_PLAYS 64
+
+/* One step of the PI operator: updates z[0..n-1] for input v and returns y. */
+PIM_API double pim_pi_step(size_t n, const double *p, const double *r, double *z, double v);
+
+/*
+ * Runs the PI operator over v[0..N-1]: y[k] as above, z updated to z[N-1].
+ * zhist (nullable) receives the play outputs row by row, zhist[k*n + i] = z_i[k].
+ */
+PIM_API void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
+                        const double *v, double *y, double *zhist);
+
+/*
+ * Time-dependent PI operator: radii given per sample, R[k*n + i] = rhat_i[k].
+ * zhist (nullable) as in pim_pi_run.
+ */
+PIM_API void pim_tdpi_run(size_t N, size_t n, const double *p, const double *R, double *z,
+                          const double *v, double *y, double *zhist);
+
+/*
+ * Exact inverse (Krejci & Kuhnen) of a PI operator with r[0] == 0 and all partial sums
+ * P_i = p_1 + ... + p_i > 0:  rinv_i = sum_{j<=i} p_j (r_i - r_j),  pinv_1 = 1/p_1,
+ * pinv_i = -p_i / (P_i P_{i-1}).  The consistent inverse state for forward play states z is
+ * zinv_i = P_i z_i + sum_{j>i} p_j z_j (pass z = NULL to skip).
+ * Returns 0 on success, -1 if the operator is not invertible (nothing written then).
+ */
+PIM_API int pim_pi_inverse(size_t n, const double *p, const double *r, const double *z,
+                           double *pinv, double *rinv, double *zinv);
+
+/*
+ * Parameter check for a forward PI operator: returns NULL when 0 <= r_1 <= ... <= r_n,
+ * all finite, and p_i > 0 (or, with signed != 0, all partial sums positive); else a static
+ * message naming the first offending parameter.  Used by the FMUs to report fmi2Error.
+ */
+PIM_API const char *pim_pi_check(size_t n, const double *p, const double *r, int signed_weights);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PIM_CORE_H */

@@ -1,0 +1,107 @@
+/* Play and PI operators; semantics in pim_core.h. */
+#include "pim_core.h"
+
+#include <math.h>
+
+/* z = max(lo, min(hi, z)) written with comparisons so that the compiler vectorises it. */
+static inline double pim_clamp(double z, double lo, double hi)
+{
+    z = z < hi ? z : hi;
+    return z > lo ? z : lo;
+}
+
+double pim_pi_step(size_t n, const double *p, const double *r, double *z, double v)
+{
+    double y = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        z[i] = pim_clamp(z[i], v - r[i], v + r[i]);
+        y += p[i] * z[i];
+    }
+    return y;
+}
+
+void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
+                const double *v, double *y, double *zhist)
+{
+    double zl[PIM_MAX_PLAYS];
+    if (n > PIM_MAX_PLAYS) { /* general path, state in caller memory */
+        for (size_t k = 0; k < N; ++k) {
+            y[k] = pim_pi_step(n, p, r, z, v[k]);
+            if (zhist) {
+                for (size_t i = 0; i < n; ++i) zhist[k * n + i] = z[i];
+            }
+        }
+        return;
+    }
+    for (size_t i = 0; i < n; ++i) zl[i] = z[i];
+    for (size_t k = 0; k < N; ++k) {
+        const double vk = v[k];
+        for (size_t i = 0; i < n; ++i) zl[i] = pim_clamp(zl[i], vk - r[i], vk + r[i]);
+        double acc = 0.0;
+        for (size_t i = 0; i < n; ++i) acc += p[i] * zl[i];
+        y[k] = acc;
+        if (zhist) {
+            for (size_t i = 0; i < n; ++i) zhist[k * n + i] = zl[i];
+        }
+    }
+    for (size_t i = 0; i < n; ++i) z[i] = zl[i];
+}
+
+void pim_tdpi_run(size_t N, size_t n, const double *p, const double *R, double *z,
+                  const double *v, double *y, double *zhist)
+{
+    for (size_t k = 0; k < N; ++k) {
+        y[k] = pim_pi_step(n, p, R + k * n, z, v[k]);
+        if (zhist) {
+            for (size_t i = 0; i < n; ++i) zhist[k * n + i] = z[i];
+        }
+    }
+}
+
+int pim_pi_inverse(size_t n, const double *p, const double *r, const double *z,
+                   double *pinv, double *rinv, double *zinv)
+{
+    if (n == 0 || r[0] != 0.0) return -1;
+    double P = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        P += p[i];
+        if (!(P > 0.0)) return -1;
+    }
+    double Pprev = 0.0, Pi = 0.0, tail = 0.0, acc_pr = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        Pi = Pprev + p[i];
+        acc_pr += p[i] * r[i];
+        rinv[i] = Pi * r[i] - acc_pr; /* sum_{j<=i} p_j (r_i - r_j) */
+        pinv[i] = (i == 0) ? 1.0 / p[0] : -p[i] / (Pi * Pprev);
+        Pprev = Pi;
+    }
+    if (z && zinv) {
+        /* zinv_i = P_i z_i + sum_{j>i} p_j z_j, accumulated from the top. */
+        Pi = P;
+        for (size_t ii = n; ii-- > 0;) {
+            zinv[ii] = Pi * z[ii] + tail;
+            tail += p[ii] * z[ii];
+            Pi -= p[ii];
+        }
+    }
+    return 0;
+}
+
+const char *pim_pi_check(size_t n, const double *p, const double *r, int signed_weights)
+{
+    if (n == 0) return "the number of plays n must be at least 1";
+    double P = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!isfinite(r[i])) return "a radius r[i] is not finite";
+        if (r[i] < 0.0) return "a radius r[i] is negative (radii must be >= 0)";
+        if (i > 0 && r[i] < r[i - 1]) return "radii r[i] are not sorted (need r[1] <= ... <= r[n])";
+        if (!isfinite(p[i])) return "a weight p[i] is not finite";
+        P += p[i];
+        if (signed_weights) {
+            if (!(P > 0.0)) return "a partial sum of weights p[1]+...+p[i] is not positive";
+        } else if (!(p[i] > 0.0)) {
+            return "a weight p[i] is not positive (weights must be > 0)";
+        }
+    }
+    return NULL;
+}

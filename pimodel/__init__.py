@@ -1,0 +1,16 @@
+"""pimodel: Prandtl-Ishlinskii hysteresis for smart-material actuators."""
+
+from .data import Record, load_record, save_record
+from .operator import PIOperator, TimeDependentPI
+from .reference import pi_reference, play_reference
+
+__all__ = [
+    "PIOperator",
+    "TimeDependentPI",
+    "Record",
+    "load_record",
+    "save_record",
+    "pi_reference",
+    "play_reference",
+]
+__version__ = "0.1.0"

@@ -1,0 +1,95 @@
+"""ctypes binding to the shared C core (``fmu/src/pim_*.c``), built at install time.
+
+Only this module touches ctypes; the rest of the package calls the typed wrappers below.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.machinery
+from pathlib import Path
+
+import numpy as np
+
+_HERE = Path(__file__).resolve().parent
+
+
+def _find_library() -> Path:
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        candidate = _HERE / f"_pim_core{suffix}"
+        if candidate.exists():
+            return candidate
+    raise ImportError(
+        "pimodel's compiled core (_pim_core) is missing: install the package with "
+        "'pip install -e .' (needs a C compiler) so that setup.py builds fmu/src/pim_*.c"
+    )
+
+
+lib = ctypes.CDLL(str(_find_library()))
+
+c_size = ctypes.c_size_t
+c_double_p = ctypes.POINTER(ctypes.c_double)
+
+_F64 = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
+
+
+class _NullableF64:
+    """ctypes argtype accepting a float64 C-contiguous array or None (NULL)."""
+
+    @classmethod
+    def from_param(cls, obj):
+        if obj is None:
+            return None
+        return _F64.from_param(obj)
+
+
+F64 = _F64
+F64_OR_NULL = _NullableF64
+
+lib.pim_pi_step.restype = ctypes.c_double
+lib.pim_pi_step.argtypes = [c_size, F64, F64, F64, ctypes.c_double]
+lib.pim_pi_run.restype = None
+lib.pim_pi_run.argtypes = [c_size, c_size, F64, F64, F64, F64, F64, F64_OR_NULL]
+lib.pim_tdpi_run.restype = None
+lib.pim_tdpi_run.argtypes = [c_size, c_size, F64, F64, F64, F64, F64, F64_OR_NULL]
+lib.pim_pi_inverse.restype = ctypes.c_int
+lib.pim_pi_inverse.argtypes = [c_size, F64, F64, F64_OR_NULL, F64, F64, F64_OR_NULL]
+
+
+def pi_run(
+    p: np.ndarray, r: np.ndarray, z: np.ndarray, v: np.ndarray, *, with_plays: bool = False
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Run the PI operator over ``v``; ``z`` (float64, length n) is updated in place."""
+    N, n = v.shape[0], p.shape[0]
+    y = np.empty(N)
+    zhist = np.empty((N, n)) if with_plays else None
+    lib.pim_pi_run(N, n, p, r, z, v, y, zhist)
+    return y, zhist
+
+
+def tdpi_run(
+    p: np.ndarray, R: np.ndarray, z: np.ndarray, v: np.ndarray, *, with_plays: bool = False
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Time-dependent PI operator, radii ``R[k, i]`` per sample; ``z`` updated in place."""
+    N, n = v.shape[0], p.shape[0]
+    y = np.empty(N)
+    zhist = np.empty((N, n)) if with_plays else None
+    lib.pim_tdpi_run(N, n, p, R, z, v, y, zhist)
+    return y, zhist
+
+
+def pi_step(p: np.ndarray, r: np.ndarray, z: np.ndarray, v: float) -> float:
+    """One step of the PI operator; ``z`` updated in place."""
+    return lib.pim_pi_step(p.shape[0], p, r, z, float(v))
+
+
+def pi_inverse(
+    p: np.ndarray, r: np.ndarray, z: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None] | None:
+    """Inverse weights, radii and consistent state; None when not invertible."""
+    n = p.shape[0]
+    pinv, rinv = np.empty(n), np.empty(n)
+    zinv = np.empty(n) if z is not None else None
+    if lib.pim_pi_inverse(n, p, r, z, pinv, rinv, zinv) != 0:
+        return None
+    return pinv, rinv, zinv

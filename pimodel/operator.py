@@ -1,0 +1,240 @@
+"""Prandtl-Ishlinskii operators: fixed radii (:class:`PIOperator`) and time-dependent radii
+(:class:`TimeDependentPI`), backed by the shared C core.
+
+Discrete-time semantics (paper eqs. 1-7, NOTES.md), for play i with radius r_i and state z_i::
+
+    z_i[k] = max(v[k] - r_i, min(v[k] + r_i, z_i[k-1])),   z_i[-1] = initial_state[i]
+    y[k]   = sum_i p_i z_i[k]
+
+``y[k]`` depends on ``v[0..k]`` (no delay). The operator is rate independent: time stamps play
+no role, only the sequence of input values. Units: ``v`` and the radii share the input unit
+(e.g. V), ``y`` is in the output unit (e.g. um), weights in output per input unit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _native
+from .checks import as_signal, as_vector
+
+
+def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarray, np.ndarray]:
+    p = as_vector(weights, "weights")
+    r = as_vector(radii, "radii")
+    if p.shape != r.shape:
+        raise ValueError(
+            f"weights and radii: expected the same length, got {p.size} weights and "
+            f"{r.size} radii"
+        )
+    if np.any(r < 0):
+        i = int(np.flatnonzero(r < 0)[0])
+        raise ValueError(f"radii: radius {i} is {r[i]!r}; radii must be >= 0")
+    if signed_weights:
+        P = np.cumsum(p)
+        if np.any(P <= 0):
+            i = int(np.flatnonzero(P <= 0)[0])
+            raise ValueError(
+                f"weights: partial sum p_1+...+p_{i + 1} = {P[i]!r}; a signed-weight PI operator "
+                "needs every partial sum > 0"
+            )
+    elif np.any(p <= 0):
+        i = int(np.flatnonzero(p <= 0)[0])
+        raise ValueError(f"weights: weight {i} is {p[i]!r}; weights must be > 0")
+    return p, r
+
+
+def _initial_state(value, n: int) -> np.ndarray:
+    z = as_vector(value, "initial_state")
+    if z.size == 1:
+        return np.full(n, z[0])
+    if z.size != n:
+        raise ValueError(
+            f"initial_state: expected a scalar or {n} values (one per play), got {z.size}"
+        )
+    return z.copy()
+
+
+class PIOperator:
+    """Weighted sum of play operators, ``y[k] = sum_i p_i Gamma_{r_i}[v][k]``.
+
+    Parameters
+    ----------
+    weights, radii:
+        ``p_i`` and ``r_i`` (same length n >= 1). Radii must be >= 0; they are **sorted
+        ascending together with their weights** (and with a per-play initial state) when given
+        unsorted, so ``op.radii`` is always non-decreasing.
+    initial_state:
+        The plays' state before the first sample, ``z_i[-1]``: a scalar (the paper's initial
+        condition x, same for all plays) or one value per play. Default 0.
+    signed_weights:
+        Allow negative weights as long as every partial sum ``p_1 + ... + p_i`` is positive
+        (the class of operators the exact inverse produces). Default False: all ``p_i > 0``.
+
+    :meth:`simulate` is pure (starts from ``initial_state`` each call); :meth:`step` streams,
+    reading and updating :attr:`state`.
+    """
+
+    def __init__(self, weights, radii, *, initial_state=0.0, signed_weights: bool = False):
+        p, r = _check_parameters(weights, radii, signed_weights=signed_weights)
+        z0 = _initial_state(initial_state, p.size)
+        order = np.argsort(r, kind="stable")
+        self._p = np.ascontiguousarray(p[order])
+        self._r = np.ascontiguousarray(r[order])
+        self._z0 = np.ascontiguousarray(z0[order])
+        self._z = self._z0.copy()
+        self.signed_weights = bool(signed_weights)
+        for a in (self._p, self._r, self._z0):
+            a.setflags(write=False)
+
+    # -- parameters ---------------------------------------------------------------------
+    @property
+    def weights(self) -> np.ndarray:
+        """Weights ``p_i`` (read-only view), ordered by radius."""
+        return self._p
+
+    @property
+    def radii(self) -> np.ndarray:
+        """Radii ``r_i`` (read-only view), non-decreasing."""
+        return self._r
+
+    @property
+    def n(self) -> int:
+        """Number of plays."""
+        return self._p.size
+
+    @property
+    def initial_state(self) -> np.ndarray:
+        """Play states before the first sample, ``z_i[-1]``."""
+        return self._z0
+
+    def __repr__(self) -> str:
+        return (
+            f"PIOperator(weights={np.array2string(self._p, precision=6, separator=', ')}, "
+            f"radii={np.array2string(self._r, precision=6, separator=', ')})"
+        )
+
+    # -- whole-array simulation ---------------------------------------------------------
+    def simulate(self, v, *, state=None, return_state: bool = False):
+        """Output ``y[k]`` for the input samples ``v[k]``, k = 0..N-1.
+
+        Starts from ``state`` (default :attr:`initial_state`) and leaves the streaming state
+        untouched. With ``return_state=True`` returns ``(y, z_final)``.
+        """
+        x = as_signal(v, "v")
+        z = self._z0.copy() if state is None else _initial_state(state, self.n)
+        y, _ = _native.pi_run(self._p, self._r, z, x)
+        return (y, z) if return_state else y
+
+    def play_outputs(self, v, *, state=None) -> np.ndarray:
+        """Play outputs ``z[k, i] = Gamma_{r_i}[v][k]``, shape (N, n)."""
+        x = as_signal(v, "v")
+        z = self._z0.copy() if state is None else _initial_state(state, self.n)
+        _, zhist = _native.pi_run(self._p, self._r, z, x, with_plays=True)
+        return zhist
+
+    # -- streaming ----------------------------------------------------------------------
+    @property
+    def state(self) -> np.ndarray:
+        """Current play states ``z_i[k]`` (a copy); settable with a scalar or n values."""
+        return self._z.copy()
+
+    @state.setter
+    def state(self, value) -> None:
+        self._z = _initial_state(value, self.n)
+
+    def reset(self) -> None:
+        """Return the streaming state to :attr:`initial_state`."""
+        self._z = self._z0.copy()
+
+    def step(self, v: float) -> float:
+        """Advance one sample: update the state with input ``v[k]`` and return ``y[k]``."""
+        vk = float(v)
+        if not np.isfinite(vk):
+            raise ValueError(f"v: input sample is {v!r}; expected a finite number")
+        return _native.pi_step(self._p, self._r, self._z, vk)
+
+    def output(self, state=None) -> float:
+        """Output ``sum_i p_i z_i`` for a state (default: the current streaming state)."""
+        z = self._z if state is None else _initial_state(state, self.n)
+        return float(self._p @ z)
+
+    # -- analysis -----------------------------------------------------------------------
+    def slopes(self) -> np.ndarray:
+        """Slopes of the loop branches (Lemma 1, Remark 1), ascending.
+
+        With ``r_1 > 0``: the n + 1 values ``0, P_1, ..., P_n``; with ``r_1 = 0`` the n values
+        ``P_1, ..., P_n``, where ``P_i = p_1 + ... + p_i``. Equal radii merge their slopes.
+        """
+        P = np.cumsum(self._p)
+        keep = np.append(self._r[1:] > self._r[:-1], True)  # last play of each radius group
+        s = P[keep]
+        return s if self._r[0] == 0 else np.concatenate(([0.0], s))
+
+    def loop_width(self) -> float:
+        """Lemma 2's loop width ``rho = 2 sum p_i r_i / sum p_i`` (input units)."""
+        return float(2.0 * (self._p @ self._r) / self._p.sum())
+
+    @property
+    def is_invertible(self) -> bool:
+        """True when the exact inverse exists: ``r_1 = 0`` and every partial sum positive."""
+        return bool(self._r[0] == 0.0 and np.all(np.cumsum(self._p) > 0))
+
+    def inverse(self) -> PIOperator:
+        """Exact analytic inverse (Krejci & Kuhnen, NOTES.md), again a PI operator.
+
+        Requires ``r_1 = 0`` (a linear play) with ``p_1 > 0``; raises ValueError otherwise.
+        The inverse's initial state is made consistent with this operator's initial state, so
+        ``op.inverse().simulate(op.simulate(v))`` returns ``v``; its weights are signed.
+        """
+        if self._r[0] != 0.0:
+            raise ValueError(
+                f"PIOperator.inverse: not invertible, the smallest radius is {self._r[0]!r}; "
+                "the exact inverse needs a linear play (r_1 = 0) with a positive weight"
+            )
+        res = _native.pi_inverse(self._p, self._r, self._z0)
+        if res is None:
+            raise ValueError(
+                "PIOperator.inverse: not invertible, a partial sum of weights is not positive"
+            )
+        pinv, rinv, zinv = res
+        return PIOperator(pinv, rinv, initial_state=zinv, signed_weights=True)
+
+    def inverse_state(self, state) -> np.ndarray:
+        """Inverse-operator state consistent with forward play states ``state``."""
+        z = _initial_state(state, self.n)
+        res = _native.pi_inverse(self._p, self._r, z)
+        if res is None:
+            raise ValueError("PIOperator.inverse_state: the operator is not invertible")
+        return res[2]
+
+
+@dataclass(frozen=True)
+class TimeDependentPI:
+    """PI operator with radii given per sample (paper eq. 7), used by the radius estimator.
+
+    ``z_i[k] = max(v[k] - R[k, i], min(v[k] + R[k, i], z_i[k-1]))``, ``y[k] = sum_i p_i z_i[k]``.
+    """
+
+    weights: np.ndarray
+
+    def __post_init__(self):
+        p = as_vector(self.weights, "weights")
+        object.__setattr__(self, "weights", p)
+
+    def simulate(self, v, radii_per_sample, *, initial_state=0.0, return_plays: bool = False):
+        """Output for inputs ``v`` (N) and radii ``radii_per_sample`` (N, n), each >= 0."""
+        x = as_signal(v, "v")
+        n = self.weights.size
+        R = np.ascontiguousarray(np.asarray(radii_per_sample, dtype=float))
+        if R.shape != (x.size, n):
+            raise ValueError(
+                f"radii_per_sample: expected shape ({x.size}, {n}), got {R.shape}"
+            )
+        if not np.all(np.isfinite(R)) or np.any(R < 0):
+            raise ValueError("radii_per_sample: every radius must be finite and >= 0")
+        z = _initial_state(initial_state, n)
+        y, zhist = _native.tdpi_run(self.weights, R, z, x, with_plays=return_plays)
+        return (y, zhist) if return_plays else y

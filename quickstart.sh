@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# pimodel quick start: sets up a virtual environment (.venv) with everything, then
+#   bash quickstart.sh demo [ARGS...]   runs the main job (pimodel demo)
+#   bash quickstart.sh test             runs lint and the whole test suite
+# Needs only Python >= 3.10, a C compiler and pip access to PyPI.
+set -euo pipefail
+cd "$(dirname "$0")"
+
+PY=${PYTHON:-}
+if [ -z "$PY" ]; then
+    for cand in python3.11 python3 python; do
+        if command -v "$cand" >/dev/null 2>&1; then PY=$cand; break; fi
+    done
+fi
+[ -n "$PY" ] || { echo "quickstart: no python3 found on PATH" >&2; exit 1; }
+
+if [ ! -x .venv/bin/python ]; then
+    echo "quickstart: creating .venv with $PY"
+    "$PY" -m venv .venv
+    .venv/bin/python -m pip install -q --upgrade pip
+fi
+echo "quickstart: installing pimodel and its dependencies into .venv (compiles the C core)"
+.venv/bin/python -m pip install -q -e ".[test]"
+
+cmd=${1:-demo}
+shift || true
+case "$cmd" in
+    demo)
+        exec .venv/bin/pimodel demo "$@" ;;
+    test)
+        .venv/bin/ruff check .
+        exec .venv/bin/python -m pytest -q "$@" ;;
+    *)
+        echo "usage: bash quickstart.sh {demo|test} [args...]" >&2; exit 2 ;;
+esac
