@@ -22,7 +22,7 @@ def as_signal(value, name: str, *, min_length: int = 1) -> np.ndarray:
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
         raise ValueError(
-            f"{name}: sample {bad[0]} is {arr[bad[0]]!r}; all samples must be finite "
+            f"{name}: sample {bad[0]} is {float(arr[bad[0]])!r}; all samples must be finite "
             f"({bad.size} non-finite in total)"
         )
     return np.ascontiguousarray(arr)

@@ -71,8 +71,8 @@ def _validate_columns(cols: dict[str, np.ndarray], source: str) -> dict[str, np.
         bad = np.flatnonzero(~np.isfinite(arr))
         if bad.size:
             raise DataError(
-                f"{source}: row {bad[0] + 1}, column '{name}': value {arr[bad[0]]!r} is not a "
-                "finite number"
+                f"{source}: row {bad[0] + 1}, column '{name}': "
+                f"value {float(arr[bad[0]])!r} is not a finite number"
             )
         out[name] = np.ascontiguousarray(arr)
     if length is None or length < 2:
@@ -82,8 +82,8 @@ def _validate_columns(cols: dict[str, np.ndarray], source: str) -> dict[str, np.
     if bad.size:
         k = bad[0] + 1
         raise DataError(
-            f"{source}: row {k + 1}, column 't': time {out['t'][k]!r} does not increase "
-            f"strictly (previous {out['t'][k - 1]!r})"
+            f"{source}: row {k + 1}, column 't': time {float(out['t'][k])!r} does not increase "
+            f"strictly (previous {float(out['t'][k - 1])!r})"
         )
     return out
 

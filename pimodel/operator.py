@@ -31,18 +31,18 @@ def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarr
         )
     if np.any(r < 0):
         i = int(np.flatnonzero(r < 0)[0])
-        raise ValueError(f"radii: radius {i} is {r[i]!r}; radii must be >= 0")
+        raise ValueError(f"radii: radius {i} is {float(r[i])!r}; radii must be >= 0")
     if signed_weights:
         P = np.cumsum(p)
         if np.any(P <= 0):
             i = int(np.flatnonzero(P <= 0)[0])
             raise ValueError(
-                f"weights: partial sum p_1+...+p_{i + 1} = {P[i]!r}; a signed-weight PI operator "
-                "needs every partial sum > 0"
+                f"weights: partial sum p_1+...+p_{i + 1} = {float(P[i])!r}; a signed-weight PI "
+                "operator needs every partial sum > 0"
             )
     elif np.any(p <= 0):
         i = int(np.flatnonzero(p <= 0)[0])
-        raise ValueError(f"weights: weight {i} is {p[i]!r}; weights must be > 0")
+        raise ValueError(f"weights: weight {i} is {float(p[i])!r}; weights must be > 0")
     return p, r
 
 
@@ -191,8 +191,9 @@ class PIOperator:
         """
         if self._r[0] != 0.0:
             raise ValueError(
-                f"PIOperator.inverse: not invertible, the smallest radius is {self._r[0]!r}; "
-                "the exact inverse needs a linear play (r_1 = 0) with a positive weight"
+                "PIOperator.inverse: not invertible, the smallest radius is "
+                f"{float(self._r[0])!r}; the exact inverse needs a linear play (r_1 = 0) with a "
+                "positive weight"
             )
         res = _native.pi_inverse(self._p, self._r, self._z0)
         if res is None:
