@@ -7,7 +7,7 @@ import argparse
 import importlib
 import sys
 
-COMMANDS = ["simulate", "demo"]
+COMMANDS = ["simulate", "demo", "study"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,42 @@
+"""``pimodel study NAME``: run a study script from ``studies/``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def register(sub) -> None:
+    from ..study_runner import available_studies
+
+    names = ", ".join(available_studies()) or "none found"
+    p = sub.add_parser(
+        "study",
+        help="run a study (figures and results tables into an output folder)",
+        description=f"Run a study from studies/ and write its figures (PNG) and results "
+        f"(Markdown and JSON) to an output folder. Studies: {names}.",
+    )
+    p.add_argument("name", nargs="?", help="study name ('all' runs every study)")
+    p.add_argument("--quick", action="store_true", help="reduced size (as run in CI)")
+    p.add_argument("--out", default=None,
+                   help="output folder (default out/studies/NAME; with 'all', a parent folder)")
+    p.add_argument("--list", action="store_true", help="list the studies and exit")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..study_runner import available_studies, run_study
+
+    if args.list or not args.name:
+        for name in available_studies():
+            print(name)
+        return 0
+    names = available_studies() if args.name == "all" else [args.name]
+    for name in names:
+        out = None
+        if args.out:
+            out = Path(args.out) / name if args.name == "all" else Path(args.out)
+        result = run_study(name, out, quick=args.quick)
+        print(result.to_markdown())
+        print(f"study {name}: results in {Path(out or Path('out') / 'studies' / name).resolve()}")
+    return 0
