@@ -1,0 +1,224 @@
+/* Adaptive radius estimator; the discrete-time law is documented in pim_estimator.h. */
+#include "pim_estimator.h"
+
+#include <math.h>
+#include <string.h>
+
+void pim_project_ordered(size_t n, double *x, const double *w, int fix_first)
+{
+    double val[PIM_MAX_PLAYS], wt[PIM_MAX_PLAYS];
+    size_t cnt[PIM_MAX_PLAYS];
+    size_t start = 0, nb = 0;
+    if (fix_first && n > 0) {
+        x[0] = 0.0;
+        start = 1;
+    }
+    for (size_t i = start; i < n; ++i) { /* pool adjacent violators */
+        val[nb] = x[i];
+        wt[nb] = w[i];
+        cnt[nb] = 1;
+        ++nb;
+        while (nb > 1 && val[nb - 2] > val[nb - 1]) {
+            double ws = wt[nb - 2] + wt[nb - 1];
+            val[nb - 2] = (wt[nb - 2] * val[nb - 2] + wt[nb - 1] * val[nb - 1]) / ws;
+            wt[nb - 2] = ws;
+            cnt[nb - 2] += cnt[nb - 1];
+            --nb;
+        }
+    }
+    size_t i = start;
+    for (size_t b = 0; b < nb; ++b) {
+        double v = val[b] > 0.0 ? val[b] : 0.0;
+        for (size_t c = 0; c < cnt[b]; ++c) x[i++] = v;
+    }
+}
+
+static void est_weights(const pim_estimator *est, double *w)
+{
+    for (size_t j = 0; j < est->n; ++j) w[j] = 1.0 / (est->gain[j] > 1e-300 ? est->gain[j] : 1e-300);
+}
+
+size_t pim_est_sizeof(void) { return sizeof(pim_estimator); }
+
+const char *pim_est_init(pim_estimator *est, size_t n, const double *p, const double *gains,
+                         const double *rhat0, double dt, double z0, double threshold,
+                         double max_step, double anneal_time, double guard, int known_linear)
+{
+    if (n < 1 || n > PIM_MAX_PLAYS) return "n: the number of plays must be between 1 and 64";
+    if (!(dt > 0.0) || !isfinite(dt)) return "dt: the sample time must be finite and > 0";
+    if (!isfinite(z0)) return "initial state: must be finite";
+    if (!(threshold >= 0.0) || !isfinite(threshold)) return "threshold: must be finite and >= 0";
+    if (!isfinite(max_step)) return "max_step: must be finite";
+    if (!isfinite(anneal_time)) return "anneal_time: must be finite";
+    if (!(guard >= 0.0) || !isfinite(guard)) return "guard: must be finite and >= 0";
+    for (size_t j = 0; j < n; ++j) {
+        if (!isfinite(p[j]) || !(p[j] > 0.0)) return "weights: every weight must be finite and > 0";
+        if (!isfinite(gains[j]) || gains[j] < 0.0) return "gains: every gain must be finite and >= 0";
+        if (!isfinite(rhat0[j]) || rhat0[j] < 0.0)
+            return "initial radii: every radius must be finite and >= 0";
+    }
+    memset(est, 0, sizeof(*est));
+    est->n = n;
+    est->dt = dt;
+    est->threshold = threshold;
+    est->max_step = max_step;
+    est->anneal_time = anneal_time;
+    est->guard = guard;
+    est->known_linear = known_linear ? 1 : 0;
+    for (size_t j = 0; j < n; ++j) {
+        est->p[j] = p[j];
+        est->gain[j] = gains[j];
+        est->rhat[j] = rhat0[j];
+        est->zhat[j] = z0;
+    }
+    double w[PIM_MAX_PLAYS];
+    est_weights(est, w);
+    pim_project_ordered(n, est->rhat, w, est->known_linear);
+    return NULL;
+}
+
+/* sat_j = 1 iff a segment travel of `travel` surely saturated play j. */
+static void est_saturation(pim_estimator *est, double travel)
+{
+    for (size_t j = 0; j < est->n; ++j)
+        est->sat[j] = travel >= 2.0 * est->rhat[j] + est->guard ? 1.0 : 0.0;
+}
+
+int pim_est_step(pim_estimator *est, double v, double y, double *rhat_used, double *yhat,
+                 double *e, double *e_delta)
+{
+    const size_t n = est->n;
+    if (!isfinite(v) || !isfinite(y)) return -1;
+    if (rhat_used) memcpy(rhat_used, est->rhat, n * sizeof(double));
+
+    /* 1. time-dependent model */
+    double yh = 0.0;
+    for (size_t j = 0; j < n; ++j) {
+        double lo = v - est->rhat[j], hi = v + est->rhat[j], z = est->zhat[j];
+        z = z < hi ? z : hi;
+        z = z > lo ? z : lo;
+        est->zhat[j] = z;
+        yh += est->p[j] * z;
+    }
+    *yhat = yh;
+    *e = yh - y;
+    *e_delta = 0.0;
+
+    /* 2. segments and reversals */
+    int usable = 0;
+    if (!est->started) {
+        est->started = 1.0;
+        est->v_first = v;
+        est->v_start = v;
+        est->v_ext = v;
+    } else if (est->dir == 0.0) {
+        if (fabs(v - est->v_first) > est->threshold) {
+            est->dir = v > est->v_first ? 1.0 : -1.0;
+            est->v_ext = v;
+        }
+    } else if (est->dir * (v - est->v_ext) >= 0.0) {
+        if (est->dir * (v - est->v_ext) > 0.0) est->v_ext = v;
+        usable = est->have_rev != 0.0;
+    } else if (fabs(v - est->v_ext) > est->threshold) {
+        est_saturation(est, fabs(est->v_ext - est->v_start));
+        est->v_rev = est->v_ext;
+        est->v_start = est->v_ext;
+        est->have_rev = 1.0;
+        est->dir = -est->dir;
+        est->v_ext = v;
+        usable = 1;
+    }
+
+    /* 3. principal case and modified error */
+    int used = 0;
+    if (usable) {
+        const double s = est->dir, d = fabs(v - est->v_rev);
+        double phi[PIM_MAX_PLAYS], ybar = 0.0;
+        int valid = 1;
+        for (size_t j = 0; j < n; ++j) {
+            if (fabs(d - 2.0 * est->rhat[j]) < est->guard) { valid = 0; break; }
+            if (d >= 2.0 * est->rhat[j]) {
+                phi[j] = est->p[j];
+                ybar += est->p[j] * (v - s * est->rhat[j]);
+            } else {
+                if (est->sat[j] == 0.0) { valid = 0; break; }
+                phi[j] = -est->p[j];
+                ybar += est->p[j] * (est->v_rev + s * est->rhat[j]);
+            }
+        }
+        if (valid) {
+            /* 4. gradient step with projection */
+            const double ed = ybar - y;
+            const double scale = est->anneal_time > 0.0 ? 1.0 / (1.0 + est->time / est->anneal_time) : 1.0;
+            double w[PIM_MAX_PLAYS];
+            for (size_t j = 0; j < n; ++j) {
+                double step = est->dt * est->gain[j] * scale * ed * s * phi[j];
+                if (est->max_step > 0.0) {
+                    step = step > est->max_step ? est->max_step : step;
+                    step = step < -est->max_step ? -est->max_step : step;
+                }
+                est->rhat[j] += step;
+            }
+            est_weights(est, w);
+            pim_project_ordered(n, est->rhat, w, est->known_linear);
+            *e_delta = ed;
+            used = 1;
+        }
+    }
+    est->time += est->dt;
+    return used;
+}
+
+long pim_est_run(pim_estimator *est, size_t N, const double *v, const double *y, double *R,
+                 double *yhat, double *e, double *e_delta, double *used)
+{
+    for (size_t k = 0; k < N; ++k) {
+        int u = pim_est_step(est, v[k], y[k], R ? R + k * est->n : NULL, yhat + k, e + k,
+                             e_delta + k);
+        if (u < 0) return (long)k;
+        if (used) used[k] = (double)u;
+    }
+    return -1;
+}
+
+void pim_est_get_state(const pim_estimator *est, double *state)
+{
+    const size_t n = est->n;
+    memcpy(state, est->rhat, n * sizeof(double));
+    memcpy(state + n, est->zhat, n * sizeof(double));
+    memcpy(state + 2 * n, est->sat, n * sizeof(double));
+    double *s = state + 3 * n;
+    s[0] = est->v_first;
+    s[1] = est->v_start;
+    s[2] = est->v_ext;
+    s[3] = est->v_rev;
+    s[4] = est->dir;
+    s[5] = est->have_rev;
+    s[6] = est->started;
+    s[7] = est->time;
+}
+
+const char *pim_est_set_state(pim_estimator *est, const double *state)
+{
+    const size_t n = est->n;
+    for (size_t i = 0; i < PIM_EST_STATE_SIZE(n); ++i) {
+        if (!isfinite(state[i])) return "state: every entry must be finite";
+    }
+    for (size_t j = 0; j < n; ++j) {
+        if (state[j] < 0.0 || (j > 0 && state[j] < state[j - 1]))
+            return "state: radii must satisfy 0 <= r_1 <= ... <= r_n";
+    }
+    memcpy(est->rhat, state, n * sizeof(double));
+    memcpy(est->zhat, state + n, n * sizeof(double));
+    memcpy(est->sat, state + 2 * n, n * sizeof(double));
+    const double *s = state + 3 * n;
+    est->v_first = s[0];
+    est->v_start = s[1];
+    est->v_ext = s[2];
+    est->v_rev = s[3];
+    est->dir = s[4];
+    est->have_rev = s[5];
+    est->started = s[6];
+    est->time = s[7];
+    return NULL;
+}
