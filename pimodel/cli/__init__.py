@@ -7,7 +7,7 @@ import argparse
 import importlib
 import sys
 
-COMMANDS = ["simulate", "demo", "study"]
+COMMANDS = ["simulate", "identify", "demo", "study"]
 
 
 def build_parser() -> argparse.ArgumentParser:

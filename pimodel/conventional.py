@@ -1,0 +1,58 @@
+"""The conventional baseline: radii preset on a grid, weights by bounded least squares.
+
+Radii ``r_i = (i - 1) / (n - 1) * span`` (``r_1 = 0``, so the model is invertible); weights
+``p >= 0`` (``p_1 >= 1e-9`` times the slope scale, keeping the inverse defined) and an output
+offset minimise ``sum_k (sum_i p_i z_i[k] + c - y[k])^2`` with the play outputs ``z_i[k]`` of the
+preset radii started from zero state (``scipy.optimize.lsq_linear``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import lsq_linear
+
+from .checks import as_signal
+from .operator import PIOperator
+
+
+@dataclass
+class ConventionalFit:
+    """Result of :func:`fit_conventional`: the operator, the output offset and the fit RMS."""
+
+    operator: PIOperator
+    offset: float
+    rms: float
+    span: float
+
+
+def fit_conventional(v, y, n_plays: int, *, span: float | None = None) -> ConventionalFit:
+    """Fit weights for ``n_plays`` preset radii spread over ``[0, span]`` (input units).
+
+    ``span`` defaults to half the input range, ``(max v - min v) / 2``: the largest radius a
+    play can have and still be excited by the record. ``y`` is modelled as ``PI[v] + offset``.
+    """
+    v = as_signal(v, "v", min_length=2)
+    y = as_signal(y, "y", min_length=2)
+    if v.size != y.size:
+        raise ValueError(f"v and y: expected equal lengths, got {v.size} and {y.size}")
+    if int(n_plays) != n_plays or n_plays < 1:
+        raise ValueError(f"n_plays: expected an integer >= 1, got {n_plays!r}")
+    n = int(n_plays)
+    span = float(np.ptp(v)) / 2 if span is None else float(span)
+    if not np.isfinite(span) or span <= 0:
+        raise ValueError(f"span: expected a radius span > 0 (input units), got {span!r}; "
+                         "is the input constant?")
+    radii = np.linspace(0.0, span, n) if n > 1 else np.zeros(1)
+    plays = PIOperator(np.ones(n), radii).play_outputs(v)
+    A = np.column_stack((plays, np.ones(v.size)))
+    scale = float(np.ptp(y) / max(np.ptp(v), 1e-300))
+    lb = np.concatenate(([1e-9 * scale], np.zeros(n - 1), [-np.inf]))
+    sol = lsq_linear(A, y, bounds=(lb, np.inf), method="bvls" if n < 40 else "trf")
+    p = np.maximum(sol.x[:n], 0.0)
+    keep = p > 0
+    keep[0] = True
+    op = PIOperator(p[keep], radii[keep])
+    resid = A @ sol.x - y
+    return ConventionalFit(op, float(sol.x[-1]), float(np.sqrt(np.mean(resid**2))), span)

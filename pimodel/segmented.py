@@ -1,0 +1,179 @@
+"""Optimal continuous piecewise-linear (segmented) regression through the origin.
+
+Fits ``Y(x) = c_b + sum_i (s_i - s_{i-1}) max(0, x - b_{i-1})`` (``b_0 = 0``, ``s_0 = 0``) with
+a free offset ``c_b`` per group b (branch). Breakpoints are first located by dynamic programming
+over binned data (Bellman's optimal segmentation, exact for the binned problem), then refined
+by continuous least squares (scipy ``least_squares``), with slope increments constrained >= 0
+when ``increasing`` (a PI operator's loop branches are convex: weights are positive).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares, lsq_linear
+
+
+@dataclass
+class SegmentedFit:
+    """A fitted continuous piecewise-linear function of ``m`` segments."""
+
+    slopes: np.ndarray       # s_1..s_m, one per segment (ascending x)
+    breakpoints: np.ndarray  # b_1..b_{m-1} (x units)
+    offsets: np.ndarray      # c_b per group
+    sse: float
+    n_points: int
+
+    @property
+    def segments(self) -> int:
+        return self.slopes.size
+
+    def bic(self, sse_floor: float = 0.0) -> float:
+        """BIC = N ln(SSE/N) + k ln N with k = 2m - 1 + groups (slopes, breakpoints, offsets)."""
+        k = 2 * self.segments - 1 + self.offsets.size
+        mse = max(self.sse / self.n_points, sse_floor)
+        return float(self.n_points * np.log(mse) + k * np.log(self.n_points))
+
+
+def _design(x: np.ndarray, groups: np.ndarray, n_groups: int, bps: np.ndarray) -> np.ndarray:
+    cols = [x] + [np.maximum(0.0, x - b) for b in bps]
+    onehot = np.zeros((x.size, n_groups))
+    onehot[np.arange(x.size), groups] = 1.0
+    return np.column_stack(cols + [onehot])
+
+
+def _dp_breakpoints(x: np.ndarray, Y: np.ndarray, m: int, bins: int) -> np.ndarray:
+    """Breakpoints of the optimal m-segment (discontinuous) linear fit on binned data."""
+    order = np.argsort(x)
+    xs, ys = x[order], Y[order]
+    edges = np.unique(np.quantile(xs, np.linspace(0, 1, bins + 1)))
+    idx = np.clip(np.searchsorted(edges, xs, side="right") - 1, 0, edges.size - 2)
+    G = edges.size - 1
+    S = np.zeros((6, G))
+    for row, val in enumerate((np.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys)):
+        S[row] = np.bincount(idx, weights=val, minlength=G)
+    C = np.concatenate((np.zeros((6, 1)), np.cumsum(S, axis=1)), axis=1)
+
+    def sse(i, j):  # bins i..j-1
+        n, sx, sy, sxx, sxy, syy = (C[:, j] - C[:, i])
+        if n < 2:
+            return 0.0
+        var_x = sxx - sx * sx / n
+        cov = sxy - sx * sy / n
+        var_y = syy - sy * sy / n
+        return max(var_y - (cov * cov / var_x if var_x > 1e-300 else 0.0), 0.0)
+
+    seg = np.array([[sse(i, j) if j > i else np.inf for j in range(G + 1)] for i in range(G + 1)])
+    cost = np.full((m + 1, G + 1), np.inf)
+    arg = np.zeros((m + 1, G + 1), dtype=int)
+    cost[0, 0] = 0.0
+    for s in range(1, m + 1):
+        for j in range(1, G + 1):
+            cand = cost[s - 1, :j] + seg[:j, j]
+            arg[s, j] = int(np.argmin(cand))
+            cost[s, j] = cand[arg[s, j]]
+    cuts, j = [], G
+    for s in range(m, 0, -1):
+        j = arg[s, j]
+        cuts.append(j)
+    cuts = sorted(cuts)[1:]  # drop the leading 0
+    return np.array([edges[c] for c in cuts])
+
+
+def _bin(x, Y, bins):
+    """Equal-width bins in x: mean x, mean Y and count of the non-empty bins."""
+    edges = np.linspace(0.0, float(x.max()) * (1 + 1e-12) + 1e-300, bins + 1)
+    idx = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, bins - 1)
+    cnt = np.bincount(idx, minlength=bins).astype(float)
+    sx = np.bincount(idx, weights=x, minlength=bins)
+    sy = np.bincount(idx, weights=Y, minlength=bins)
+    ok = cnt > 0
+    return sx[ok] / cnt[ok], sy[ok] / cnt[ok], cnt[ok]
+
+
+def _fit_binned(xb, yb, wb, segments, increasing, bins):
+    """Continuous fit through the origin on binned data (weights = counts)."""
+    sw = np.sqrt(wb)
+    ones = np.zeros(xb.size, dtype=int)
+
+    def solve(bps):
+        A = _design(xb, ones, 1, bps) * sw[:, None]
+        m = bps.size + 1
+        lb = np.full(A.shape[1], -np.inf)
+        if increasing:
+            lb[1:m] = 0.0
+        sol = lsq_linear(A, yb * sw, bounds=(lb, np.inf), method="bvls")
+        return sol.x, A @ sol.x - yb * sw
+
+    bps = np.empty(0)
+    if segments > 1:
+        bps = _dp_breakpoints(xb, yb, segments, min(bins, xb.size))
+        if bps.size != segments - 1:
+            bps = np.quantile(xb, np.linspace(0, 1, segments + 1)[1:-1])
+        xmax = float(xb.max())
+        sol = least_squares(lambda b: solve(np.sort(b))[1], bps, bounds=(0.0, xmax),
+                            x_scale=max(xmax, 1e-12) / 10, max_nfev=100 * segments)
+        bps = np.sort(sol.x)
+    coef, _ = solve(bps)
+    return bps, coef
+
+
+def fit_segmented(x, Y, groups=None, *, segments: int, increasing: bool = True,
+                  bins: int = 300, iterations: int = 3) -> SegmentedFit:
+    """Continuous piecewise-linear fit with ``segments`` segments (see module docstring).
+
+    The per-group offsets and the shared curve are fitted alternately (``iterations`` times):
+    offsets start at each group's first samples; the curve is fitted on the offset-corrected
+    data averaged into ``bins`` equal-width bins of x, which keeps the fit fast on long records.
+    """
+    x = np.asarray(x, float)
+    Y = np.asarray(Y, float)
+    groups = np.zeros(x.size, dtype=int) if groups is None else np.asarray(groups, dtype=int)
+    n_groups = int(groups.max()) + 1
+    offsets = np.array([np.mean(Y[groups == g][:5]) for g in range(n_groups)])
+    for _ in range(max(1, iterations)):
+        xb, yb, wb = _bin(x, Y - offsets[groups], bins)
+        bps, coef = _fit_binned(xb, yb, wb, segments, increasing, bins)
+        curve = _design(x, np.zeros(x.size, dtype=int), 1, bps)[:, :segments] @ coef[:segments]
+        resid = Y - curve
+        offsets = np.bincount(groups, resid, n_groups) / np.bincount(groups, minlength=n_groups)
+    r = Y - curve - offsets[groups]
+    slopes = np.cumsum(coef[:segments])
+    return SegmentedFit(slopes, bps, offsets, float(r @ r), x.size)
+
+
+def polish_fit(x, Y, groups, fit: SegmentedFit, *, increasing: bool = True,
+               max_points: int = 100_000) -> SegmentedFit:
+    """Refine a binned fit's breakpoints and slopes on the unbinned data (offsets held), then
+    re-estimate the offsets. Removes the small bias that binning leaves near breakpoints."""
+    x = np.asarray(x, float)
+    Y = np.asarray(Y, float)
+    groups = np.asarray(groups, dtype=int)
+    m = fit.segments
+    Yc = Y - fit.offsets[groups]
+    sel = np.linspace(0, x.size - 1, min(x.size, max_points)).astype(int)
+    xs, ys = x[sel], Yc[sel]
+    ones = np.zeros(xs.size, dtype=int)
+
+    def solve(bps, xx, yy, g1):
+        A = _design(xx, g1, 1, bps)[:, :m]
+        lb = np.full(m, -np.inf)
+        if increasing:
+            lb[1:] = 0.0
+        sol = lsq_linear(A, yy, bounds=(lb, np.inf), method="bvls")
+        return sol.x, A @ sol.x - yy
+
+    bps = fit.breakpoints
+    if m > 1:
+        xmax = float(x.max())
+        sol = least_squares(lambda b: solve(np.sort(b), xs, ys, ones)[1], bps,
+                            bounds=(0.0, xmax), x_scale=max(xmax, 1e-12) / 10,
+                            max_nfev=50 * m, xtol=1e-12, ftol=1e-12)
+        bps = np.sort(sol.x)
+    coef, _ = solve(bps, x, Yc, np.zeros(x.size, dtype=int))
+    curve = _design(x, np.zeros(x.size, dtype=int), 1, bps)[:, :m] @ coef
+    n_groups = fit.offsets.size
+    offsets = np.bincount(groups, Y - curve, n_groups) / np.bincount(groups, minlength=n_groups)
+    r = Y - curve - offsets[groups]
+    return SegmentedFit(np.cumsum(coef), bps, offsets, float(r @ r), x.size)
