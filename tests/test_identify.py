@@ -52,11 +52,13 @@ def test_slopes_detect_linear_play_on_stage():
 
 
 def paper_comparison_errors(snr_db=None):
-    t, v = triangle(2, 1, fs=1000, duration=3)
+    """1 Hz triangle of 2 V peak to peak (the paper's 17 um range) for identification; a
+    record with major and minor loops for validation."""
+    t, v = triangle(1, 1, fs=1000, duration=3)
     y = STAGE.simulate(v)
     if snr_db is not None:
         y = add_noise_snr(y, snr_db, np.random.default_rng(0))
-    tv, vv = major_minor_loops(2, 1, fs=1000, minor_fractions=(0.6, 0.3, 0.15))
+    tv, vv = major_minor_loops(1, 1, fs=1000, minor_fractions=(0.6, 0.3, 0.15))
     yv = STAGE.simulate(vv)
     proposed = identify(v, y, dt=1e-3, n_plays=4)
     errs = {"proposed n=4": float(np.max(np.abs(proposed.predict(vv) - yv)))}
