@@ -16,7 +16,11 @@ input ``v[k]`` (input unit, e.g. V) and measured output ``y[k]`` (output unit, e
    ``d >= 2 rhat_j[k]`` (no noisy output slope is differenced). Samples where an interior play
    was not saturated at the reversal (minor loops, the first segment) are not used, nor samples
    with ``d`` closer than ``guard`` to a breakpoint ``2 rhat_j`` (misclassification there biases
-   the estimate under noise).
+   the estimate under noise). Slope check: the measured output change over the
+   ``slope_window`` samples before k (y[k] not used) must agree with the case model's change
+   within ``slope_tol * min p`` per unit of travel, else the regime read from rhat is wrong
+   (an overestimated radius whose play is already on its envelope) and the sample is skipped;
+   without it an overestimate can run away.
    ``e_delta[k] = ybar - y[k] = s phi^T (r - rhat)`` with
    ``ybar = sum_on p_j (v - s rhat_j) + sum_interior p_j (v_rev + s rhat_j)`` and
    ``phi_j = +p_j`` (on envelope) or ``-p_j`` (interior), i.e. ``sgn(i - j) p_j`` (eq. 19);
@@ -60,6 +64,9 @@ _lib.pim_est_get_state.restype = None
 _lib.pim_est_get_state.argtypes = [ctypes.c_void_p, _F64]
 _lib.pim_est_set_state.restype = ctypes.c_char_p
 _lib.pim_est_set_state.argtypes = [ctypes.c_void_p, _F64]
+_lib.pim_est_set_slope_check.restype = ctypes.c_char_p
+_lib.pim_est_set_slope_check.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_double]
+EST_WINDOW = 64  # PIM_EST_WIN in pim_estimator.h
 _lib.pim_project_ordered.restype = None
 _lib.pim_project_ordered.argtypes = [ctypes.c_size_t, _F64, _F64, ctypes.c_int]
 
@@ -105,7 +112,8 @@ class RadiusEstimator:
     ``gains`` (scalar or per play, >= 0; the paper's Lambda diagonal), ``initial_radii``
     (projected onto the ordered set), ``known_linear_play`` (hold rhat_1 = 0), ``threshold``
     (reversal threshold, input unit), ``max_step`` (per-sample clip of the update, input unit),
-    ``guard`` (breakpoint guard band, input unit),
+    ``guard`` (breakpoint guard band, input unit), ``slope_window`` and ``slope_tol`` (the slope
+    check: samples, 0 to disable; tolerance in units of the smallest weight),
     ``anneal_time`` (gain annealing time constant [s]), ``initial_state`` (model play state).
     See the module docstring for the exact discrete-time law.
     """
@@ -113,7 +121,8 @@ class RadiusEstimator:
     def __init__(self, weights, *, dt: float, gains=10.0, initial_radii=None,
                  known_linear_play: bool = False, threshold: float = 0.0,
                  max_step: float | None = None, anneal_time: float | None = None,
-                 guard: float = 0.0, initial_state: float = 0.0):
+                 guard: float = 0.0, slope_window: int = 8, slope_tol: float = 0.5,
+                 initial_state: float = 0.0):
         p = as_vector(weights, "weights")
         n = p.size
         if n > MAX_PLAYS:
@@ -153,6 +162,12 @@ class RadiusEstimator:
                                 int(self.known_linear_play))
         if msg:
             raise ValueError(msg.decode())
+        if int(slope_window) != slope_window:
+            raise ValueError(f"slope_window: expected an integer, got {slope_window!r}")
+        msg = _lib.pim_est_set_slope_check(self._buf, int(slope_window), float(slope_tol))
+        if msg:
+            raise ValueError(msg.decode())
+        self._state_size = 3 * n + 10 + 2 * EST_WINDOW
         self._initial = self.state
 
     @property
@@ -162,14 +177,14 @@ class RadiusEstimator:
 
     @property
     def state(self) -> np.ndarray:
-        """Everything needed to resume, as a flat array of ``3 n + 8`` floats."""
-        s = np.empty(3 * self.n + 8)
+        """Everything needed to resume, as a flat array of ``3 n + 138`` floats."""
+        s = np.empty(self._state_size)
         _lib.pim_est_get_state(self._buf, s)
         return s
 
     @state.setter
     def state(self, value) -> None:
-        s = as_vector(value, "state", length=3 * self.n + 8)
+        s = as_vector(value, "state", length=self._state_size)
         msg = _lib.pim_est_set_state(self._buf, np.ascontiguousarray(s))
         if msg:
             raise ValueError(msg.decode())
@@ -205,7 +220,8 @@ class RadiusEstimator:
 def estimate_radii(v, y, weights, *, dt: float, gains=10.0, initial_radii=None,
                    known_linear_play: bool = False, threshold: float = 0.0,
                    max_step: float | None = None, anneal_time: float | None = None,
-                   guard: float = 0.0, initial_state: float = 0.0) -> RadiusEstimate:
+                   guard: float = 0.0, slope_window: int = 8, slope_tol: float = 0.5,
+                   initial_state: float = 0.0) -> RadiusEstimate:
     """Estimate the play radii from a record ``(v[k], y[k])``, k = 0..N-1, sampled every ``dt``.
 
     Runs :class:`RadiusEstimator` over the arrays (the C batch loop); see the module docstring
@@ -214,6 +230,7 @@ def estimate_radii(v, y, weights, *, dt: float, gains=10.0, initial_radii=None,
     est = RadiusEstimator(weights, dt=dt, gains=gains, initial_radii=initial_radii,
                           known_linear_play=known_linear_play, threshold=threshold,
                           max_step=max_step, anneal_time=anneal_time, guard=guard,
+                          slope_window=slope_window, slope_tol=slope_tol,
                           initial_state=initial_state)
     return est.run(v, y)
 

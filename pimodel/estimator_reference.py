@@ -29,7 +29,7 @@ def project_ordered_reference(x: np.ndarray, w: np.ndarray, fix_first: bool) -> 
 
 def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_linear_play=False,
                              threshold=0.0, max_step=None, anneal_time=None, guard=0.0,
-                             initial_state=0.0):
+                             slope_window=8, slope_tol=0.5, initial_state=0.0):
     """Returns ``(history, yhat, e, e_delta, used, final radii)`` as in the C batch loop."""
     p = np.asarray(weights, float)
     n = p.size
@@ -43,6 +43,9 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
     have_rev = False
     v_first = v_start = v_ext = v_rev = 0.0
     time = 0.0
+    nseg = 0
+    past_v: list[float] = []  # inputs and outputs before sample k
+    past_y: list[float] = []
     N = len(v)
     hist, yhat, e, ed, used = np.empty((N, n)), np.empty(N), np.empty(N), np.zeros(N), np.zeros(N)
     for k in range(N):
@@ -69,7 +72,18 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
             have_rev = True
             direction = -direction
             v_ext = vk
+            nseg = 0
             usable = True
+        if usable and slope_window > 0:
+            m = slope_window
+            if nseg < m + 1:
+                usable = False
+            else:
+                da, db = abs(past_v[-1 - m] - v_rev), abs(past_v[-1] - v_rev)
+                if db - da > 0:
+                    model = sum(p[j] * max(0.0, db - max(da, 2.0 * rhat[j])) for j in range(n))
+                    meas = direction * (past_y[-1] - past_y[-1 - m])
+                    usable = abs(meas - model) <= slope_tol * p.min() * (db - da)
         if usable:
             s, d = direction, abs(vk - v_rev)
             phi = np.empty(n)
@@ -98,4 +112,7 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
                 ed[k] = err
                 used[k] = 1.0
         time += dt
+        nseg += 1
+        past_v.append(vk)
+        past_y.append(yk)
     return hist, yhat, e, ed, used.astype(bool), rhat

@@ -32,8 +32,8 @@ def max_rel_error(est, truth):
 
 
 def test_paper_sinusoid_noise_free_within_1_percent():
-    """v = 30 sin(2 pi t), gains 10, 1 kHz, 60 s, from a wrong start: final estimate."""
-    t, v = sinusoid(30, 1, fs=1000, duration=60)
+    """v = 30 sin(2 pi t), gains 10, 1 kHz, 150 s, from a wrong start: final estimate."""
+    t, v = sinusoid(30, 1, fs=1000, duration=150)
     y = PIOperator(P, R).simulate(v)
     res = estimate_radii(v, y, P, dt=1e-3, gains=10, initial_radii=WRONG)
     assert max_rel_error(res.radii, R) < 0.01
@@ -43,11 +43,12 @@ def test_paper_sinusoid_noise_free_within_1_percent():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_paper_sinusoid_snr20_within_5_percent(seed):
-    """SNR 20 dB on y; 10 kHz for 2000 s (20 M samples), gain 1, guard 0.2 V; the average of
-    the estimate over the last half of the record is within 5 % of every radius."""
+    """SNR 20 dB on y; 10 kHz for 2000 s (20 M samples), gain 1, guard 0.2 V, slope check off
+    (a sample-to-sample slope is meaningless at this noise); the average of the estimate over
+    the last half of the record is within 5 % of every radius."""
     t, v = sinusoid(30, 1, fs=10_000, duration=2000)
     y = add_noise_snr(PIOperator(P, R).simulate(v), 20, np.random.default_rng(seed))
-    est = RadiusEstimator(P, dt=1e-4, gains=1.0, initial_radii=WRONG, guard=0.2)
+    est = RadiusEstimator(P, dt=1e-4, gains=1.0, initial_radii=WRONG, guard=0.2, slope_window=0)
     _, avg = run_tail_average(est, v, y)
     assert max_rel_error(avg, R) < 0.05
 
@@ -57,7 +58,7 @@ def test_biased_staircase_snr20_within_5_percent(seed):
     """Periodic biased stair-step (-15..25, steps 0.5 held 5 ms), 1 kHz, 2000 s, SNR 20 dB."""
     t, v = biased_staircase(20, 5, step=0.5, hold=0.005, fs=1000, duration=2000)
     y = add_noise_snr(PIOperator(P, R).simulate(v), 20, np.random.default_rng(seed))
-    est = RadiusEstimator(P, dt=1e-3, gains=1.0, initial_radii=WRONG, guard=0.2)
+    est = RadiusEstimator(P, dt=1e-3, gains=1.0, initial_radii=WRONG, guard=0.2, slope_window=0)
     _, avg = run_tail_average(est, v, y)
     assert max_rel_error(avg, R) < 0.05
 
@@ -67,6 +68,19 @@ def test_biased_staircase_noise_free_within_1_percent():
     y = PIOperator(P, R).simulate(v)
     res = estimate_radii(v, y, P, dt=1e-3, gains=10, initial_radii=WRONG)
     assert max_rel_error(res.radii, R) < 0.01
+
+
+def test_overestimated_radii_do_not_run_away():
+    """A start far above the truth on a small travel (the regime read from rhat is wrong where
+    the true play is already on its envelope): the slope check keeps the estimate converging;
+    without it the estimate runs away above the input travel and freezes there."""
+    t, v = triangle(1, 1, fs=1000, duration=60)
+    y = PIOperator(STAGE_P, STAGE_R).simulate(v)
+    kw = dict(dt=1e-3, gains=20, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
+    res = estimate_radii(v, y, STAGE_P, **kw)
+    assert max_rel_error(res.radii, STAGE_R) < 0.01
+    bad = estimate_radii(v, y, STAGE_P, slope_window=0, **kw)
+    assert max_rel_error(bad.radii, STAGE_R) > 0.5
 
 
 def test_piezo_stage_triangle_with_known_linear_play():
@@ -88,7 +102,7 @@ def test_c_core_equals_numpy_reference(seed):
     v[1500:1600] = v[1500]  # a hold
     y = PIOperator(P, R).simulate(v) + rng.normal(0, 1.0, v.size)
     kw = dict(dt=1e-3, gains=[10, 5, 10, 2, 10], initial_radii=WRONG, guard=0.1,
-              max_step=0.02, anneal_time=1.5, threshold=0.01)
+              max_step=0.02, anneal_time=1.5, threshold=0.01, slope_window=4, slope_tol=8.0)
     a = estimate_radii(v, y, P, **kw)
     hist, yhat, e, ed, used, final = estimate_radii_reference(v, y, P, **kw)
     np.testing.assert_allclose(a.history, hist, rtol=0, atol=1e-12)
@@ -166,5 +180,5 @@ def test_step_rejects_nan():
     est = RadiusEstimator(P, dt=1e-3, initial_radii=WRONG)
     with pytest.raises(ValueError, match="samples must be finite"):
         est.step(np.nan, 0.0)
-    with pytest.raises(ValueError, match="state: expected 23 values"):
+    with pytest.raises(ValueError, match="state: expected 153 values"):
         est.state = np.zeros(3)

@@ -40,6 +40,36 @@ static void est_weights(const pim_estimator *est, double *w)
 
 size_t pim_est_sizeof(void) { return sizeof(pim_estimator); }
 
+const char *pim_est_set_slope_check(pim_estimator *est, int window, double tol)
+{
+    if (window < 0 || window >= PIM_EST_WIN) return "slope_window: must be between 0 and 63";
+    if (!(tol > 0.0) || !isfinite(tol)) return "slope_tol: must be finite and > 0";
+    est->slope_window = window;
+    est->slope_tol = tol;
+    return NULL;
+}
+
+/* Slope check: measured vs case-model output change over the window before this sample. */
+static int est_slope_ok(const pim_estimator *est)
+{
+    const int m = est->slope_window;
+    if (m == 0) return 1;
+    if (est->nseg < (double)(m + 1)) return 0;
+    const int hb = ((int)est->head + PIM_EST_WIN - 1) % PIM_EST_WIN;
+    const int ha = ((int)est->head + PIM_EST_WIN - 1 - m) % PIM_EST_WIN;
+    const double da = fabs(est->vbuf[ha] - est->v_rev), db = fabs(est->vbuf[hb] - est->v_rev);
+    const double travel = db - da;
+    if (travel <= 0.0) return 1; /* hold: nothing to compare */
+    double model = 0.0, pmin = est->p[0];
+    for (size_t j = 0; j < est->n; ++j) {
+        double start = da > 2.0 * est->rhat[j] ? da : 2.0 * est->rhat[j];
+        if (db > start) model += est->p[j] * (db - start);
+        if (est->p[j] < pmin) pmin = est->p[j];
+    }
+    const double meas = est->dir * (est->ybuf[hb] - est->ybuf[ha]);
+    return fabs(meas - model) <= est->slope_tol * pmin * travel;
+}
+
 const char *pim_est_init(pim_estimator *est, size_t n, const double *p, const double *gains,
                          const double *rhat0, double dt, double z0, double threshold,
                          double max_step, double anneal_time, double guard, int known_linear)
@@ -65,6 +95,8 @@ const char *pim_est_init(pim_estimator *est, size_t n, const double *p, const do
     est->anneal_time = anneal_time;
     est->guard = guard;
     est->known_linear = known_linear ? 1 : 0;
+    est->slope_window = 8;
+    est->slope_tol = 0.5;
     for (size_t j = 0; j < n; ++j) {
         est->p[j] = p[j];
         est->gain[j] = gains[j];
@@ -126,11 +158,13 @@ int pim_est_step(pim_estimator *est, double v, double y, double *rhat_used, doub
         est->have_rev = 1.0;
         est->dir = -est->dir;
         est->v_ext = v;
+        est->nseg = 0.0;
         usable = 1;
     }
 
     /* 3. principal case and modified error */
     int used = 0;
+    if (usable && !est_slope_ok(est)) usable = 0;
     if (usable) {
         const double s = est->dir, d = fabs(v - est->v_rev);
         double phi[PIM_MAX_PLAYS], ybar = 0.0;
@@ -166,6 +200,11 @@ int pim_est_step(pim_estimator *est, double v, double y, double *rhat_used, doub
         }
     }
     est->time += est->dt;
+    est->nseg += 1.0;
+    const int h = (int)est->head;
+    est->vbuf[h] = v;
+    est->ybuf[h] = y;
+    est->head = (double)((h + 1) % PIM_EST_WIN);
     return used;
 }
 
@@ -196,6 +235,10 @@ void pim_est_get_state(const pim_estimator *est, double *state)
     s[5] = est->have_rev;
     s[6] = est->started;
     s[7] = est->time;
+    s[8] = est->nseg;
+    s[9] = est->head;
+    memcpy(s + 10, est->vbuf, PIM_EST_WIN * sizeof(double));
+    memcpy(s + 10 + PIM_EST_WIN, est->ybuf, PIM_EST_WIN * sizeof(double));
 }
 
 const char *pim_est_set_state(pim_estimator *est, const double *state)
@@ -220,5 +263,9 @@ const char *pim_est_set_state(pim_estimator *est, const double *state)
     est->have_rev = s[5];
     est->started = s[6];
     est->time = s[7];
+    est->nseg = s[8];
+    est->head = (s[9] >= 0.0 && s[9] < PIM_EST_WIN) ? (double)(int)s[9] : 0.0;
+    memcpy(est->vbuf, s + 10, PIM_EST_WIN * sizeof(double));
+    memcpy(est->ybuf, s + 10 + PIM_EST_WIN, PIM_EST_WIN * sizeof(double));
     return NULL;
 }

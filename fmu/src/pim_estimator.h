@@ -17,6 +17,12 @@
  *      interior play was saturated at the reversal (else its state is unknown: minor loops),
  *      and only when d is at least `guard` away from every breakpoint 2 rhat_j (a sample near a
  *      breakpoint may be misclassified, which biases the estimate under noise).
+ *      Slope check (slope_window m > 0): the measured output change over the m samples before
+ *      k (within the segment; y[k] itself is not used, so the choice does not correlate with
+ *      the current noise) must match the case model's change within slope_tol * min p_j per
+ *      unit of travel; otherwise the regime read from rhat is wrong (an overestimated radius
+ *      whose true play is already on its envelope) and the sample is skipped.  Without this
+ *      check a radius overestimate can run away.
  *      Case model   ybar = sum_{on} p_j (v - s rhat_j) + sum_{interior} p_j (v_rev + s rhat_j),
  *      modified error e_delta = ybar - y = s phi^T (r - rhat),  phi_j = +p_j (on), -p_j (interior)
  *   4. gradient law with projection:
@@ -36,6 +42,8 @@
 extern "C" {
 #endif
 
+#define PIM_EST_WIN 64 /* ring buffer for the slope check (max window + 1) */
+
 typedef struct {
     /* parameters */
     size_t n;
@@ -47,6 +55,8 @@ typedef struct {
     double anneal_time; /* gain annealing time constant [s], <= 0: constant gains */
     double guard;       /* samples with |d - 2 rhat_j| < guard for some j are not used */
     int known_linear;   /* rhat_1 fixed at 0 */
+    int slope_window;   /* samples of the slope check window (0: no check) */
+    double slope_tol;   /* tolerated slope mismatch, in units of the smallest weight */
     /* state (see pim_est_get_state for the flat layout) */
     double rhat[PIM_MAX_PLAYS];
     double zhat[PIM_MAX_PLAYS];
@@ -59,10 +69,13 @@ typedef struct {
     double have_rev; /* 1 once a reversal has been seen */
     double started;  /* 1 once a sample has been processed */
     double time;     /* elapsed time k*dt [s] */
+    double nseg;     /* samples seen since the last reversal */
+    double head;     /* ring buffer position */
+    double vbuf[PIM_EST_WIN], ybuf[PIM_EST_WIN]; /* last inputs and outputs */
 } pim_estimator;
 
-/* Flat state length: 3n + 8 doubles. */
-#define PIM_EST_STATE_SIZE(n) (3 * (n) + 8)
+/* Flat state length: 3n + 10 + 2 PIM_EST_WIN doubles. */
+#define PIM_EST_STATE_SIZE(n) (3 * (n) + 10 + 2 * PIM_EST_WIN)
 
 /*
  * Initialise: n plays with weights p (> 0), gains (>= 0), initial radii rhat0 (projected onto
@@ -90,6 +103,10 @@ PIM_API long pim_est_run(pim_estimator *est, size_t N, const double *v, const do
 
 PIM_API size_t pim_est_sizeof(void);
 PIM_API void pim_est_get_state(const pim_estimator *est, double *state);
+/* Slope check settings (see above); window 0 disables it, at most PIM_EST_WIN - 1.  Returns
+ * NULL or a message.  pim_est_init sets window 8, tolerance 0.5. */
+PIM_API const char *pim_est_set_slope_check(pim_estimator *est, int window, double tol);
+
 /* Returns NULL or a message if the state is not admissible (non-finite, unordered radii). */
 PIM_API const char *pim_est_set_state(pim_estimator *est, const double *state);
 
