@@ -7,7 +7,7 @@ import argparse
 import importlib
 import sys
 
-COMMANDS = ["simulate", "identify", "demo", "study"]
+COMMANDS = ["simulate", "identify", "fmu", "demo", "study"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,224 @@
+"""Build the pimodel FMUs (FMI 2.0 Co-Simulation, Linux binary + sources) with a C compiler.
+
+Each FMU holds ``modelDescription.xml``, ``binaries/linux64/<id>.so``, ``sources/`` (our C core
+and FMI glue plus a one-line ``model.c`` selecting the unit, listed in the model description
+and in ``sources/buildDescription.xml`` so that ``fmpy compile`` rebuilds it elsewhere) and
+``documentation/index.html``. The FMI headers come from the installed fmpy (``fmpy/c-code``).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import tempfile
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+from xml.sax.saxutils import escape
+
+NMAX = 16  # declared array variables per FMU (p[1..16], r[1..16], r_hat[1..16])
+CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
+HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h")
+GLUE = "fmi2_pimodel.c"
+CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-O2", "-fPIC",
+          "-shared"]
+
+SAMPLING = ("Internal sample k at time k*Ts; doStep(t, h) processes every sample with k*Ts in "
+            "[t, t+h) using the inputs set before the call; outputs hold the last sample's "
+            "values.")
+
+
+@dataclass(frozen=True)
+class Var:
+    name: str
+    vr: int
+    kind: str  # Real, Integer, Boolean
+    causality: str  # parameter, input, output
+    start: str
+    description: str
+
+
+def _arrays(prefix: str, base: int, causality: str, start: str, what: str) -> list[Var]:
+    return [Var(f"{prefix}[{i + 1}]", base + i, "Real", causality, start, f"{what} {i + 1}")
+            for i in range(NMAX)]
+
+
+def _common() -> list[Var]:
+    return [
+        Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (> 0)"),
+        Var("n", 1, "Integer", "parameter", "1", f"number of plays, 1 <= n <= {NMAX}"),
+        Var("z0", 2, "Real", "parameter", "0", "initial play state (input unit)"),
+        *_arrays("p", 100, "parameter", "1", "weight p (> 0), play"),
+    ]
+
+
+MODELS: dict[str, dict] = {
+    "PIHysteresis": {
+        "id": 1,
+        "description": "Prandtl-Ishlinskii operator y = sum p_i Gamma_{r_i}[v] (pimodel C core)",
+        "vars": [*_common(), *_arrays("r", 200, "parameter", "0", "radius r (>= 0, sorted), play"),
+                 Var("v", 10, "Real", "input", "0", "input v (e.g. V)"),
+                 Var("y", 11, "Real", "output", "0", "output y (e.g. um)")],
+    },
+    "RadiusEstimator": {
+        "id": 2,
+        "description": "Adaptive estimation of the play radii (gradient law with projection)",
+        "vars": [*_common(), *_arrays("r", 200, "parameter", "0", "initial radius estimate, play"),
+                 Var("gain", 4, "Real", "parameter", "10", "adaptation gain (>= 0)"),
+                 Var("known_linear", 5, "Boolean", "parameter", "false",
+                     "hold r_hat[1] = 0 (known linear play)"),
+                 Var("guard", 6, "Real", "parameter", "0", "breakpoint guard band (input unit)"),
+                 Var("slope_window", 7, "Integer", "parameter", "8",
+                     "slope check window in samples (0: off)"),
+                 Var("v", 10, "Real", "input", "0", "actuator input v"),
+                 Var("y", 12, "Real", "input", "0", "measured output y"),
+                 Var("y_hat", 11, "Real", "output", "0", "model output"),
+                 Var("e", 13, "Real", "output", "0", "estimation error y_hat - y"),
+                 *_arrays("r_hat", 300, "output", "0", "radius estimate, play")],
+    },
+    "InversePI": {
+        "id": 3,
+        "description": "Exact inverse PI compensator, fixed radii or adaptive (r_hat inputs)",
+        "vars": [*_common(), *_arrays("r", 200, "parameter", "0", "radius (fixed mode), play"),
+                 Var("adaptive", 3, "Boolean", "parameter", "false",
+                     "take the radii from the r_hat inputs at every sample"),
+                 Var("y_d", 10, "Real", "input", "0", "desired output"),
+                 Var("v", 11, "Real", "output", "0", "compensator output (actuator input)"),
+                 *_arrays("r_hat", 300, "input", "0", "radius input (adaptive mode), play")],
+    },
+}
+
+
+def guid(name: str) -> str:
+    """Fixed GUID of a unit (changes with the interface version)."""
+    import uuid
+
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi2/{name}/v1")) + "}"
+
+
+def source_dir() -> Path:
+    """The C sources: ``fmu/src`` beside the package (editable install) or packaged copy."""
+    here = Path(__file__).resolve()
+    for cand in (here.parents[2] / "fmu" / "src", here.parent / "src"):
+        if (cand / GLUE).exists():
+            return cand
+    raise FileNotFoundError("pimodel FMU sources (fmu/src) not found; install pimodel from a "
+                            "source checkout ('pip install -e .')")
+
+
+def fmi_headers() -> Path:
+    import fmpy
+
+    path = Path(fmpy.__file__).parent / "c-code"
+    if not (path / "fmi2Functions.h").exists():
+        raise FileNotFoundError(f"FMI 2 headers not found in {path} (fmpy installation)")
+    return path
+
+
+def find_compiler() -> str:
+    """A C compiler on PATH ($CC, cc, gcc or clang); RuntimeError naming them when none."""
+    for cand in (os.environ.get("CC"), "cc", "gcc", "clang"):
+        if cand and shutil.which(cand):
+            return cand
+    raise RuntimeError("no C compiler found: set CC or put cc, gcc or clang on PATH")
+
+
+def model_description(name: str) -> str:
+    spec = MODELS[name]
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<fmiModelDescription fmiVersion="2.0" modelName="{name}" guid="{guid(name)}" '
+        f'description="{escape(spec["description"])}" generationTool="pimodel" '
+        'variableNamingConvention="structured" numberOfEventIndicators="0">',
+        f'  <CoSimulation modelIdentifier="{name}" canHandleVariableCommunicationStepSize="true"'
+        ' canGetAndSetFMUstate="true" canSerializeFMUstate="true"'
+        ' canNotUseMemoryManagementFunctions="true" canInterpolateInputs="false">',
+        "    <SourceFiles>",
+        '      <File name="model.c"/>',
+        *[f'      <File name="{s}"/>' for s in CORE_SOURCES],
+        "    </SourceFiles>",
+        "  </CoSimulation>",
+        '  <LogCategories><Category name="logStatusError" description="errors"/></LogCategories>',
+        '  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>',
+        "  <ModelVariables>",
+    ]
+    outputs = []
+    for idx, v in enumerate(spec["vars"], start=1):
+        if v.causality == "parameter":
+            attrs = 'causality="parameter" variability="fixed" initial="exact"'
+        elif v.causality == "input":
+            attrs = 'causality="input" variability="discrete"'
+        else:
+            attrs = 'causality="output" variability="discrete" initial="exact"'
+            outputs.append(idx)
+        lines.append(f'    <ScalarVariable name="{v.name}" valueReference="{v.vr}" {attrs} '
+                     f'description="{escape(v.description)}"><{v.kind} start="{v.start}"/>'
+                     "</ScalarVariable>")
+    lines += ["  </ModelVariables>", "  <ModelStructure>", "    <Outputs>"]
+    lines += [f'      <Unknown index="{i}"/>' for i in outputs]
+    lines += ["    </Outputs>", "  </ModelStructure>", "</fmiModelDescription>", ""]
+    return "\n".join(lines)
+
+
+def build_description(name: str) -> str:
+    files = "\n".join(f'        <SourceFile name="{s}"/>' for s in ("model.c", *CORE_SOURCES))
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n<fmiBuildDescription fmiVersion="3.0">\n'
+        f'  <BuildConfiguration modelIdentifier="{name}">\n'
+        '    <SourceFileSet language="C99">\n'
+        f"{files}\n"
+        "    </SourceFileSet>\n  </BuildConfiguration>\n</fmiBuildDescription>\n"
+    )
+
+
+def _model_c(name: str) -> str:
+    return (f"/* {name}: selects the unit in the shared FMI 2 glue. */\n"
+            f"#define PIM_MODEL {MODELS[name]['id']}\n"
+            f'#define PIM_MODEL_GUID "{guid(name)}"\n'
+            f'#include "{GLUE}"\n')
+
+
+def _documentation(name: str) -> str:
+    spec = MODELS[name]
+    rows = "".join(f"<tr><td>{v.name}</td><td>{v.causality}</td><td>{escape(v.description)}"
+                   "</td></tr>" for v in spec["vars"] if "[" not in v.name or "[1]" in v.name)
+    return (f"<html><body><h1>{name}</h1><p>{escape(spec['description'])}.</p>"
+            f"<p>{escape(SAMPLING)} Arrays are declared up to index {NMAX}; the first n are "
+            "used. Bad parameters or non-finite inputs return fmi2Error with a logged message."
+            f"</p><table>{rows}</table></body></html>\n")
+
+
+def build_fmus(out_dir, which=None, *, compiler: str | None = None) -> list[Path]:
+    """Compile and package the FMUs named in ``which`` (default all) into ``out_dir``."""
+    names = list(MODELS) if which is None else list(which)
+    unknown = [n for n in names if n not in MODELS]
+    if unknown:
+        raise ValueError(f"which: unknown FMU(s) {unknown}; available: {list(MODELS)}")
+    cc = compiler or find_compiler()
+    src, inc = source_dir(), fmi_headers()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name in names:
+        with tempfile.TemporaryDirectory() as tmp:
+            tmp = Path(tmp)
+            (tmp / "model.c").write_text(_model_c(name))
+            for f in (GLUE, *CORE_SOURCES, *HEADERS):
+                shutil.copy(src / f, tmp / f)
+            so = tmp / f"{name}.so"
+            cmd = [cc, *CFLAGS, "-I", str(tmp), "-I", str(inc), str(tmp / "model.c"),
+                   *[str(tmp / s) for s in CORE_SOURCES], "-o", str(so), "-lm"]
+            proc = subprocess.run(cmd, capture_output=True, text=True)
+            if proc.returncode != 0:
+                raise RuntimeError(f"compiling {name} failed:\n{proc.stderr}")
+            fmu = out / f"{name}.fmu"
+            with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
+                z.writestr("modelDescription.xml", model_description(name))
+                z.write(so, f"binaries/linux64/{name}.so")
+                for f in ("model.c", GLUE, *CORE_SOURCES, *HEADERS):
+                    z.write(tmp / f, f"sources/{f}")
+                z.writestr("sources/buildDescription.xml", build_description(name))
+                z.writestr("documentation/index.html", _documentation(name))
+            paths.append(fmu)
+    return paths
