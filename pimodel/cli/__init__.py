@@ -7,7 +7,7 @@ import argparse
 import importlib
 import sys
 
-COMMANDS = ["simulate", "identify", "fmu", "demo", "study"]
+COMMANDS = ["simulate", "identify", "fmu", "diagnose", "demo", "study"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,205 @@
+"""Candidate augmentations of the nominal PI model, each a physical model with few parameters.
+
+The hysteresis is represented by the play outputs ``Z`` of a fixed radius grid (the conventional
+parametrisation, linear in the weights), so every candidate is fitted *jointly* with the
+hysteresis weights by linear least squares on the train records (a nonlinear parameter such as
+a mode frequency or a delay is chosen on a grid by the train residual). A candidate adds ``k``
+parameters to the nominal model (for the information criterion on the validate records).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.signal import cont2discrete, lfilter, lfilter_zi
+
+from ..operator import PIOperator
+
+CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
+MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
+MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
+MAX_DELAY_S = 1e-3
+EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift")
+
+
+@dataclass
+class Segment:
+    """One record: time [s], input, measured output, play outputs ``Z`` of the radius grid."""
+
+    t: np.ndarray
+    v: np.ndarray
+    y: np.ndarray
+    Z: np.ndarray
+
+    @property
+    def dt(self) -> float:
+        return float(self.t[1] - self.t[0])
+
+
+def make_segment(t, v, y, radii) -> Segment:
+    Z = PIOperator(np.ones(len(radii)), radii).play_outputs(v)
+    return Segment(t, v, y, Z)
+
+
+def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
+    """First-order lag (exact discretisation), at rest around x[0]; works column-wise."""
+    a = np.exp(-dt / tau)
+    zi = np.atleast_1d(a * x[0])[None, :] if x.ndim > 1 else [a * x[0]]
+    out, _ = lfilter([1 - a], [1, -a], x, axis=0, zi=zi)
+    return out
+
+
+def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
+    """Unit-gain second-order mode (zero-order-hold discretisation, as a DAC drives the stage),
+    at rest around x[0]; works column-wise."""
+    w = 2 * np.pi * fn
+    num, den, _ = cont2discrete(([w * w], [1.0, 2 * zeta * w, w * w]), dt, method="zoh")
+    b, a = np.ravel(num), np.ravel(den)
+    b = b / a[0]
+    a = a / a[0]
+    zi = lfilter_zi(b, a)
+    zi = zi[:, None] * x[0][None, :] if x.ndim > 1 else zi * x[0]
+    out, _ = lfilter(b, a, x, axis=0, zi=zi)
+    return out
+
+
+def shift(x: np.ndarray, d: int) -> np.ndarray:
+    if d == 0:
+        return x
+    pad = np.repeat(x[:1], d, axis=0)
+    return np.concatenate((pad, x[: x.shape[0] - d]), axis=0)
+
+
+@dataclass
+class Model:
+    """A fitted (nominal or augmented) model: ``features(seg) @ coef``."""
+
+    name: str
+    k: int
+    features: object = field(repr=False)
+    coef: np.ndarray = field(repr=False, default=None)
+    params: dict = field(default_factory=dict)
+    grid: dict = field(default_factory=dict)
+
+    def predict(self, seg: Segment) -> np.ndarray:
+        return self.features(seg) @ self.coef
+
+
+def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
+    A = np.vstack([features(s) for s in train])
+    y = np.concatenate([s.y for s in train])
+    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+    rss = float(np.sum((A @ coef - y) ** 2))
+    return Model(name, k, features, coef, params or {}), rss
+
+
+def _ones(s: Segment) -> np.ndarray:
+    return np.ones((s.t.size, 1))
+
+
+def base_features(s: Segment) -> np.ndarray:
+    return np.hstack((s.Z, _ones(s)))
+
+
+def fit_nominal(train) -> Model:
+    model = _fit("nominal", 0, base_features, train)[0]
+    h = np.concatenate([model.predict(s) for s in train])
+    model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12)}
+    return model
+
+
+def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None = None,
+               nominal: Model | None = None) -> Model:
+    """Fit the nominal model augmented with the effects ``combo + (name,)`` jointly; the grid
+    parameters of the effects in ``combo`` are held at ``fixed`` (from earlier rounds)."""
+    return _fit_combo((*combo, name), train, dict(fixed or {}), nominal or fit_nominal(train))
+
+
+def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> Model:
+    grids = [[()]]
+    for e in effects:
+        if e == "dynamics" and "fn" in fixed:
+            grids.append([(("fn", fixed["fn"]), ("zeta", fixed["zeta"]))])
+        elif e == "delay" and "d" in fixed:
+            grids.append([(("d", fixed["d"]),)])
+        elif e == "dynamics":
+            grids.append([(("fn", f), ("zeta", z)) for f in MODE_HZ for z in MODE_DAMPING])
+        elif e == "delay":
+            dt = train[0].dt
+            grids.append([(("d", d),) for d in range(0, int(round(MAX_DELAY_S / dt)) + 1)])
+    # Cartesian product of the nonlinear grids (at most dynamics x delay)
+    combos = [()]
+    for g in grids[1:]:
+        combos = [c + x for c in combos for x in g]
+    best = None
+    for nl in combos:
+        p = dict(nl)
+        feats = _combo_features(effects, p, nominal)
+        k = _combo_k(effects)
+        model, rss = _fit("+".join(effects), k, feats, train, p)
+        if best is None or rss < best[1]:
+            best = (model, rss)
+    if "dynamics" in effects and "fn" not in fixed:  # refine the mode around the grid optimum
+        f0, z0 = best[0].params["fn"], best[0].params["zeta"]
+        for f in f0 * np.linspace(0.88, 1.12, 13):
+            for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0]):
+                p = {**best[0].params, "fn": float(f), "zeta": float(z)}
+                model, rss = _fit("+".join(effects), _combo_k(effects),
+                                  _combo_features(effects, p, nominal), train, p)
+                if rss < best[1]:
+                    best = (model, rss)
+    model = best[0]
+    model.grid = dict(model.params)
+    model.params = _describe(effects, model, nominal)
+    return model
+
+
+def _combo_k(effects) -> int:
+    return sum({"creep": len(CREEP_TAUS), "dynamics": 2, "delay": 1, "asymmetry": 2,
+                "drift": 1}[e] for e in effects)
+
+
+def _combo_features(effects, p, nominal: Model):
+    def feats(s: Segment) -> np.ndarray:
+        Z = s.Z
+        if "dynamics" in effects:
+            Z = mode(Z, p["fn"], p["zeta"], s.dt)
+        if "delay" in effects:
+            Z = shift(Z, p["d"])
+        cols = [Z, _ones(s)]
+        h0 = nominal.predict(s)
+        if "creep" in effects:
+            cols.append(np.column_stack([lag(h0, tau, s.dt) - h0 for tau in CREEP_TAUS]))
+        if "asymmetry" in effects:
+            c = nominal.params["center"]
+            u = (h0 - c) / nominal.params["half_range"]
+            cols.append(np.column_stack((u**2, u**3)))
+        if "drift" in effects:
+            cols.append((s.t - s.t[0])[:, None])
+        return np.hstack(cols)
+
+    return feats
+
+
+def _describe(effects, model: Model, nominal: Model) -> dict:
+    out: dict = {}
+    n = nominal.coef.size - 1
+    extra = model.coef[n + 1:]
+    i = 0
+    for e in effects:
+        if e == "creep":
+            out["creep_lag_gains"] = extra[i:i + len(CREEP_TAUS)].tolist()
+            out["creep_time_constants_s"] = list(CREEP_TAUS)
+            i += len(CREEP_TAUS)
+        elif e == "asymmetry":
+            out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
+            i += 2
+        elif e == "drift":
+            out["drift_per_s"] = float(extra[i])
+            i += 1
+    if "fn" in model.params:
+        out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
+    if "d" in model.params:
+        out["delay_samples"] = model.params["d"]
+    return out

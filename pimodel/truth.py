@@ -1,0 +1,133 @@
+"""Truth simulator for tests and studies: a piezo stage with PI hysteresis (optionally
+asymmetric) plus any combination of unmodelled effects, and a set of excitations.
+
+Signal path, sampled at ``dt``: ``v -> PI -> h -> asymmetry -> creep -> mode -> delay -> + drift
++ noise -> y``. Magnitudes follow real piezo stages: creep 1-2 % of the last move per decade of
+time, first mode 0.5-3 kHz with damping 0.02-0.1, delays of tens to hundreds of microseconds,
+sensor noise of a few nm to 0.1 um. This module only generates data; the diagnosis never
+imports it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+from scipy.signal import lfilter, lfilter_zi
+
+from .actuators import creep_per_decade, delay_samples, second_order_mode
+from .data import Record
+from .operator import PIOperator
+
+STAGE_WEIGHTS = (6.3460, 1.6735, 1.1552, 0.4477)
+STAGE_RADII = (0.0, 0.1945, 0.4826, 0.5707)
+EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift")
+
+
+@dataclass
+class Truth:
+    """A simulated stage. ``None`` switches an effect off."""
+
+    weights: tuple = STAGE_WEIGHTS
+    radii: tuple = STAGE_RADII
+    creep_percent_per_decade: float | None = None
+    mode_hz: float | None = None
+    mode_damping: float = 0.05
+    delay_s: float | None = None
+    asymmetry: float | None = None  # quadratic output term, fraction of the half range
+    drift_um_per_s: float | None = None
+    noise_um: float = 0.005
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def effects(self) -> list[str]:
+        on = {"creep": self.creep_percent_per_decade, "dynamics": self.mode_hz,
+              "delay": self.delay_s, "asymmetry": self.asymmetry,
+              "drift": self.drift_um_per_s}
+        return [k for k, v in on.items() if v is not None]
+
+    def simulate(self, t: np.ndarray, v: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t`` [s]."""
+        dt = float(t[1] - t[0])
+        y = PIOperator(self.weights, self.radii).simulate(v)
+        if self.asymmetry is not None:
+            half = 0.5 * float(np.sum(self.weights)) * 1.0
+            y = y + self.asymmetry * (y**2) / half
+        if self.creep_percent_per_decade is not None:
+            y = _filter(creep_per_decade(self.creep_percent_per_decade, t_min=0.01, decades=4),
+                        y, dt)
+        if self.mode_hz is not None:
+            y = _filter(second_order_mode(self.mode_hz, self.mode_damping), y, dt)
+        if self.delay_s is not None:
+            d = delay_samples(self.delay_s, dt)
+            y = np.concatenate((np.full(d, y[0]), y[: y.size - d])) if d else y
+        if self.drift_um_per_s is not None:
+            y = y + self.drift_um_per_s * (t - t[0])
+        return y + rng.normal(0.0, self.noise_um, y.size)
+
+    def record(self, t, v, seed: int, name: str = "truth") -> Record:
+        return Record(t, v, self.simulate(t, v, np.random.default_rng(seed)), source=name)
+
+
+def _filter(G, x: np.ndarray, dt: float) -> np.ndarray:
+    """Apply a continuous SISO system (ZOH-discretised) to ``x``, starting at rest around x[0]."""
+    Gd = control.c2d(control.tf(G), dt, method="zoh")
+    a = np.ravel(Gd.den[0][0])
+    b = np.ravel(Gd.num[0][0])
+    b = np.concatenate((np.zeros(a.size - b.size), b))  # coefficients of z^0, z^-1, ...
+    out, _ = lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])
+    return out
+
+
+def excitation(kind: str, *, fs: float = 10_000.0, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Standard excitations (input in V, peak 1 V): ``train`` (triangles at 2 and 20 Hz, minor
+    loops, steps with 0.2 s holds) and ``validate`` (sines at 5 and 40 Hz, minor loops, steps
+    with holds), each about 2.5 s."""
+    rng = np.random.default_rng(seed)
+    dt = 1.0 / fs
+    parts = []
+
+    def tri(freq, amp, periods):
+        n = int(round(periods * fs / freq))
+        tt = np.arange(n) * dt
+        ph = (tt * freq + 0.25) % 1.0
+        return -amp * (4 * np.abs(ph - 0.5) - 1)
+
+    def sine(freq, amp, periods):
+        tt = np.arange(int(round(periods * fs / freq))) * dt
+        return amp * np.sin(2 * np.pi * freq * tt)
+
+    def steps(levels, hold):
+        return np.concatenate([np.full(int(round(hold * fs)), lv) for lv in levels])
+
+    lv = rng.uniform(-0.9, 0.9, 6)
+    if kind == "train":
+        parts = [tri(2, 1.0, 2), tri(20, 1.0, 10), tri(20, 0.5, 6), steps(lv, 0.2)]
+    elif kind == "validate":
+        parts = [sine(5, 1.0, 3), sine(40, 1.0, 16), sine(40, 0.6, 8), steps(lv, 0.2)]
+    else:
+        raise ValueError(f"kind: expected 'train' or 'validate', got {kind!r}")
+    v = np.concatenate(parts)
+    return np.arange(v.size) * dt, v
+
+
+def random_truth(effects, seed: int) -> Truth:
+    """A truth with the named effects at random realistic magnitudes (seeded)."""
+    rng = np.random.default_rng(1000 + seed)
+    unknown = set(effects) - set(EFFECTS)
+    if unknown:
+        raise ValueError(f"effects: unknown {sorted(unknown)}; known: {EFFECTS}")
+    kw = {}
+    if "creep" in effects:
+        kw["creep_percent_per_decade"] = rng.uniform(1.0, 2.0)
+    if "dynamics" in effects:
+        kw["mode_hz"] = rng.uniform(500, 3000)
+        kw["mode_damping"] = rng.uniform(0.02, 0.1)
+    if "delay" in effects:
+        kw["delay_s"] = rng.uniform(100e-6, 400e-6)
+    if "asymmetry" in effects:
+        kw["asymmetry"] = rng.uniform(0.03, 0.08) * rng.choice([-1, 1])
+    if "drift" in effects:
+        kw["drift_um_per_s"] = rng.uniform(0.05, 0.15) * rng.choice([-1, 1])
+    return Truth(noise_um=rng.uniform(0.003, 0.01), **kw)
