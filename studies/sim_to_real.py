@@ -3,7 +3,7 @@ real piezo record.
 
 For each effect (and two pairs, and a clean PI stage) the truth simulator generates train and
 validate records with seeded random magnitudes; the diagnosis never sees the effect's name.
-Full size: 10 seeds per case; ``--quick``: 2 seeds, no pairs.
+Full size: 10 seeds per case; ``--quick``: 1 seed, no pairs.
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ def real_record(out: Path):
 def run(out: Path, quick: bool = False) -> StudyResult:
     from tqdm import tqdm
 
-    seeds = range(2 if quick else 10)
+    seeds = range(1 if quick else 10)
     res = StudyResult("sim_to_real")
     rows, numbers = [], {}
     cases = withheld_cases(quick)

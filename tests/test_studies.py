@@ -1,0 +1,75 @@
+"""Every study runs in its reduced size (--quick) and its numbers meet the issues' bounds; the
+figures exist."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from pimodel.cli import main
+from pimodel.study_runner import available_studies, run_study
+
+
+def test_all_studies_are_listed():
+    assert set(available_studies()) >= {"paper_simulation", "paper_experiment", "compensation",
+                                        "cosimulation", "sim_to_real", "real_data"}
+
+
+def _run(name, tmp_path):
+    res = run_study(name, tmp_path / name, quick=True)
+    out = tmp_path / name
+    assert (out / "results.md").exists() and (out / "results.json").exists()
+    for fig in res.figures:
+        assert fig.exists() and fig.stat().st_size > 10_000  # a real PNG, not an empty canvas
+    return res
+
+
+def test_paper_simulation(tmp_path):
+    res = _run("paper_simulation", tmp_path)
+    assert res.numbers["noise_free_max_rel_error"] < 0.01
+
+
+def test_paper_experiment(tmp_path):
+    n = _run("paper_experiment", tmp_path).numbers
+    for k in ("conventional_4", "conventional_7", "conventional_10"):
+        assert n["proposed"]["max"] < n[k]["max"]
+
+
+def test_compensation(tmp_path):
+    tab = _run("compensation", tmp_path).numbers
+    prop, none = tab["proposed n=4"], tab["none (gain)"]
+    assert prop["mode"]["max"] * 10 <= none["mode"]["max"]
+    assert prop["mode+PID"]["max"] < none["mode+PID"]["max"]
+    for n in (4, 7, 10):
+        assert prop["mode"]["max"] < tab[f"conventional n={n}"]["mode"]["max"]
+
+
+def test_cosimulation(tmp_path):
+    assert _run("cosimulation", tmp_path).numbers["max_difference"] < 1e-12
+
+
+def test_real_data(tmp_path):
+    n = _run("real_data", tmp_path).numbers
+    if n.get("skipped"):
+        pytest.skip("shared real record absent")
+    assert n["adaptive (BIC)"]["held_out_rms"] < n["conventional n=10"]["held_out_rms"]
+
+
+def test_sim_to_real(tmp_path):
+    n = _run("sim_to_real", tmp_path).numbers
+    for case, d in n.items():
+        if case == "real":
+            continue
+        assert d["hits"] == d["n"], case
+        if case != "none (clean PI)":
+            assert d["min_shrink"] >= 0.5, case
+
+
+def test_cli_study_list_and_unknown(tmp_path, capsys):
+    assert main(["study", "--list"]) == 0
+    assert "compensation" in capsys.readouterr().out
+    assert main(["study", "nope", "--out", str(tmp_path)]) == 2
+    assert main(["study", "compensation", "--quick", "--out", str(tmp_path / "c")]) == 0
+    data = json.loads((tmp_path / "c" / "results.json").read_text())
+    assert data["quick"] is True
