@@ -19,12 +19,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from ..data import Record
 from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment
 from .where import residual_breakdown
 
 N_GRID = 20
+MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
+MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
@@ -102,6 +105,11 @@ def _check(records: list[Record], role: str) -> None:
 def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 3
              ) -> DiagnosisReport:
     """Diagnose the gap between a PI model fitted on ``train`` and the ``validate`` records."""
+    with threadpool_limits(1, user_api="blas"):
+        return _diagnose(train, validate, max_effects)
+
+
+def _diagnose(train: list[Record], validate: list[Record], max_effects: int) -> DiagnosisReport:
     _check(train, "train")
     _check(validate, "validate")
     dts = [(r.source, r.dt) for r in train + validate]
@@ -164,7 +172,7 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         if best is None:
             break
         dbic, name, m, o = best
-        if dbic > -10 or _errors(va, o)["rms"] > 0.9 * rms_now:
+        if dbic > -MIN_BIC_DROP or _errors(va, o)["rms"] > (1 - MIN_RMS_CUT) * rms_now:
             break
         chosen += (name,)
         fixed.update(m.grid)

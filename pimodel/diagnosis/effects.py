@@ -50,18 +50,36 @@ def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
     return out
 
 
+def mode_coefficients(fn: float, zeta: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """ZOH discretisation ``(b, a)`` of the unit-gain mode ``w^2 / (s^2 + 2 zeta w s + w^2)``.
+
+    Underdamped modes use the closed form (the discrete step response equals the sampled
+    continuous one); others fall back to :func:`scipy.signal.cont2discrete`."""
+    w = 2 * np.pi * fn
+    if zeta >= 1.0:
+        num, den, _ = cont2discrete(([w * w], [1.0, 2 * zeta * w, w * w]), dt, method="zoh")
+        b, a = np.ravel(num), np.ravel(den)
+        return b / a[0], a / a[0]
+    sigma, wd = zeta * w, w * np.sqrt(1 - zeta * zeta)
+
+    def step(t):
+        return 1 - np.exp(-sigma * t) * (np.cos(wd * t) + sigma / wd * np.sin(wd * t))
+
+    a1, a2 = -2 * np.exp(-sigma * dt) * np.cos(wd * dt), np.exp(-2 * sigma * dt)
+    s1, s2 = step(dt), step(2 * dt)
+    return np.array([0.0, s1, s2 + a1 * s1 - s1]), np.array([1.0, a1, a2])
+
+
 def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
     """Unit-gain second-order mode (zero-order-hold discretisation, as a DAC drives the stage),
-    at rest around x[0]; works column-wise."""
-    w = 2 * np.pi * fn
-    num, den, _ = cont2discrete(([w * w], [1.0, 2 * zeta * w, w * w]), dt, method="zoh")
-    b, a = np.ravel(num), np.ravel(den)
-    b = b / a[0]
-    a = a / a[0]
+    at rest around x[0]; works column-wise: ``out[k]`` depends on ``x[0..k-1]``."""
+    b, a = mode_coefficients(fn, zeta, dt)
     zi = lfilter_zi(b, a)
-    zi = zi[:, None] * x[0][None, :] if x.ndim > 1 else zi * x[0]
-    out, _ = lfilter(b, a, x, axis=0, zi=zi)
-    return out
+    if x.ndim == 1:
+        return lfilter(b, a, x, zi=zi * x[0])[0]
+    xt = np.ascontiguousarray(x.T)
+    out, _ = lfilter(b, a, xt, axis=-1, zi=zi[None, :] * xt[:, :1])
+    return out.T
 
 
 def shift(x: np.ndarray, d: int) -> np.ndarray:
@@ -87,10 +105,17 @@ class Model:
 
 
 def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
-    A = np.vstack([features(s) for s in train])
-    y = np.concatenate([s.y for s in train])
-    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
-    rss = float(np.sum((A @ coef - y) ** 2))
+    """Least squares over all train records through the normal equations (columns scaled to
+    unit norm; the Gram matrix is small), so a grid search costs one pass over the data per
+    point; the residual sum of squares is computed from the residuals themselves."""
+    blocks = [features(s) for s in train]
+    G = sum(A.T @ A for A in blocks)
+    g = sum(A.T @ s.y for A, s in zip(blocks, train, strict=True))
+    d = np.sqrt(np.diag(G))
+    d[d == 0] = 1.0
+    c, *_ = np.linalg.lstsq(G / d[:, None] / d[None, :], g / d, rcond=1e-13)
+    coef = c / d
+    rss = float(sum(np.sum((A @ coef - s.y) ** 2) for A, s in zip(blocks, train, strict=True)))
     return Model(name, k, features, coef, params or {}), rss
 
 
@@ -133,9 +158,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     for g in grids[1:]:
         combos = [c + x for c in combos for x in g]
     best = None
+    static: dict = {}
     for nl in combos:
         p = dict(nl)
-        feats = _combo_features(effects, p, nominal)
+        feats = _combo_features(effects, p, nominal, static)
         k = _combo_k(effects)
         model, rss = _fit("+".join(effects), k, feats, train, p)
         if best is None or rss < best[1]:
@@ -146,7 +172,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0]):
                 p = {**best[0].params, "fn": float(f), "zeta": float(z)}
                 model, rss = _fit("+".join(effects), _combo_k(effects),
-                                  _combo_features(effects, p, nominal), train, p)
+                                  _combo_features(effects, p, nominal, static), train, p)
                 if rss < best[1]:
                     best = (model, rss)
     model = best[0]
@@ -160,24 +186,32 @@ def _combo_k(effects) -> int:
                 "drift": 1}[e] for e in effects)
 
 
-def _combo_features(effects, p, nominal: Model):
+def _combo_features(effects, p, nominal: Model, static: dict):
+    """Feature builder for the effects with grid parameters ``p``; the columns that do not
+    depend on ``p`` (offset, creep, asymmetry, drift) are memoised per segment in ``static``."""
+
+    def static_columns(s: Segment) -> np.ndarray:
+        key = id(s)
+        if key not in static:
+            cols = [_ones(s)]
+            h0 = nominal.predict(s)
+            if "creep" in effects:
+                cols.append(np.column_stack([lag(h0, tau, s.dt) - h0 for tau in CREEP_TAUS]))
+            if "asymmetry" in effects:
+                u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
+                cols.append(np.column_stack((u**2, u**3)))
+            if "drift" in effects:
+                cols.append((s.t - s.t[0])[:, None])
+            static[key] = (s, np.hstack(cols))  # keep s alive so its id stays unique
+        return static[key][1]
+
     def feats(s: Segment) -> np.ndarray:
         Z = s.Z
         if "dynamics" in effects:
             Z = mode(Z, p["fn"], p["zeta"], s.dt)
         if "delay" in effects:
             Z = shift(Z, p["d"])
-        cols = [Z, _ones(s)]
-        h0 = nominal.predict(s)
-        if "creep" in effects:
-            cols.append(np.column_stack([lag(h0, tau, s.dt) - h0 for tau in CREEP_TAUS]))
-        if "asymmetry" in effects:
-            c = nominal.params["center"]
-            u = (h0 - c) / nominal.params["half_range"]
-            cols.append(np.column_stack((u**2, u**3)))
-        if "drift" in effects:
-            cols.append((s.t - s.t[0])[:, None])
-        return np.hstack(cols)
+        return np.hstack((Z, static_columns(s)))
 
     return feats
 
