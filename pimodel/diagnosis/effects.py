@@ -19,7 +19,7 @@ from ..operator import PIOperator
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
 MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
-MAX_DELAY_S = 1e-3
+MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift")
 
 
@@ -141,40 +141,49 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
     return _fit_combo((*combo, name), train, dict(fixed or {}), nominal or fit_nominal(train))
 
 
+def delay_grid(dt: float) -> np.ndarray:
+    """Coarse delay grid [samples]: every sample up to 12, then geometric up to MAX_DELAY_S."""
+    dmax = max(int(round(MAX_DELAY_S / dt)), 1)
+    coarse = np.concatenate((np.arange(min(dmax, 12) + 1), np.geomspace(12, dmax, 24)))
+    return np.unique(np.round(coarse).astype(int)[coarse <= dmax])
+
+
 def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> Model:
-    grids = [[()]]
-    for e in effects:
-        if e == "dynamics" and "fn" in fixed:
-            grids.append([(("fn", fixed["fn"]), ("zeta", fixed["zeta"]))])
-        elif e == "delay" and "d" in fixed:
-            grids.append([(("d", fixed["d"]),)])
-        elif e == "dynamics":
-            grids.append([(("fn", f), ("zeta", z)) for f in MODE_HZ for z in MODE_DAMPING])
-        elif e == "delay":
-            dt = train[0].dt
-            grids.append([(("d", d),) for d in range(0, int(round(MAX_DELAY_S / dt)) + 1)])
-    # Cartesian product of the nonlinear grids (at most dynamics x delay)
-    combos = [()]
-    for g in grids[1:]:
-        combos = [c + x for c in combos for x in g]
-    best = None
+    """Joint fit; the nonlinear parameters (mode, delay) by grid search on the train RSS, then
+    refined around the grid optimum."""
+    name, k = "+".join(effects), _combo_k(effects)
     static: dict = {}
-    for nl in combos:
-        p = dict(nl)
-        feats = _combo_features(effects, p, nominal, static)
-        k = _combo_k(effects)
-        model, rss = _fit("+".join(effects), k, feats, train, p)
-        if best is None or rss < best[1]:
-            best = (model, rss)
+
+    def search(points, best=None):
+        for p in points:
+            model, rss = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)
+            if best is None or rss < best[1]:
+                best = (model, rss)
+        return best
+
+    grids: list[list[dict]] = []
+    for e in effects:
+        if e == "dynamics":
+            grids.append([{"fn": fixed["fn"], "zeta": fixed["zeta"]}] if "fn" in fixed else
+                         [{"fn": f, "zeta": z} for f in MODE_HZ for z in MODE_DAMPING])
+        elif e == "delay":
+            grids.append([{"d": fixed["d"]}] if "d" in fixed else
+                         [{"d": int(d)} for d in delay_grid(train[0].dt)])
+    points = [{}]
+    for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
+        points = [{**a, **b} for a in points for b in g]
+    best = search(points)
+    if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
+        grid = delay_grid(train[0].dt)
+        i = int(np.searchsorted(grid, best[0].params["d"]))
+        lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+        best = search([{**best[0].params, "d": int(d)} for d in range(lo, hi + 1)
+                       if d not in grid], best)
     if "dynamics" in effects and "fn" not in fixed:  # refine the mode around the grid optimum
         f0, z0 = best[0].params["fn"], best[0].params["zeta"]
-        for f in f0 * np.linspace(0.88, 1.12, 13):
-            for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0]):
-                p = {**best[0].params, "fn": float(f), "zeta": float(z)}
-                model, rss = _fit("+".join(effects), _combo_k(effects),
-                                  _combo_features(effects, p, nominal, static), train, p)
-                if rss < best[1]:
-                    best = (model, rss)
+        best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
+                       for f in f0 * np.linspace(0.88, 1.12, 13)
+                       for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0])], best)
     model = best[0]
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
