@@ -68,8 +68,9 @@ def run(out: Path, quick: bool = False) -> StudyResult:
                             ["case", "setting", "r1", "r2", "r3", "r4", "r5",
                              "max error [%]"], rows))
     res.numbers = numbers
-    res.notes.append("Goals: 1 % noise-free, 5 % at SNR 20 dB, 10 % at SNR 10 dB; the 10 dB "
-                     "goal is out of reach of the data (README, estimator section).")
+    res.notes.append("Goals: 1 % noise-free, 5 % at SNR 20 dB, 10 % at SNR 10 dB. This table is "
+                     "seed 0; at 10 dB seeds 1 and 2 give 14.9 % and 20.3 %, so the 10 dB goal "
+                     "is not met in general (README, estimator section).")
     return res
 
 

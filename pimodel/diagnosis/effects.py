@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import minimize
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
@@ -184,6 +185,21 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
                        for f in f0 * np.linspace(0.88, 1.12, 13)
                        for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0])], best)
+    if "dynamics" in effects and "fn" not in fixed:  # continuous polish: a light mode's
+        # resonance is narrower than the grid
+        base = dict(best[0].params)
+
+        def cost(x):
+            p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
+            return _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[1]
+
+        x0 = np.log([base["fn"], base["zeta"]])
+        r = minimize(cost, x0, method="Nelder-Mead", options={
+            "initial_simplex": [x0, x0 + [0.03, 0], x0 + [0, 0.2]], "xatol": 1e-4,
+            "fatol": 1e-9 * best[1], "maxfev": 60})
+        if r.fun < best[1]:
+            best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
+                          best)
     model = best[0]
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
