@@ -32,10 +32,12 @@ def test_withheld_single_effect(effect):
     assert v["shrink"] >= 0.5
 
 
-def test_withheld_pair():
-    train, validate = records(["creep", "asymmetry"], 3)
+@pytest.mark.parametrize("pair,seed", [(("creep", "asymmetry"), 3), (("dynamics", "drift"), 1)])
+def test_withheld_pair(pair, seed):
+    # seed 1 of dynamics+drift: a light 2 kHz mode (damping 0.02), narrower than the mode grid
+    train, validate = records(list(pair), seed)
     v = diagnose(train, validate).verdict
-    assert sorted(v["effects"]) == ["asymmetry", "creep"]
+    assert sorted(v["effects"]) == sorted(pair)
     assert v["shrink"] >= 0.5
 
 
@@ -90,5 +92,7 @@ def test_real_record_diagnosis(real_record_path):
     mid = k0 + (len(rec) - k0) // 2
     rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)])
     v = rep.verdict
-    assert v["effects"] != ["none"]  # the real stage is not a clean PI operator
-    assert v["gap_after"] < v["gap_before"]
+    # the real stage is not a clean PI operator: its output lags the voltage by about 12 ms
+    assert v["effects"] == ["delay"]
+    assert 0.008 < v["model"]["delay_samples"] * rec.dt < 0.016
+    assert v["shrink"] >= 0.5

@@ -20,6 +20,8 @@ from ..operator import PIOperator
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
 MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
+MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
+MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift")
 
@@ -162,11 +164,13 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                 best = (model, rss)
         return best
 
+    fmax = MAX_MODE_NYQUIST * 0.5 / train[0].dt  # a sampled mode must stay below Nyquist
     grids: list[list[dict]] = []
     for e in effects:
         if e == "dynamics":
+            fgrid = [f for f in MODE_HZ if f <= fmax] or [fmax]
             grids.append([{"fn": fixed["fn"], "zeta": fixed["zeta"]}] if "fn" in fixed else
-                         [{"fn": f, "zeta": z} for f in MODE_HZ for z in MODE_DAMPING])
+                         [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in delay_grid(train[0].dt)])
@@ -184,13 +188,17 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         f0, z0 = best[0].params["fn"], best[0].params["zeta"]
         best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
                        for f in f0 * np.linspace(0.88, 1.12, 13)
-                       for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0])], best)
+                       for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0])
+                       if f <= fmax and MODE_DAMPING_RANGE[0] <= z <= MODE_DAMPING_RANGE[1]],
+                      best)
     if "dynamics" in effects and "fn" not in fixed:  # continuous polish: a light mode's
         # resonance is narrower than the grid
         base = dict(best[0].params)
 
         def cost(x):
             p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
+            if p["fn"] > fmax or not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
+                return np.inf
             return _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[1]
 
         x0 = np.log([base["fn"], base["zeta"]])
