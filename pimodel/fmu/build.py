@@ -19,7 +19,7 @@ from xml.sax.saxutils import escape
 
 NMAX = 16  # declared array variables per FMU (p[1..16], r[1..16], r_hat[1..16])
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
-HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h")
+HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_unit.h")
 GLUE = "fmi2_pimodel.c"
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-O2", "-fPIC",
           "-shared"]
