@@ -1,4 +1,4 @@
-"""Any FMI 2.0 co-simulation FMU as a discrete-time python-control block.
+"""Any FMI 2.0 or 3.0 co-simulation FMU as a discrete-time python-control block.
 
 ``fmu_block(path, dt, ...)`` returns a ``control.NonlinearIOSystem`` whose inputs and outputs
 are the FMU's (by name). Semantics: at step k the block sets the inputs ``u[k]`` and calls
@@ -17,6 +17,16 @@ from ..checks import positive_scalar
 from .unit import FMUUnit
 
 
+def _signals(unit: FMUUnit, causality: str) -> list[str]:
+    """Scalar signal names of that causality; FMI 3 arrays as ``name[1]`` ... ``name[N]``."""
+    names = []
+    for v in unit.md.modelVariables:
+        if v.causality == causality:
+            size = unit._size(v) if v.dimensions else 0
+            names += [f"{v.name}[{i + 1}]" for i in range(size)] if size else [v.name]
+    return names
+
+
 def fmu_block(path, dt: float, *, start: dict | None = None, inputs=None, outputs=None,
               name: str | None = None) -> control.NonlinearIOSystem:
     """Wrap the FMU at ``path`` (communication step ``dt``) as a python-control block.
@@ -29,8 +39,8 @@ def fmu_block(path, dt: float, *, start: dict | None = None, inputs=None, output
     unit = FMUUnit(path, start, instance_name=name or "fmu")
     if not unit.md.coSimulation.canGetAndSetFMUstate:
         raise ValueError(f"{unit.path.name}: the wrapper needs canGetAndSetFMUstate")
-    ins = inputs or [v.name for v in unit.md.modelVariables if v.causality == "input"]
-    outs = outputs or [v.name for v in unit.md.modelVariables if v.causality == "output"]
+    ins = inputs or _signals(unit, "input")
+    outs = outputs or _signals(unit, "output")
     for n in (*ins, *outs):
         unit._var(n)  # KeyError naming the variable when absent
 
@@ -49,6 +59,7 @@ def fmu_block(path, dt: float, *, start: dict | None = None, inputs=None, output
         advance(u)
         y = unit.get(outs)
         unit.set_state(saved)
+        unit.free_state(saved)
         return y
 
     sys = control.nlsys(upd, out, inputs=list(ins), outputs=list(outs),

@@ -20,7 +20,8 @@ from xml.sax.saxutils import escape
 NMAX = 16  # declared array variables per FMU (p[1..16], r[1..16], r_hat[1..16])
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
 HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_unit.h")
-GLUE = "fmi2_pimodel.c"
+GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
+FMI_VERSIONS = tuple(GLUE)
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-O2", "-fPIC",
           "-shared"]
 
@@ -101,7 +102,7 @@ def source_dir() -> Path:
     """The C sources: ``fmu/src`` beside the package (editable install) or packaged copy."""
     here = Path(__file__).resolve()
     for cand in (here.parents[2] / "fmu" / "src", here.parent / "src"):
-        if (cand / GLUE).exists():
+        if (cand / GLUE["2.0"]).exists():
             return cand
     raise FileNotFoundError("pimodel FMU sources (fmu/src) not found; install pimodel from a "
                             "source checkout ('pip install -e .')")
@@ -172,11 +173,16 @@ def build_description(name: str) -> str:
     )
 
 
-def _model_c(name: str) -> str:
-    return (f"/* {name}: selects the unit in the shared FMI 2 glue. */\n"
-            f"#define PIM_MODEL {MODELS[name]['id']}\n"
-            f'#define PIM_MODEL_GUID "{guid(name)}"\n'
-            f'#include "{GLUE}"\n')
+def _model_c(name: str, fmi_version: str) -> str:
+    if fmi_version == "3.0":
+        from .fmi3 import token
+
+        ident = f'#define PIM_MODEL_TOKEN "{token(name)}"\n'
+    else:
+        ident = f'#define PIM_MODEL_GUID "{guid(name)}"\n'
+    return (f"/* {name}: selects the unit in the shared FMI {fmi_version} glue. */\n"
+            f"#define PIM_MODEL {MODELS[name]['id']}\n{ident}"
+            f'#include "{GLUE[fmi_version]}"\n')
 
 
 def _documentation(name: str) -> str:
@@ -185,38 +191,54 @@ def _documentation(name: str) -> str:
                    "</td></tr>" for v in spec["vars"] if "[" not in v.name or "[1]" in v.name)
     return (f"<html><body><h1>{name}</h1><p>{escape(spec['description'])}.</p>"
             f"<p>{escape(SAMPLING)} Arrays are declared up to index {NMAX}; the first n are "
-            "used. Bad parameters or non-finite inputs return fmi2Error with a logged message."
+            "used. Bad parameters or non-finite inputs return an error status (fmi2Error, "
+            "fmi3Error) with a logged message."
             f"</p><table>{rows}</table></body></html>\n")
 
 
-def build_fmus(out_dir, which=None, *, compiler: str | None = None) -> list[Path]:
-    """Compile and package the FMUs named in ``which`` (default all) into ``out_dir``."""
+def build_fmus(out_dir, which=None, *, compiler: str | None = None,
+               fmi_version: str = "2.0") -> list[Path]:
+    """Compile and package the FMUs named in ``which`` (default all) into ``out_dir``.
+
+    ``fmi_version``: ``"2.0"`` (files ``NAME.fmu``) or ``"3.0"`` (files ``NAME_fmi3.fmu``,
+    arrays as FMI 3 arrays); the model identifier is ``NAME`` in both."""
     names = list(MODELS) if which is None else list(which)
     unknown = [n for n in names if n not in MODELS]
     if unknown:
         raise ValueError(f"which: unknown FMU(s) {unknown}; available: {list(MODELS)}")
+    if fmi_version not in GLUE:
+        raise ValueError(f"fmi_version: expected one of {FMI_VERSIONS}, got {fmi_version!r}")
     cc = compiler or find_compiler()
     src, inc = source_dir(), fmi_headers()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    glue = GLUE[fmi_version]
+    if fmi_version == "3.0":
+        from .fmi3 import PLATFORM
+        from .fmi3 import model_description3 as describe
+
+        platform, suffix = PLATFORM, "_fmi3"
+    else:
+        describe, platform, suffix = model_description, "linux64", ""
     paths = []
     for name in names:
         with tempfile.TemporaryDirectory() as tmp:
             tmp = Path(tmp)
-            (tmp / "model.c").write_text(_model_c(name))
-            for f in (GLUE, *CORE_SOURCES, *HEADERS):
+            (tmp / "model.c").write_text(_model_c(name, fmi_version))
+            for f in (glue, *CORE_SOURCES, *HEADERS):
                 shutil.copy(src / f, tmp / f)
             so = tmp / f"{name}.so"
             cmd = [cc, *CFLAGS, "-I", str(tmp), "-I", str(inc), str(tmp / "model.c"),
                    *[str(tmp / s) for s in CORE_SOURCES], "-o", str(so), "-lm"]
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if proc.returncode != 0:
-                raise RuntimeError(f"compiling {name} failed:\n{proc.stderr}")
-            fmu = out / f"{name}.fmu"
+                raise RuntimeError(f"compiling {name} (FMI {fmi_version}) failed:\n"
+                                   f"{proc.stderr}")
+            fmu = out / f"{name}{suffix}.fmu"
             with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
-                z.writestr("modelDescription.xml", model_description(name))
-                z.write(so, f"binaries/linux64/{name}.so")
-                for f in ("model.c", GLUE, *CORE_SOURCES, *HEADERS):
+                z.writestr("modelDescription.xml", describe(name))
+                z.write(so, f"binaries/{platform}/{name}.so")
+                for f in ("model.c", glue, *CORE_SOURCES, *HEADERS):
                     z.write(tmp / f, f"sources/{f}")
                 z.writestr("sources/buildDescription.xml", build_description(name))
                 z.writestr("documentation/index.html", _documentation(name))

@@ -1,5 +1,8 @@
-"""A small co-simulation handle on an FMI 2.0 CS unit (ours or any other), over fmpy's
-``FMU2Slave``: parameters and signals by name, fixed-step stepping, state save/restore."""
+"""A small co-simulation handle on an FMI 2.0 or 3.0 CS unit (ours or any other), over fmpy's
+``FMU2Slave`` / ``FMU3Slave``: parameters and signals by name, fixed-step stepping, state
+save/restore. FMI 3 arrays are set whole by their name (``"p": [...]``, shorter sequences fill
+the first elements) or element-wise with the FMI 2 style names (``"p[2]"``), so the same
+names drive both versions."""
 
 from __future__ import annotations
 
@@ -16,6 +19,7 @@ from fmpy.fmi2 import (
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
 )
+from fmpy.fmi3 import FMU3Slave
 
 
 class FMUUnit:
@@ -37,20 +41,29 @@ class FMUUnit:
         self._dir = extract(str(self.path), tempfile.mkdtemp(prefix="pimodel_fmu_"))
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.log: list[str] = []
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self._dir,
-                             modelIdentifier=self.md.coSimulation.modelIdentifier,
-                             instanceName=instance_name)
-        self._callbacks = fmi2CallbackFunctions()
-        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._logger)
-        self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        self.fmu.instantiate(loggingOn=True, callbacks=self._callbacks)
-        self.fmu.setupExperiment(startTime=0.0)
-        self.fmu.enterInitializationMode()
+        self.fmi3 = self.md.fmiVersion.startswith("3")
+        ident = self.md.coSimulation.modelIdentifier
+        if self.fmi3:
+            self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=self._dir,
+                                 modelIdentifier=ident, instanceName=instance_name)
+            self.fmu.instantiate(loggingOn=True, logMessage=self._logger3)
+            self.fmu.enterInitializationMode(startTime=0.0)
+        else:
+            self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self._dir,
+                                 modelIdentifier=ident, instanceName=instance_name)
+            self._callbacks = fmi2CallbackFunctions()
+            self._callbacks.logger = fmi2CallbackLoggerTYPE(self._logger)
+            self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+            self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+            self.fmu.instantiate(loggingOn=True, callbacks=self._callbacks)
+            self.fmu.setupExperiment(startTime=0.0)
+            self.fmu.enterInitializationMode()
         if start:
             self.set(start)
         try:
             self.fmu.exitInitializationMode()
+            if self.fmi3:
+                self.fmu.enterStepMode()
         except Exception as exc:
             self.fmu.freeInstance()
             raise ValueError(f"{self.path.name}: initialisation failed: "
@@ -60,29 +73,66 @@ class FMUUnit:
     def _logger(self, env, instance, status, category, message) -> None:
         self.log.append(message.decode(errors="replace") if message else "")
 
+    def _logger3(self, env, status, category, message) -> None:
+        self.log.append(message.decode(errors="replace") if message else "")
+
     def _var(self, name: str):
-        try:
-            return self.vars[name]
-        except KeyError:
-            raise KeyError(f"{self.path.name}: no variable {name!r}") from None
+        """(variable, element index or None) for ``name`` or an FMI 3 element ``base[i]``."""
+        if name in self.vars:
+            return self.vars[name], None
+        base, _, rest = name.partition("[")
+        v = self.vars.get(base)
+        if v is not None and v.dimensions and rest.endswith("]") and rest[:-1].isdigit():
+            i = int(rest[:-1]) - 1
+            if 0 <= i < self._size(v):
+                return v, i
+        raise KeyError(f"{self.path.name}: no variable {name!r}")
+
+    @staticmethod
+    def _size(v) -> int:
+        return int(np.prod([int(d.start) for d in v.dimensions]))
+
+    def _get_array(self, v) -> np.ndarray:
+        return np.array(self.fmu.getFloat64([v.valueReference], nValues=self._size(v)))
 
     def set(self, values: dict) -> None:
-        """Set variables by name (Real, Integer or Boolean)."""
+        """Set variables by name (Real/Float64, Integer/Int32 or Boolean)."""
         for name, value in values.items():
-            v = self._var(name)
-            if v.type == "Real":
-                self.fmu.setReal([v.valueReference], [float(value)])
-            elif v.type == "Integer":
-                self.fmu.setInteger([v.valueReference], [int(value)])
+            v, i = self._var(name)
+            vr = [v.valueReference]
+            if v.dimensions:
+                arr = self._get_array(v)
+                if i is None:
+                    x = np.atleast_1d(np.asarray(value, float))
+                    if x.size > arr.size:
+                        raise ValueError(f"{name}: at most {arr.size} values, got {x.size}")
+                    arr[: x.size] = x
+                else:
+                    arr[i] = float(value)
+                self.fmu.setFloat64(vr, list(arr))
+            elif v.type in ("Real", "Float64"):
+                (self.fmu.setFloat64 if self.fmi3 else self.fmu.setReal)(vr, [float(value)])
+            elif v.type in ("Integer", "Int32"):
+                (self.fmu.setInt32 if self.fmi3 else self.fmu.setInteger)(vr, [int(value)])
             elif v.type == "Boolean":
-                self.fmu.setBoolean([v.valueReference], [bool(value)])
+                self.fmu.setBoolean(vr, [bool(value)])
             else:
                 raise TypeError(f"{name}: unsupported type {v.type}")
 
     def get(self, names) -> np.ndarray:
-        """Real values of the named variables."""
-        refs = [self._var(n).valueReference for n in names]
-        return np.array(self.fmu.getReal(refs))
+        """Real values of the named variables (FMI 3 array elements as ``base[i]``)."""
+        if not self.fmi3:
+            return np.array(self.fmu.getReal([self._var(n)[0].valueReference for n in names]))
+        out, arrays = [], {}
+        for name in names:
+            v, i = self._var(name)
+            if v.dimensions:
+                if v.name not in arrays:
+                    arrays[v.name] = self._get_array(v)
+                out.extend(arrays[v.name] if i is None else [arrays[v.name][i]])
+            else:
+                out.append(self.fmu.getFloat64([v.valueReference])[0])
+        return np.array(out)
 
     def step(self, h: float) -> None:
         """One communication step of length ``h`` from the current time."""
@@ -99,6 +149,9 @@ class FMUUnit:
     def set_state(self, state) -> None:
         self.fmu.setFMUState(state[0])
         self.time = state[1]
+
+    def free_state(self, state) -> None:
+        self.fmu.freeFMUState(state[0])
 
     def close(self) -> None:
         try:
