@@ -60,7 +60,8 @@ def run(out: Path, quick: bool = False) -> StudyResult:
     ax[0, 0].bar(np.arange(len(rows)), [r[2] for r in rows], color="tab:orange", width=0.5,
                  label="major loops")
     ax[0, 0].set_xticks(np.arange(len(rows)), labels, rotation=45, fontsize=7)
-    ax[0, 0].set(ylabel="max error [um]", title="Proposed n = 4 against conventional n")
+    ax[0, 0].set(xlabel="model (identified from the 1 Hz triangle)", ylabel="max error [um]",
+                 title="Proposed n = 4 against conventional n")
     ax[0, 0].legend()
     ax[0, 1].plot(vm, ym, lw=1.0, color="0.3", label="stage (truth)")
     ax[0, 1].plot(vm, prop.predict(vm), "--", lw=0.8, label="proposed n = 4")

@@ -73,3 +73,20 @@ def test_cli_study_list_and_unknown(tmp_path, capsys):
     assert main(["study", "compensation", "--quick", "--out", str(tmp_path / "c")]) == 0
     data = json.loads((tmp_path / "c" / "results.json").read_text())
     assert data["quick"] is True
+
+
+def test_unreadable_figure_is_refused(tmp_path):
+    """Every figure goes through save_figure, which refuses unlabelled axes and missing
+    legends; the studies and the demo above therefore only write readable figures."""
+    from pimodel.plotting import new_figure, readability_problems, save_figure
+
+    fig, ax = new_figure()
+    ax[0, 0].plot([0, 1], [0, 1], label="a")
+    ax[0, 0].plot([0, 1], [1, 0], label="b")
+    assert len(readability_problems(fig)) == 3
+    with pytest.raises(ValueError, match="bad.png: figure not readable: .*no x label"):
+        save_figure(fig, tmp_path / "bad.png")
+    fig, ax = new_figure()
+    ax[0, 0].plot([0, 1], [0, 1], label="a")
+    ax[0, 0].set(xlabel="t [s]", ylabel="y [um]")
+    assert save_figure(fig, tmp_path / "ok.png").exists()

@@ -43,7 +43,8 @@ def plot_diagnosis(rep, out_dir, *, prefix: str = "", units=("V", "um")) -> list
     ax[0, 1].barh(np.arange(len(names)), conc, color="tab:orange", label="energy / sample share")
     ax[0, 1].axvline(1.0, color="0.4", lw=0.8, label="uniform")
     ax[0, 1].set_yticks(np.arange(len(names)), names, fontsize=7)
-    ax[0, 1].set(xlabel="residual concentration [-]", title="Where the nominal residual lies")
+    ax[0, 1].set(xlabel="residual concentration [-]", ylabel="region of the validate records",
+                 title="Where the nominal residual lies")
     ax[0, 1].legend(fontsize=7)
     paths.append(save_figure(fig, out / f"{prefix}loops_and_regions.png"))
     return paths
