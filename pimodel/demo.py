@@ -31,7 +31,7 @@ from .signals import major_minor_loops, triangle
 FS_ID = 1000.0  # Hz, identification record
 FS_LOOP = 10_000.0  # Hz, compensation loops
 NOISE_UM = 0.005
-GAIN = 50.0  # estimator gain in the co-simulated loop [1/(um^2 s)]
+GAIN = 50.0  # estimator gain in the co-simulated loop
 
 
 def _md_table(header: list[str], rows: list[list]) -> str:
@@ -137,53 +137,31 @@ def step_compensate(out: Path, models: dict) -> tuple[dict, str]:
 
 def step_fmu(out: Path, weights) -> tuple[dict, str]:
     """Build the FMUs and co-simulate the adaptive compensation loop; compare with native."""
-    from . import RadiusEstimator
     from .fmu import build_fmus
-    from .fmu.cosim import cosimulate_adaptive_loop
+    from .fmu.compare import compare_with_native, plot_comparison
 
-    dt = 1 / FS_LOOP
     fmu_dir = out / "fmus"
     t0 = time.perf_counter()
     paths = build_fmus(fmu_dir)
     t_build = time.perf_counter() - t0
-    t, v = triangle(1.0, 5, fs=FS_LOOP, duration=1.0)
-    yd = STAGE.simulate(v)
-    G = stage_dynamics(dt, fn_hz=1000, damping=0.05)
     n = len(weights)
     r0 = [0.0, *np.linspace(0.3, 0.8, n - 1).round(3).tolist()]  # deliberately wrong start
-    t0 = time.perf_counter()
-    co = cosimulate_adaptive_loop(fmu_dir, yd, dt, STAGE, weights=weights, gain=GAIN,
-                                  initial_radii=r0, dynamics=G)
-    t_co = time.perf_counter() - t0
-    est = RadiusEstimator(weights, dt=dt, gains=GAIN, initial_radii=r0, known_linear_play=True)
-    native = run_loop(yd, STAGE, dt, dynamics=G, feedforward="adaptive", estimator=est)
-    diff = float(np.max(np.abs(co.y - native.y)))
-    fig, ax = new_figure(2, 1)
-    for i in range(1, n):
-        ax[0, 0].plot(t, co.radii[:, i], label=f"r_hat[{i + 1}] (FMU)")
-    for r in STAGE.radii[1:]:
-        ax[0, 0].axhline(r, color="0.6", ls="--", lw=0.6)
-    ax[0, 0].set(xlabel="time t [s]", ylabel="radius estimate [V]",
-                 title="RadiusEstimator FMU in the loop (dashed: truth)")
-    ax[0, 0].legend(fontsize=8)
-    ax[0, 1].plot(t, co.error, lw=0.8, label="FMU co-simulation")
-    ax[0, 1].plot(t, native.error, "--", lw=0.8, label="native compiled loop")
-    ax[0, 1].set(xlabel="time t [s]", ylabel="tracking error [um]",
-                 title="Adaptive inverse compensation")
-    ax[0, 1].legend(fontsize=8)
-    save_figure(fig, out / "fmu_cosimulation.png")
-    nums = {"fmus": [p.name for p in paths], "build_s": t_build, "steps": t.size,
-            "cosim_steps_per_s": t.size / t_co, "max_abs_difference_um": diff,
-            "final_radii": co.radii[-1].tolist(),
-            "tracking_last_20_percent": co.tracking(int(0.8 * t.size))}
+    cmp = compare_with_native(fmu_dir, duration=1.0, weights=weights, initial_radii=r0,
+                              gain=GAIN)
+    plot_comparison(cmp, out / "fmu_cosimulation.png")
+    co, steps = cmp.cosim, cmp.cosim.t.size
+    nums = {"fmus": [p.name for p in paths], "build_s": t_build, "steps": steps,
+            "cosim_steps_per_s": cmp.cosim_steps_per_s,
+            "max_abs_difference_um": cmp.max_difference, "final_radii": co.radii[-1].tolist(),
+            "tracking_last_20_percent": co.tracking(int(0.8 * steps))}
     text = (
         "## 3. FMU co-simulation\n\n"
         f"Built {', '.join(nums['fmus'])} (FMI 2.0 co-simulation, C) into `fmus/` in "
         f"{t_build:.1f} s. A fixed-step master runs plant FMU + 1 kHz mode + RadiusEstimator "
         "FMU + adaptive InversePI FMU (weights from step 1) on a 5 Hz triangle, the estimator "
-        f"starting from wrong radii {r0}: {t.size} steps at "
+        f"starting from wrong radii {r0}: {steps} steps at "
         f"{nums['cosim_steps_per_s']:.0f} steps/s; largest difference "
-        f"from the native compiled loop {diff:.1e} um; final radii "
+        f"from the native compiled loop {cmp.max_difference:.1e} um; final radii "
         f"{np.round(co.radii[-1], 4).tolist()} V (truth {STAGE.radii.tolist()}); tracking "
         f"error over the last 20 %: max {nums['tracking_last_20_percent']['max_percent']:.2f} % "
         "of range.\n\n![FMU co-simulation](fmu_cosimulation.png)\n\n"
