@@ -215,3 +215,11 @@ def test_cli_builds_fmi3(tmp_path):
     assert main(["fmu", "build", "--out", str(tmp_path), "--which", "InversePI",
                  "--fmi-version", "3.0"]) == 0
     assert validate_fmu(str(tmp_path / "InversePI_fmi3.fmu")) == []
+
+
+def test_bad_build_and_cosim_version(tmp_path):
+    with pytest.raises(ValueError, match="fmi_version: expected one of"):
+        build_fmus(tmp_path, fmi_version="4.0")
+    with pytest.raises(ValueError, match="fmi_version: expected '2.0' or '3.0'"):
+        cosimulate_adaptive_loop(tmp_path, [0.0, 1.0], 1e-3, STAGE, weights=STAGE.weights,
+                                 gain=1.0, initial_radii=STAGE.radii, fmi_version="1.0")
