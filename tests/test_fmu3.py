@@ -220,6 +220,6 @@ def test_cli_builds_fmi3(tmp_path):
 def test_bad_build_and_cosim_version(tmp_path):
     with pytest.raises(ValueError, match="fmi_version: expected one of"):
         build_fmus(tmp_path, fmi_version="4.0")
-    with pytest.raises(ValueError, match="fmi_version: expected '2.0' or '3.0'"):
+    with pytest.raises(ValueError, match="fmi_version: expected one of"):
         cosimulate_adaptive_loop(tmp_path, [0.0, 1.0], 1e-3, STAGE, weights=STAGE.weights,
                                  gain=1.0, initial_radii=STAGE.radii, fmi_version="1.0")

@@ -165,6 +165,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         return best
 
     fmax = MAX_MODE_NYQUIST * 0.5 / train[0].dt  # a sampled mode must stay below Nyquist
+    dgrid = delay_grid(train[0].dt)
     grids: list[list[dict]] = []
     for e in effects:
         if e == "dynamics":
@@ -173,26 +174,25 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
-                         [{"d": int(d)} for d in delay_grid(train[0].dt)])
+                         [{"d": int(d)} for d in dgrid])
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
     best = search(points)
     if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
-        grid = delay_grid(train[0].dt)
-        i = int(np.searchsorted(grid, best[0].params["d"]))
-        lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+        i = int(np.searchsorted(dgrid, best[0].params["d"]))
+        lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
         best = search([{**best[0].params, "d": int(d)} for d in range(lo, hi + 1)
-                       if d not in grid], best)
-    if "dynamics" in effects and "fn" not in fixed:  # refine the mode around the grid optimum
+                       if d not in dgrid], best)
+    if "dynamics" in effects and "fn" not in fixed:
+        # refine the mode around the grid optimum, then polish it continuously (a light
+        # mode's resonance is narrower than the grid)
         f0, z0 = best[0].params["fn"], best[0].params["zeta"]
         best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
                        for f in f0 * np.linspace(0.88, 1.12, 13)
                        for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0])
                        if f <= fmax and MODE_DAMPING_RANGE[0] <= z <= MODE_DAMPING_RANGE[1]],
                       best)
-    if "dynamics" in effects and "fn" not in fixed:  # continuous polish: a light mode's
-        # resonance is narrower than the grid
         base = dict(best[0].params)
 
         def cost(x):

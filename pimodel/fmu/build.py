@@ -22,6 +22,20 @@ CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
 HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
 FMI_VERSIONS = tuple(GLUE)
+SUFFIX = {"2.0": "", "3.0": "_fmi3"}  # file NAME{suffix}.fmu per FMI version
+
+
+def check_fmi_version(fmi_version: str) -> str:
+    """``fmi_version`` if supported, else ValueError naming the supported ones."""
+    if fmi_version not in GLUE:
+        raise ValueError(f"fmi_version: expected one of {FMI_VERSIONS}, got {fmi_version!r}")
+    return fmi_version
+
+
+def fmu_filename(name: str, fmi_version: str = "2.0") -> str:
+    """File name of a unit's FMU as :func:`build_fmus` writes it (``NAME.fmu``,
+    ``NAME_fmi3.fmu``)."""
+    return f"{name}{SUFFIX[check_fmi_version(fmi_version)]}.fmu"
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-O2", "-fPIC",
           "-shared"]
 
@@ -206,8 +220,7 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
     unknown = [n for n in names if n not in MODELS]
     if unknown:
         raise ValueError(f"which: unknown FMU(s) {unknown}; available: {list(MODELS)}")
-    if fmi_version not in GLUE:
-        raise ValueError(f"fmi_version: expected one of {FMI_VERSIONS}, got {fmi_version!r}")
+    check_fmi_version(fmi_version)
     cc = compiler or find_compiler()
     src, inc = source_dir(), fmi_headers()
     out = Path(out_dir)
@@ -217,9 +230,9 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
         from .fmi3 import PLATFORM
         from .fmi3 import model_description3 as describe
 
-        platform, suffix = PLATFORM, "_fmi3"
+        platform = PLATFORM
     else:
-        describe, platform, suffix = model_description, "linux64", ""
+        describe, platform = model_description, "linux64"
     paths = []
     for name in names:
         with tempfile.TemporaryDirectory() as tmp:
@@ -234,7 +247,7 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
             if proc.returncode != 0:
                 raise RuntimeError(f"compiling {name} (FMI {fmi_version}) failed:\n"
                                    f"{proc.stderr}")
-            fmu = out / f"{name}{suffix}.fmu"
+            fmu = out / fmu_filename(name, fmi_version)
             with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
                 z.writestr("modelDescription.xml", describe(name))
                 z.write(so, f"binaries/{platform}/{name}.so")

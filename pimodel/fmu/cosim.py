@@ -17,6 +17,7 @@ import numpy as np
 
 from ..loops import LoopResult
 from ..operator import PIOperator
+from .build import fmu_filename
 from .unit import FMUUnit
 
 
@@ -31,20 +32,19 @@ def cosimulate_adaptive_loop(fmu_dir, ref, dt: float, plant: PIOperator, *, weig
     """Run the adaptive compensation loop with the three FMUs in ``fmu_dir`` (as written by
     :func:`~pimodel.fmu.build_fmus` for that ``fmi_version``)."""
     fmu_dir = Path(fmu_dir)
-    sfx = {"2.0": "", "3.0": "_fmi3"}.get(fmi_version)
-    if sfx is None:
-        raise ValueError(f"fmi_version: expected '2.0' or '3.0', got {fmi_version!r}")
+    files = {name: fmu_dir / fmu_filename(name, fmi_version)
+             for name in ("PIHysteresis", "RadiusEstimator", "InversePI")}
     ref = np.asarray(ref, float)
     w = np.asarray(weights, float)
     n = w.size
-    plant_fmu = FMUUnit(fmu_dir / f"PIHysteresis{sfx}.fmu", {
+    plant_fmu = FMUUnit(files["PIHysteresis"], {
         "Ts": dt, "n": plant.n, **_arrays("p", plant.weights), **_arrays("r", plant.radii)},
         instance_name="plant")
-    est = FMUUnit(fmu_dir / f"RadiusEstimator{sfx}.fmu", {
+    est = FMUUnit(files["RadiusEstimator"], {
         "Ts": dt, "n": n, "gain": gain, "known_linear": known_linear, "guard": guard,
         "slope_window": slope_window, **_arrays("p", w), **_arrays("r", initial_radii)},
         instance_name="estimator")
-    inv = FMUUnit(fmu_dir / f"InversePI{sfx}.fmu", {
+    inv = FMUUnit(files["InversePI"], {
         "Ts": dt, "n": n, "adaptive": True, **_arrays("p", w)}, instance_name="inverse")
     if dynamics is not None:
         dyn = control.ss(dynamics)

@@ -57,7 +57,7 @@ def model_description3(name: str) -> str:
         if causality == "parameter":
             attrs = 'causality="parameter" variability="fixed"'
         elif causality == "input":
-            attrs = f'causality="input" variability="{"discrete"}"'
+            attrs = 'causality="input" variability="discrete"'
         else:
             attrs = 'causality="output" variability="discrete" initial="exact"'
             outputs.append(vr)

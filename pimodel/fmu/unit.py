@@ -74,7 +74,7 @@ class FMUUnit:
         self.log.append(message.decode(errors="replace") if message else "")
 
     def _logger3(self, env, status, category, message) -> None:
-        self.log.append(message.decode(errors="replace") if message else "")
+        self._logger(env, None, status, category, message)
 
     def _var(self, name: str):
         """(variable, element index or None) for ``name`` or an FMI 3 element ``base[i]``."""
