@@ -38,6 +38,7 @@ default gains by ``1 / sum p^2``.
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -235,31 +236,50 @@ def estimate_radii(v, y, weights, *, dt: float, gains=10.0, initial_radii=None,
     return est.run(v, y)
 
 
-def run_tail_average(estimator: RadiusEstimator, v, y, *, tail: float = 0.5,
-                     chunk: int = 1_000_000) -> tuple[np.ndarray, np.ndarray]:
-    """Run ``estimator`` over a long record in chunks (bounded memory) and return
-    ``(final radii, mean of rhat[k] over the last tail fraction of the samples)``.
+def stream_tail_average(estimator: RadiusEstimator, chunks: Iterable[tuple], *, total: int,
+                        tail: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """Run ``estimator`` over a record given as ``(v, y)`` chunks (``total`` samples in all) and
+    return ``(final radii, mean of rhat[k] over the last tail fraction of the samples)``.
 
     Averaging the iterates (Polyak-Ruppert) is how the estimate reaches the accuracy the data
-    allow under heavy output noise; the constant-gain iterate itself keeps fluctuating.
+    allow under heavy output noise; the constant-gain iterate itself keeps fluctuating. Memory
+    is bounded by the chunk size, so records of 10^8 samples are fine
+    (:mod:`pimodel.long_records` makes such chunks).
     """
+    if int(total) != total or total < 2:
+        raise ValueError(f"total: expected an integer >= 2, got {total!r}")
+    if not 0 < tail <= 1:
+        raise ValueError(f"tail: expected a fraction in (0, 1], got {tail!r}")
+    start = int(total * (1 - tail))
+    acc = np.zeros(estimator.n)
+    a = 0
+    for v, y in chunks:
+        x = as_signal(v, "v")
+        m = as_signal(y, "y")
+        if x.size != m.size:
+            raise ValueError(f"v and y: expected equal chunk lengths, got {x.size} and {m.size}")
+        if a + x.size > total:
+            raise ValueError(f"chunks: more than total={total} samples")
+        if x.size == 1:  # a single sample: step it (history holds the estimate before it)
+            hist = estimator.radii[None, :]
+            estimator.step(x[0], m[0])
+        else:
+            hist = estimator.run(x, m).history
+        lo = max(start - a, 0)
+        if lo < x.size:
+            acc += hist[lo:].sum(axis=0)
+        a += x.size
+    if a != total:
+        raise ValueError(f"chunks: expected {total} samples in all, got {a}")
+    return estimator.radii, acc / (total - start)
+
+
+def run_tail_average(estimator: RadiusEstimator, v, y, *, tail: float = 0.5,
+                     chunk: int = 1_000_000) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`stream_tail_average` over whole arrays ``v``, ``y``, processed in chunks."""
     x = as_signal(v, "v", min_length=2)
     m = as_signal(y, "y", min_length=2)
     if x.size != m.size:
         raise ValueError(f"v and y: expected equal lengths, got {x.size} and {m.size}")
-    if not 0 < tail <= 1:
-        raise ValueError(f"tail: expected a fraction in (0, 1], got {tail!r}")
-    start = int(x.size * (1 - tail))
-    total = np.zeros(estimator.n)
-    for a in range(0, x.size, chunk):
-        b = min(a + chunk, x.size)
-        if b - a < 2:  # a last single sample: step it
-            estimator.step(x[a], m[a])
-            if a >= start:
-                total += estimator.radii
-            continue
-        res = estimator.run(x[a:b], m[a:b])
-        lo = max(start - a, 0)
-        if lo < b - a:
-            total += res.history[lo:].sum(axis=0)
-    return estimator.radii, total / (x.size - start)
+    chunks = ((x[a:a + chunk], m[a:a + chunk]) for a in range(0, x.size, chunk))
+    return stream_tail_average(estimator, chunks, total=x.size, tail=tail)

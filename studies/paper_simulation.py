@@ -1,8 +1,9 @@
 """Study: the paper's simulation (Sec. IV). Five plays, p = (0.3, 0.5, 0.8, 0.3, 0.2),
 r = (0.4, 1, 1.5, 2, 3.6), from r0 = (1, 2, 3, 4, 5): v = 30 sin(2 pi t) noise-free (gains 10)
-and at SNR 10 dB, and a periodic biased stair-step at SNR 20 dB (gain 1, guard 0.2, slope check
-off, estimate averaged over the last half). Radius histories, e and e_delta, final errors.
-Full size: 10 kHz for 2000 s (noisy cases); ``--quick``: 1 kHz for 300 s.
+and at SNR 20 dB (gain 1) and 10 dB (gain 0.3, ten seeds), and a periodic biased stair-step at
+SNR 20 dB (gain 1); noisy cases with guard 0.2, slope check off, the estimate averaged over the
+last half. Radius histories, e and e_delta, final errors. Full size: 10 kHz for 2000 s (20 dB)
+and 6000 s (10 dB, chunked); ``--quick``: 1 kHz for 300 s.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from pimodel import PIOperator, RadiusEstimator, estimate_radii  # noqa: E402
-from pimodel.estimator import run_tail_average  # noqa: E402
+from pimodel.estimator import run_tail_average, stream_tail_average  # noqa: E402
+from pimodel.long_records import noisy_output_chunks, record_length  # noqa: E402
 from pimodel.plotting import new_figure, save_figure  # noqa: E402
 from pimodel.signals import add_noise_snr, biased_staircase, sinusoid  # noqa: E402
 from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
@@ -51,26 +53,44 @@ def run(out: Path, quick: bool = False) -> StudyResult:
     res.figures.append(save_figure(fig, out / "paper_simulation_noise_free.png"))
 
     fs, dur = (1000.0, 300.0) if quick else (10_000.0, 2000.0)
-    dt = 1 / fs
-    cases = [("sinusoid, SNR 10 dB", sinusoid(30, 1, fs=fs, duration=dur), 10),
-             ("sinusoid, SNR 20 dB", sinusoid(30, 1, fs=fs, duration=dur), 20),
+    cases = [("sinusoid, SNR 20 dB", sinusoid(30, 1, fs=fs, duration=dur), 20),
              ("stair-step, SNR 20 dB", biased_staircase(20, 5, step=0.5, hold=0.005, fs=fs,
                                                         duration=dur), 20)]
     for name, (_t, v), snr in cases:
         y = add_noise_snr(op.simulate(v), snr, np.random.default_rng(0))
-        est = RadiusEstimator(P, dt=dt, gains=1.0, initial_radii=R0, guard=0.2, slope_window=0)
-        final, avg = run_tail_average(est, v, y)
+        est = RadiusEstimator(P, dt=1 / fs, gains=1.0, initial_radii=R0, guard=0.2,
+                              slope_window=0)
+        _, avg = run_tail_average(est, v, y)
         e = np.abs(avg / R - 1)
         rows.append([name, f"gain 1, {fs / 1e3:g} kHz, {dur:g} s, mean of last half", *avg,
                      100 * e.max()])
         numbers[name] = float(e.max())
+
+    # SNR 10 dB: a smaller gain and a longer record, made and consumed chunk by chunk
+    fs, dur, seeds = (1000.0, 300.0, [0]) if quick else (10_000.0, 6000.0, list(range(10)))
+    worst = []
+    for seed in seeds:
+        chunks = noisy_output_chunks(op, lambda t: 30 * np.sin(2 * np.pi * t), fs=fs,
+                                     duration=dur, snr_db=10, rng=np.random.default_rng(seed))
+        est = RadiusEstimator(P, dt=1 / fs, gains=0.3, initial_radii=R0, guard=0.2,
+                              slope_window=0)
+        _, avg = stream_tail_average(est, chunks, total=record_length(fs, dur))
+        e = np.abs(avg / R - 1)
+        worst.append(float(e.max()))
+        rows.append([f"sinusoid, SNR 10 dB, seed {seed}",
+                     f"gain 0.3, {fs / 1e3:g} kHz, {dur:g} s, mean of last half", *avg,
+                     100 * e.max()])
+    numbers["sinusoid, SNR 10 dB"] = worst[0]
+    numbers["sinusoid, SNR 10 dB, worst seed"] = max(worst)
     res.tables.append(Table("Radius estimates against the truth r = (0.4, 1, 1.5, 2, 3.6)",
                             ["case", "setting", "r1", "r2", "r3", "r4", "r5",
                              "max error [%]"], rows))
     res.numbers = numbers
-    res.notes.append("Goals: 1 % noise-free, 5 % at SNR 20 dB, 10 % at SNR 10 dB. This table is "
-                     "seed 0; at 10 dB seeds 1 and 2 give 14.9 % and 20.3 %, so the 10 dB goal "
-                     "is not met in general (README, estimator section).")
+    res.notes.append("Goals: 1 % noise-free, 5 % at SNR 20 dB, 10 % at SNR 10 dB. The 20 dB "
+                     "rows are seed 0 (seeds 0-2 are tested); the 10 dB rows are seeds 0-9. "
+                     "At 10 dB, gain 1 over 2000 s missed the goal (6.6-20.3 % for seeds 0-2): "
+                     "the noise drove r_2 and r_3 together and r_1, the slowest direction, had "
+                     "not finished its transient.")
     return res
 
 

@@ -15,8 +15,10 @@ from pimodel.estimator import (
     estimate_radii,
     project_ordered,
     run_tail_average,
+    stream_tail_average,
 )
 from pimodel.estimator_reference import estimate_radii_reference, project_ordered_reference
+from pimodel.long_records import noisy_output_chunks, record_length
 from pimodel.signals import add_noise_snr, biased_staircase, sinusoid, triangle
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
@@ -51,6 +53,21 @@ def test_paper_sinusoid_snr20_within_5_percent(seed):
     est = RadiusEstimator(P, dt=1e-4, gains=1.0, initial_radii=WRONG, guard=0.2, slope_window=0)
     _, avg = run_tail_average(est, v, y)
     assert max_rel_error(avg, R) < 0.05
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_paper_sinusoid_snr10_within_10_percent(seed):
+    """SNR 10 dB on y; 10 kHz for 6000 s (60 M samples, made and consumed in 1 M chunks), gain
+    0.3, guard 0.2 V, slope check off; the average of the estimate over the last half of the
+    record is within 10 % of every radius. (Gain 1 over 2000 s missed: 6.6-20.3 %, from a
+    noise-driven drift of r_2 and r_3 and an unfinished r_1 transient.)"""
+    fs, duration = 10_000, 6000
+    chunks = noisy_output_chunks(PIOperator(P, R), lambda t: 30 * np.sin(2 * np.pi * t), fs=fs,
+                                 duration=duration, snr_db=10, rng=np.random.default_rng(seed))
+    est = RadiusEstimator(P, dt=1 / fs, gains=0.3, initial_radii=WRONG, guard=0.2,
+                          slope_window=0)
+    _, avg = stream_tail_average(est, chunks, total=record_length(fs, duration))
+    assert max_rel_error(avg, R) < 0.10
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
