@@ -7,9 +7,21 @@ smaller than the threshold.
 
 from __future__ import annotations
 
+import ctypes
 from dataclasses import dataclass
 
 import numpy as np
+
+from ._native import F64
+from ._native import lib as _lib
+
+_lib.pim_rev_scan_sizeof.restype = ctypes.c_size_t
+_lib.pim_rev_scan_init.restype = None
+_lib.pim_rev_scan_init.argtypes = [ctypes.c_void_p]
+_lib.pim_rev_scan_run.restype = ctypes.c_size_t
+_I64 = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
+_lib.pim_rev_scan_run.argtypes = [ctypes.c_void_p, ctypes.c_size_t, F64, ctypes.c_double, _I64,
+                                  _I64]
 
 
 @dataclass(frozen=True)
@@ -23,24 +35,35 @@ class Branch:
     from_reversal: bool
 
 
+class ReversalScanner:
+    """Streaming reversal detection (C core ``fmu/src/pim_reversals.c``): feed chunks of the
+    input with :meth:`scan`; returns the absolute indices of the reversals declared in them."""
+
+    def __init__(self, threshold: float = 0.0):
+        if not np.isfinite(threshold) or threshold < 0:
+            raise ValueError(f"threshold: expected a finite number >= 0, got {threshold!r}")
+        self.threshold = float(threshold)
+        self._buf = ctypes.create_string_buffer(_lib.pim_rev_scan_sizeof())
+        _lib.pim_rev_scan_init(self._buf)
+
+    def scan(self, v: np.ndarray) -> np.ndarray:
+        """Absolute sample indices (int64) of the input extremes at which the direction
+        changed, for the reversals declared within these samples."""
+        return self.scan_with_declaration(v)[0]
+
+    def scan_with_declaration(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(extremes, declared)``: for each reversal declared within these samples, the
+        absolute index of its extreme and of the sample at which it was declared."""
+        x = np.ascontiguousarray(v, dtype=float)
+        ext = np.empty(max(x.size, 1), dtype=np.int64)
+        decl = np.empty_like(ext)
+        cnt = _lib.pim_rev_scan_run(self._buf, x.size, x, self.threshold, ext, decl)
+        return ext[:cnt].copy(), decl[:cnt].copy()
+
+
 def find_reversals(v: np.ndarray, threshold: float) -> list[int]:
     """Indices of the input extremes at which the direction changes."""
-    rev: list[int] = []
-    direction = 0
-    ext_i = 0
-    for k in range(1, v.size):
-        if direction == 0:
-            if abs(v[k] - v[0]) > threshold:
-                direction = 1 if v[k] > v[0] else -1
-                ext_i = k
-            continue
-        if direction * (v[k] - v[ext_i]) > 0:
-            ext_i = k
-        elif abs(v[k] - v[ext_i]) > threshold:
-            rev.append(ext_i)
-            direction = -direction
-            ext_i = k
-    return rev
+    return ReversalScanner(threshold).scan(v).tolist()
 
 
 def split_branches(v: np.ndarray, threshold: float) -> list[Branch]:

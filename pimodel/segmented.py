@@ -55,16 +55,16 @@ def _dp_breakpoints(x: np.ndarray, Y: np.ndarray, m: int, bins: int) -> np.ndarr
         S[row] = np.bincount(idx, weights=val, minlength=G)
     C = np.concatenate((np.zeros((6, 1)), np.cumsum(S, axis=1)), axis=1)
 
-    def sse(i, j):  # bins i..j-1
-        n, sx, sy, sxx, sxy, syy = (C[:, j] - C[:, i])
-        if n < 2:
-            return 0.0
+    D = C[:, None, :] - C[:, :, None]  # D[:, i, j]: sums over bins i..j-1
+    n, sx, sy, sxx, sxy, syy = D
+    with np.errstate(divide="ignore", invalid="ignore"):
         var_x = sxx - sx * sx / n
         cov = sxy - sx * sy / n
         var_y = syy - sy * sy / n
-        return max(var_y - (cov * cov / var_x if var_x > 1e-300 else 0.0), 0.0)
-
-    seg = np.array([[sse(i, j) if j > i else np.inf for j in range(G + 1)] for i in range(G + 1)])
+        explained = np.where(var_x > 1e-300, cov * cov / var_x, 0.0)
+        seg = np.maximum(var_y - explained, 0.0)
+    seg = np.where(n < 2, 0.0, seg)
+    seg[np.tril_indices(G + 1)] = np.inf  # j <= i: empty
     cost = np.full((m + 1, G + 1), np.inf)
     arg = np.zeros((m + 1, G + 1), dtype=int)
     cost[0, 0] = 0.0
@@ -92,8 +92,13 @@ def _bin(x, Y, bins):
     return sx[ok] / cnt[ok], sy[ok] / cnt[ok], cnt[ok]
 
 
-def _fit_binned(xb, yb, wb, segments, increasing, bins):
-    """Continuous fit through the origin on binned data (weights = counts)."""
+def fit_binned(xb, yb, wb, segments: int, increasing: bool = True, bins: int = 300):
+    """Continuous fit on binned data: bin mean x ``xb``, mean Y ``yb``, weights ``wb`` (counts).
+
+    Breakpoints from the dynamic programme over at most ``bins`` quantile bins, then refined by
+    continuous least squares. Returns ``(breakpoints, coef)`` with ``coef = (s_1, s_2 - s_1,
+    ..., s_m - s_{m-1}, offset)``.
+    """
     sw = np.sqrt(wb)
     ones = np.zeros(xb.size, dtype=int)
 
@@ -134,7 +139,7 @@ def fit_segmented(x, Y, groups=None, *, segments: int, increasing: bool = True,
     offsets = np.array([np.mean(Y[groups == g][:5]) for g in range(n_groups)])
     for _ in range(max(1, iterations)):
         xb, yb, wb = _bin(x, Y - offsets[groups], bins)
-        bps, coef = _fit_binned(xb, yb, wb, segments, increasing, bins)
+        bps, coef = fit_binned(xb, yb, wb, segments, increasing, bins)
         curve = _design(x, np.zeros(x.size, dtype=int), 1, bps)[:, :segments] @ coef[:segments]
         resid = Y - curve
         offsets = np.bincount(groups, resid, n_groups) / np.bincount(groups, minlength=n_groups)

@@ -75,6 +75,16 @@ def _pool_branches(v, y, threshold, min_travel_fraction, max_points):
     return x, Y, groups, len(keep)
 
 
+def plays_from_slopes(slopes: np.ndarray, breakpoints: np.ndarray, *,
+                      linear_play: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Weights and radii from a branch fit's slopes ``s_1..s_m`` and breakpoints ``b_1..b_{m-1}``
+    (Lemma 1): with a linear play ``p = (s_1, s_2 - s_1, ...)``, ``r = (0, b_1/2, ...)``;
+    without one the first segment is flat and ``p = (s_2 - s_1, ...)``, ``r = (b_1/2, ...)``."""
+    if linear_play:
+        return np.diff(np.concatenate(([0.0], slopes))), np.concatenate(([0.0], breakpoints / 2))
+    return np.diff(slopes), breakpoints / 2
+
+
 def identify_slopes(v, y, *, max_segments: int = 8, n_plays: int | None = None,
                     linear_play: bool | None = None, threshold: float | None = None,
                     min_travel_fraction: float = 0.5, max_points: int = 500_000,
@@ -128,12 +138,7 @@ def identify_slopes(v, y, *, max_segments: int = 8, n_plays: int | None = None,
     fit = polish_fit(x, Y, groups, fits[best])
     lin = has_linear(fit)
     s = fit.slopes
-    if lin:
-        weights = np.diff(np.concatenate(([0.0], s)))
-        radii = np.concatenate(([0.0], fit.breakpoints / 2))
-    else:
-        weights = np.diff(s)
-        radii = fit.breakpoints / 2
+    weights, radii = plays_from_slopes(s, fit.breakpoints, linear_play=lin)
     keep = weights > 1e-9 * max(abs(s[-1]), 1e-300)
     if not np.all(keep):
         warnings.warn(f"slope identification: {int((~keep).sum())} segment(s) with no slope "
