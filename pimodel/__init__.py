@@ -5,6 +5,7 @@ from .data import Record, load_record, save_record
 from .estimator import RadiusEstimate, RadiusEstimator, estimate_radii
 from .excitation import check_excitation
 from .identify import Identification, identify
+from .joint import JointEstimate, JointEstimator, estimate_jointly, stream_jointly
 from .operator import PIOperator, TimeDependentPI
 from .reference import pi_reference, play_reference
 from .slopes import identify_slopes
@@ -15,6 +16,10 @@ __all__ = [
     "fit_conventional",
     "identify",
     "identify_slopes",
+    "JointEstimate",
+    "JointEstimator",
+    "estimate_jointly",
+    "stream_jointly",
     "RadiusEstimate",
     "RadiusEstimator",
     "estimate_radii",

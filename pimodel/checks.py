@@ -45,3 +45,15 @@ def positive_scalar(value, name: str) -> float:
     if not np.isfinite(x) or x <= 0:
         raise ValueError(f"{name}: expected a finite number > 0, got {value!r}")
     return x
+
+
+def integer_in(value, name: str, lo: int, hi: int | None = None) -> int:
+    """``value`` as an int in ``[lo, hi]``, else a ValueError naming ``name``."""
+    rng = f"from {lo} to {hi}" if hi is not None else f">= {lo}"
+    try:
+        ok = isinstance(value, (int, np.integer, float, np.floating)) and int(value) == value
+    except (OverflowError, ValueError):
+        ok = False
+    if not ok or value < lo or (hi is not None and value > hi):
+        raise ValueError(f"{name}: expected an integer {rng}, got {value!r}")
+    return int(value)

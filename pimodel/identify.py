@@ -5,8 +5,10 @@ of plays, the weights and first radius guesses; the adaptive estimator then runs
 repeated ``passes`` times from its first reversal (rate independence makes the repetition a
 longer periodic excitation), and the radii are the average of the estimate over the last half
 of the run. ``method="conventional"``: preset radii, least-squares weights
-(:func:`~pimodel.conventional.fit_conventional`). Both model ``y[k] = PI[v][k] + offset`` with
-zero initial play states.
+(:func:`~pimodel.conventional.fit_conventional`). ``method="joint"`` (beyond the paper): the
+number of plays and the linear-play choice from the slopes, then weights and radii together by
+the joint estimator (:class:`~pimodel.joint.JointEstimator`, one pass). All model
+``y[k] = PI[v][k] + offset`` with zero initial play states.
 """
 
 from __future__ import annotations
@@ -22,10 +24,11 @@ from .checks import as_signal, positive_scalar
 from .conventional import fit_conventional
 from .estimator import RadiusEstimator, run_tail_average
 from .excitation import ExcitationReport, check_excitation
+from .joint import JointEstimator
 from .operator import PIOperator
 from .slopes import SlopeIdentification, identify_slopes
 
-METHODS = ("adaptive", "conventional")
+METHODS = ("adaptive", "conventional", "joint")
 
 
 @dataclass
@@ -119,6 +122,8 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
 
     slopes = identify_slopes(v, y, n_plays=n_plays, linear_play=linear_play,
                              max_segments=max_segments)
+    if method == "joint":
+        return _identify_jointly(v, y, slopes)
     p = slopes.weights
     exc = check_excitation(v, p, slopes.radii_guess)
     guess = PIOperator(p, slopes.radii_guess)
@@ -140,3 +145,19 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     settings = {"gains": np.broadcast_to(g, p.shape).tolist(), "passes": passes,
                 "guard": guard_, "radii_from": "average of the estimate over the last half"}
     return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings)
+
+
+def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification) -> Identification:
+    threshold = 0.01 * float(np.ptp(v))
+    est = JointEstimator(slopes.weights.size, linear_play=slopes.linear_play,
+                         initial_weights=np.maximum(slopes.weights, 0.0),
+                         initial_radii=slopes.radii_guess, threshold=threshold)
+    est.run(v, y)
+    res = est.finish()
+    op = PIOperator(res.weights, res.radii)
+    exc = check_excitation(v, res.weights, res.radii)
+    offset, rms, mx = _errors(op, v, y)
+    settings = {"threshold": threshold, "updates": int(res.update_index.size),
+                "branches_used": res.branches_used, "samples_used": res.samples_used,
+                "branch_fit_rms": res.fit_rms}
+    return Identification(op, offset, "joint", rms, mx, float(np.ptp(y)), exc, slopes, settings)

@@ -13,35 +13,41 @@ and measured output ``y[k]`` (output unit):
    branch that ended at ``v_rev``, ``Y[k] = c_b + g(x[k])`` with
    ``g(x) = sum_j p_j max(0, x - 2 r_j)`` and ``c_b`` constant on the branch, whatever came
    before (major or minor loop). Only these samples are used;
-3. when a reversal is declared (the sample at which ``v`` has moved back by more than ``h``),
-   the branch that ended is centred, ``Y - c_b`` with ``c_b = mean(Y - ghat(x))`` (``ghat`` the
-   current estimate; the first update fits the offsets jointly instead), and added to
-   ``bins`` equal-width bins of x on ``[0, travel_range]`` (count, sum x, sum Y, sum Y^2); the
-   older statistics are multiplied by ``forgetting`` per branch;
-4. after every ``refit_every`` branches the estimate is updated: the optimal continuous
-   piecewise-linear curve with ``n`` segments (``n + 1`` without a linear play) is fitted to the
-   bin means, weighted by counts (dynamic programming for the breakpoints, then continuous least
-   squares with non-decreasing slopes), and ``p``, ``r`` follow from its slopes and breakpoints
-   (:func:`pimodel.slopes.plays_from_slopes`).
+3. when ``refit_every`` branches have ended (at the sample where the last reversal is
+   declared, i.e. ``v`` has moved back by more than ``h``), each of them is centred,
+   ``Y - c_b`` with ``c_b = mean(Y - ghat(x))`` (``ghat`` the estimate in force; before the
+   first estimate, the offsets and the shape are fitted together on the first
+   ``FIRST_FIT_BRANCHES`` branches), and added to ``bins`` equal-width bins of x on
+   ``[0, travel_range]`` (count, sum x, sum Y); the older statistics are multiplied by
+   ``forgetting`` per branch;
+4. the estimate is updated: ``c + sum_j p_j max(0, x - 2 r_j)`` (with ``p_1 x`` for a linear
+   play) is fitted to the bin means weighted by the counts, with every ``p_j >= 0``
+   (:func:`pimodel.segmented.fit_hinges`: hinges from dynamic programming and from the previous
+   estimate, coordinate sweeps over a grid, then continuous least squares; the better start
+   is kept).
 
 ``weights[k]``, ``radii[k]`` are the estimate in force at sample k (held between updates), so
 the estimate after sample k uses ``v[0..k]``, ``y[0..k]`` only. The statistics are sufficient
-for the fit, so memory is bounded (one branch of raw samples) and the result does not depend on
-how the record is cut into chunks. With ``forgetting = 1`` every used sample counts equally
-(the estimate converges like least squares, as 1/sqrt(samples) under white output noise).
+for the fit, so memory is bounded (``refit_every`` branches of raw samples) and the result does
+not depend on how the record is cut into chunks. With ``forgetting = 1`` every used sample
+counts equally (the estimate converges like least squares, as 1/sqrt(samples) under white
+output noise).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
 from .branches import ReversalScanner
-from .checks import as_signal, as_vector, positive_scalar
-from .segmented import fit_binned, fit_segmented
+from .checks import as_signal, as_vector, integer_in, positive_scalar
+from .segmented import fit_hinges, fit_segmented
 from .slopes import plays_from_slopes
+
+FIRST_FIT_BRANCHES = 50
 
 
 @dataclass
@@ -50,8 +56,9 @@ class JointEstimate:
 
     ``update_index[u]`` is the sample at which update u was made (the estimate
     ``weight_history[u]``, ``radius_history[u]`` is in force from the next sample on).
-    ``fit_rms`` is the RMS of the used samples about the fitted branch shape (output unit), an
-    estimate of the output noise once the model fits.
+    ``fit_rms`` is the RMS of the samples of the branches of the last update about the fitted
+    branch shape, each branch with its own offset (output unit): an estimate of the output noise
+    once the model fits.
     """
 
     weights: np.ndarray
@@ -86,31 +93,26 @@ class JointEstimator:
     def __init__(self, n_plays: int, *, linear_play: bool = False, initial_weights=None,
                  initial_radii=None, travel_range: float | None = None, bins: int = 2048,
                  refit_every: int = 10, forgetting: float = 1.0, threshold: float = 0.0):
-        if int(n_plays) != n_plays or not 1 <= n_plays <= 64:
-            raise ValueError(f"n_plays: expected an integer from 1 to 64, got {n_plays!r}")
-        self.n = int(n_plays)
+        self.n = integer_in(n_plays, "n_plays", 1, 64)
         self.linear_play = bool(linear_play)
-        self.weights = self._start(initial_weights, "initial_weights", np.ones(self.n), lo=0.0)
+        self.weights = self._start(initial_weights, "initial_weights", np.ones(self.n))
         default_r = np.arange(self.n, dtype=float)
-        self.radii = np.sort(self._start(initial_radii, "initial_radii", default_r, lo=None))
+        self.radii = np.sort(self._start(initial_radii, "initial_radii", default_r))
         if self.linear_play:
             self.radii[0] = 0.0
-        if int(bins) != bins or bins < 4 * (self.n + 1):
-            raise ValueError(f"bins: expected an integer >= {4 * (self.n + 1)}, got {bins!r}")
-        if int(refit_every) != refit_every or refit_every < 1:
-            raise ValueError(f"refit_every: expected an integer >= 1, got {refit_every!r}")
-        if not (np.isfinite(forgetting) and 0 < forgetting <= 1):
+        if not (isinstance(forgetting, (int, float, np.number)) and np.isfinite(forgetting)
+                and 0 < forgetting <= 1):
             raise ValueError(f"forgetting: expected a number in (0, 1], got {forgetting!r}")
-        self.bins = int(bins)
-        self.refit_every = int(refit_every)
+        self.bins = integer_in(bins, "bins", 4 * (self.n + 1))
+        self.refit_every = integer_in(refit_every, "refit_every", 1)
         self.forgetting = float(forgetting)
         self.travel_range = None if travel_range is None else positive_scalar(
             travel_range, "travel_range")
         self._scanner = ReversalScanner(threshold)
-        self._stats = np.zeros((4, self.bins))  # count, sum x, sum Y, sum Y^2
+        self._stats = np.zeros((3, self.bins))  # count, sum x, sum Y
         self._k = 0                    # samples seen
-        self._buf_v = np.empty(0)      # raw samples since the last reversal extreme
-        self._buf_y = np.empty(0)
+        self._buf_v: list[np.ndarray] = []  # raw samples since the last reversal extreme
+        self._buf_y: list[np.ndarray] = []
         self._buf_start = 0            # absolute index of _buf_v[0]
         self._from_reversal = False    # the buffered branch starts at a reversal
         self._prev_travel = 0.0
@@ -123,31 +125,48 @@ class JointEstimator:
         self.fit_rms = float("nan")
 
     @staticmethod
-    def _start(value, name, default, lo):
+    def _start(value, name, default):
         if value is None:
             return default
         arr = as_vector(value, name, length=default.size)
-        if lo is not None and np.any(arr <= lo):
-            raise ValueError(f"{name}: every value must be > {lo}")
-        if lo is None and np.any(arr < 0):
-            raise ValueError(f"{name}: every radius must be >= 0")
+        if np.any(arr < 0):
+            raise ValueError(f"{name}: every value must be >= 0")
         return arr.copy()
 
     # -- streaming -------------------------------------------------------------------------
     def step(self, v: float, y: float) -> tuple[np.ndarray, np.ndarray]:
-        """Process sample k; returns the estimate ``(weights, radii)`` after it."""
-        self.run(np.array([v], float), np.array([y], float), _min_length=1)
+        """Process sample k; returns the estimate ``(weights, radii)`` in force after it."""
+        self._consume(as_signal([v], "v", min_length=1), as_signal([y], "y", min_length=1))
         return self.weights.copy(), self.radii.copy()
 
-    def run(self, v, y, *, _min_length: int = 2) -> JointEstimate:
-        """Process the next samples (arrays, any length); returns everything so far."""
-        x = as_signal(v, "v", min_length=_min_length)
-        m = as_signal(y, "y", min_length=_min_length)
+    def run(self, v, y) -> JointEstimate:
+        """Process the next samples (arrays, any length >= 1); returns everything so far."""
+        x = as_signal(v, "v", min_length=1)
+        m = as_signal(y, "y", min_length=1)
         if x.size != m.size:
             raise ValueError(f"v and y: expected equal lengths, got {x.size} and {m.size}")
+        self._consume(x, m)
+        return self.result()
+
+    def finish(self) -> JointEstimate:
+        """End of record: update with the branches completed since the last update (the branch
+        still running is left out: its end, hence its travel, is unknown)."""
+        if self._pending:
+            self._update(self._k - 1)
+        if not self._updates:
+            warnings.warn("JointEstimator: no usable branch (a branch between two reversals, "
+                          "after a first one) in the record; the estimate is the start",
+                          RuntimeWarning, stacklevel=2)
+        return self.result()
+
+    def _consume(self, x: np.ndarray, m: np.ndarray) -> None:
         ext, decl = self._scanner.scan_with_declaration(x)
-        bv = np.concatenate((self._buf_v, x))
-        by = np.concatenate((self._buf_y, m))
+        self._buf_v.append(x)
+        self._buf_y.append(m)
+        self._k += x.size
+        if ext.size == 0:
+            return
+        bv, by = np.concatenate(self._buf_v), np.concatenate(self._buf_y)
         for e, d in zip(ext, decl, strict=True):
             b = int(e) - self._buf_start
             self._close_branch(bv[:b + 1], by[:b])
@@ -155,9 +174,7 @@ class JointEstimator:
             self._buf_start = int(e)
             if len(self._pending) >= self.refit_every:
                 self._update(int(d))
-        self._buf_v, self._buf_y = bv, by
-        self._k += x.size
-        return self.result()
+        self._buf_v, self._buf_y = [bv], [by]
 
     def _close_branch(self, v: np.ndarray, y: np.ndarray) -> None:
         """Branch samples v[0..-2] with outputs y; v[-1] is the next reversal extreme."""
@@ -180,15 +197,18 @@ class JointEstimator:
             self._first_fit()
         else:
             self._accumulate(self._pending)
-        self._pending = []
         self._fit_bins()
+        self.fit_rms = self._rms_about_fit(self._pending)
+        self._pending = []
         self._updates.append((k, self.weights.copy(), self.radii.copy()))
 
     def _first_fit(self) -> None:
-        """Before any estimate exists: offsets fitted jointly with the shape on raw samples."""
-        x = np.concatenate([b[0] for b in self._pending])
-        Y = np.concatenate([b[1] for b in self._pending])
-        groups = np.concatenate([np.full(b[0].size, i) for i, b in enumerate(self._pending)])
+        """Before any estimate exists: offsets fitted jointly with the shape on the raw samples of
+        the first pending branches (at most ``FIRST_FIT_BRANCHES``)."""
+        first = self._pending[:FIRST_FIT_BRANCHES]
+        x = np.concatenate([b[0] for b in first])
+        Y = np.concatenate([b[1] for b in first])
+        groups = np.concatenate([np.full(b[0].size, i) for i, b in enumerate(first)])
         fit = fit_segmented(x, Y, groups, segments=self._segments(), increasing=True)
         self._set_estimate(fit.slopes, fit.breakpoints)
         self._fitted = True
@@ -204,24 +224,32 @@ class JointEstimator:
             Yc = Y - c
             idx = np.minimum((x / h).astype(np.int64), self.bins - 1)
             self._stats *= self.forgetting
-            for row, w in enumerate((None, x, Yc, Yc * Yc)):
+            for row, w in enumerate((None, x, Yc)):
                 self._stats[row] += np.bincount(idx, weights=w, minlength=self.bins)
             self.branches_used += 1
             self.samples_used += x.size
 
     def _fit_bins(self) -> None:
-        cnt, sx, sy, syy = self._stats
+        cnt, sx, sy = self._stats
         ok = cnt > 0
         xb, yb, wb = sx[ok] / cnt[ok], sy[ok] / cnt[ok], cnt[ok]
-        m = self._segments()
-        if xb.size < 2 * m + 1:
-            return  # too few distinct travels to place the breakpoints yet
-        bps, coef = fit_binned(xb, yb, wb, m, increasing=True)
-        self._set_estimate(np.cumsum(coef[:m]), bps)
-        curve = coef[m] + branch_shape(xb, self.weights, self.radii) + (
-            coef[0] * xb if not self.linear_play else 0.0)
-        sse = float(np.sum(syy[ok] - 2 * curve * sy[ok] + cnt[ok] * curve**2))
-        self.fit_rms = float(np.sqrt(max(sse, 0.0) / max(wb.sum(), 1.0)))
+        hinges = self.n - 1 if self.linear_play else self.n
+        if xb.size < 2 * self.n + 2:
+            return  # too few distinct travels to place the hinges yet
+        start = 2 * self.radii[1:] if self.linear_play else 2 * self.radii
+        b, a, c, _ = fit_hinges(xb, yb, wb, hinges, linear_term=self.linear_play, start=start)
+        self.weights = a.copy()
+        self.radii = np.concatenate(([0.0], b / 2)) if self.linear_play else b / 2
+
+    def _rms_about_fit(self, branches: list[tuple[np.ndarray, np.ndarray]]) -> float:
+        """RMS of ``Y - c_b - ghat(x)`` over the given branches, ``c_b`` their own offsets."""
+        sse, count = 0.0, 0
+        for x, Y in branches:
+            e = Y - branch_shape(x, self.weights, self.radii)
+            e -= e.mean()
+            sse += float(e @ e)
+            count += e.size
+        return float(np.sqrt(sse / count)) if count else float("nan")
 
     def _set_estimate(self, slopes: np.ndarray, breakpoints: np.ndarray) -> None:
         p, r = plays_from_slopes(slopes, np.sort(breakpoints), linear_play=self.linear_play)
@@ -242,11 +270,13 @@ def estimate_jointly(v, y, n_plays: int, **options) -> JointEstimate:
     """Joint weights and radii from a record ``(v[k], y[k])`` (see :class:`JointEstimator` for
     the options)."""
     est = JointEstimator(n_plays, **options)
-    return est.run(v, y)
+    est.run(v, y)
+    return est.finish()
 
 
 def stream_jointly(estimator: JointEstimator, chunks: Iterable[tuple]) -> JointEstimate:
-    """Run ``estimator`` over a record given as ``(v, y)`` chunks (bounded memory)."""
+    """Run ``estimator`` over a record given as ``(v, y)`` chunks (bounded memory), then
+    :meth:`JointEstimator.finish`."""
     for v, y in chunks:
-        estimator.run(v, y, _min_length=1)
-    return estimator.result()
+        estimator.run(v, y)
+    return estimator.finish()

@@ -2,9 +2,12 @@
 
 Fits ``Y(x) = c_b + sum_i (s_i - s_{i-1}) max(0, x - b_{i-1})`` (``b_0 = 0``, ``s_0 = 0``) with
 a free offset ``c_b`` per group b (branch). Breakpoints are first located by dynamic programming
-over binned data (Bellman's optimal segmentation, exact for the binned problem), then refined
-by continuous least squares (scipy ``least_squares``), with slope increments constrained >= 0
-when ``increasing`` (a PI operator's loop branches are convex: weights are positive).
+over binned data (Bellman's optimal segmentation, exact for the binned discontinuous problem),
+then moved one at a time to the best of a grid of positions for the continuous fit (coordinate
+sweeps, which leave the local minima the dynamic programme's start can fall into on noisy
+data), then refined by continuous least squares (scipy ``least_squares``), with slope
+increments constrained >= 0 when ``increasing`` (a PI operator's loop branches are convex:
+weights are positive).
 """
 
 from __future__ import annotations
@@ -92,12 +95,94 @@ def _bin(x, Y, bins):
     return sx[ok] / cnt[ok], sy[ok] / cnt[ok], cnt[ok]
 
 
+def _sweep_breakpoints(xb, yb, wb, bps, *, linear_term: bool = True, candidates: int = 512,
+                       sweeps: int = 20):
+    """Coordinate sweeps: each breakpoint (hinge) in turn moves to the grid position that
+    minimises the weighted SSE of the fit ``c + [s x] + sum_j a_j max(0, x - b_j)`` with the
+    others fixed (closed form per candidate: projection of the candidate column off the span of
+    the others; ``linear_term`` adds the ``s x`` column); stops when none moves."""
+    sw = np.sqrt(wb)
+    y = yb * sw
+    grid = np.unique(np.quantile(xb, np.linspace(0.0, 1.0, candidates + 2)[1:-1]))
+    C = np.maximum(0.0, xb[:, None] - grid[None, :]) * sw[:, None]
+    bps = np.array(bps, float)
+    base = [np.ones_like(xb)] + ([xb] if linear_term else [])
+
+    def basis(others):
+        cols = base + [np.maximum(0.0, xb - b) for b in others]
+        return np.linalg.qr(np.column_stack(cols) * sw[:, None])[0]
+
+    for _ in range(sweeps):
+        moved = False
+        for j in range(bps.size):
+            Q = basis(np.delete(bps, j))
+            r0 = y - Q @ (Q.T @ y)
+            here = np.maximum(0.0, xb - bps[j]) * sw
+            here -= Q @ (Q.T @ here)
+            Cp = C - Q @ (Q.T @ C)
+            norms = np.einsum("ij,ij->j", Cp, Cp)
+            tiny = 1e-12 * max(float(norms.max()), 1e-300)
+            gain = np.where(norms > tiny, (Cp.T @ r0) ** 2 / np.maximum(norms, tiny), 0.0)
+            k = int(np.argmax(gain))
+            hn = float(here @ here)
+            now = float(here @ r0) ** 2 / hn if hn > tiny else 0.0
+            if gain[k] > now * (1 + 1e-9) + 1e-12 * float(r0 @ r0):
+                bps[j] = grid[k]
+                moved = True
+        if not moved:
+            break
+    return np.sort(bps)
+
+
+def fit_hinges(xb, yb, wb, hinges: int, *, linear_term: bool,
+               start: np.ndarray | None = None, bins: int = 300):
+    """Weighted fit of ``Y(x) = c + [a_0 x] + sum_j a_j max(0, x - b_j)`` with every ``a >= 0``
+    (a PI operator's branch: ``a_j = p_j``, ``b_j = 2 r_j``) to binned data (mean x ``xb``, mean
+    Y ``yb``, weights ``wb``). Hinges from the dynamic programme (and from ``start`` when given:
+    the better of the two is kept), coordinate sweeps over a grid, then continuous least squares.
+    Returns ``(b, a, c, sse)``: hinges ascending, ``a`` (with ``a_0`` first when
+    ``linear_term``), offset and weighted SSE."""
+    sw = np.sqrt(wb)
+
+    def solve(b):
+        cols = [np.ones_like(xb)] + ([xb] if linear_term else [])
+        A = np.column_stack(cols + [np.maximum(0.0, xb - h) for h in b]) * sw[:, None]
+        lb = np.zeros(A.shape[1])
+        lb[0] = -np.inf
+        sol = lsq_linear(A, yb * sw, bounds=(lb, np.inf), method="bvls")
+        return sol.x, A @ sol.x - yb * sw
+
+    def refine(b):
+        b = _sweep_breakpoints(xb, yb, wb, b, linear_term=linear_term)
+        xmax = float(xb.max())
+        sol = least_squares(lambda h: solve(np.sort(h))[1], b, bounds=(0.0, xmax),
+                            x_scale=max(xmax, 1e-12) / 10, max_nfev=100 * max(hinges, 1))
+        b = np.sort(sol.x)
+        coef, r = solve(b)
+        return b, coef, float(r @ r)
+
+    starts = []
+    if hinges > 0:
+        dp = _dp_breakpoints(xb, yb, hinges + 1, min(bins, xb.size))
+        if dp.size != hinges:
+            dp = np.quantile(xb, np.linspace(0, 1, hinges + 2)[1:-1])
+        starts.append(dp)
+        if start is not None:
+            starts.append(np.sort(np.asarray(start, float)))
+        best = min((refine(b) for b in starts), key=lambda f: f[2])
+    else:
+        coef, r = solve(np.empty(0))
+        best = (np.empty(0), coef, float(r @ r))
+    b, coef, sse = best
+    return b, coef[1:], float(coef[0]), sse
+
+
 def fit_binned(xb, yb, wb, segments: int, increasing: bool = True, bins: int = 300):
     """Continuous fit on binned data: bin mean x ``xb``, mean Y ``yb``, weights ``wb`` (counts).
 
-    Breakpoints from the dynamic programme over at most ``bins`` quantile bins, then refined by
-    continuous least squares. Returns ``(breakpoints, coef)`` with ``coef = (s_1, s_2 - s_1,
-    ..., s_m - s_{m-1}, offset)``.
+    Breakpoints from the dynamic programme over at most ``bins`` quantile bins, then coordinate
+    sweeps over a grid, then continuous least squares. Returns ``(breakpoints, coef)`` with
+    ``coef = (s_1, s_2 - s_1, ..., s_m - s_{m-1}, offset)``.
     """
     sw = np.sqrt(wb)
     ones = np.zeros(xb.size, dtype=int)
@@ -116,6 +201,7 @@ def fit_binned(xb, yb, wb, segments: int, increasing: bool = True, bins: int = 3
         bps = _dp_breakpoints(xb, yb, segments, min(bins, xb.size))
         if bps.size != segments - 1:
             bps = np.quantile(xb, np.linspace(0, 1, segments + 1)[1:-1])
+        bps = _sweep_breakpoints(xb, yb, wb, bps, linear_term=True)
         xmax = float(xb.max())
         sol = least_squares(lambda b: solve(np.sort(b))[1], bps, bounds=(0.0, xmax),
                             x_scale=max(xmax, 1e-12) / 10, max_nfev=100 * segments)

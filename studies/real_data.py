@@ -30,7 +30,10 @@ def run(out: Path, quick: bool = False) -> StudyResult:
     k0 = int(np.argmax(np.abs(rec.v) > 1))
     mid = k0 + (len(rec) - k0) // 2
     models = {"adaptive (BIC)": identify(rec.v[k0:mid], rec.y[k0:mid], dt=rec.dt),
-              "adaptive n=4": identify(rec.v[k0:mid], rec.y[k0:mid], dt=rec.dt, n_plays=4)}
+              "adaptive n=4": identify(rec.v[k0:mid], rec.y[k0:mid], dt=rec.dt, n_plays=4),
+              "joint (BIC)": identify(rec.v[k0:mid], rec.y[k0:mid], dt=rec.dt, method="joint"),
+              "joint n=4": identify(rec.v[k0:mid], rec.y[k0:mid], dt=rec.dt, n_plays=4,
+                                    method="joint")}
     for n in (4, 10, 20):
         models[f"conventional n={n}"] = identify(rec.v[k0:mid], rec.y[k0:mid], dt=rec.dt,
                                                  method="conventional", n_plays=n)

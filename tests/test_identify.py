@@ -141,6 +141,13 @@ def test_cli_identify_writes_json_and_plots(tmp_path):
     assert main(["identify", str(tmp_path / "rec.csv"), "--json", str(out), "--method",
                  "conventional", "--plays", "7"]) == 0
     assert json.loads(out.read_text())["n_plays"] <= 7
+    assert main(["identify", str(tmp_path / "rec.csv"), "--json", str(out), "--method",
+                 "joint", "--plots", str(tmp_path / "plots")]) == 0
+    data = json.loads(out.read_text())
+    assert data["method"] == "joint" and data["settings"]["updates"] >= 1
+    np.testing.assert_allclose(data["weights"], STAGE.weights, rtol=1e-3)
+    np.testing.assert_allclose(data["radii"], STAGE.radii, atol=2e-3)
+    assert (tmp_path / "plots" / "identify_joint.png").exists()
 
 
 def test_real_record_identification(real_record_path):

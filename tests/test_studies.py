@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from pimodel.cli import main
@@ -90,3 +91,9 @@ def test_unreadable_figure_is_refused(tmp_path):
     ax[0, 0].plot([0, 1], [0, 1], label="a")
     ax[0, 0].set(xlabel="t [s]", ylabel="y [um]")
     assert save_figure(fig, tmp_path / "ok.png").exists()
+
+
+def test_joint_estimation(tmp_path):
+    n = _run("joint_estimation", tmp_path).numbers
+    assert n["noise_free"]["weights"] < 0.01 and n["noise_free"]["radii"] < 0.01
+    assert np.isfinite(n["sinusoid, SNR 20 dB"]["radii"])

@@ -18,7 +18,9 @@ def register(sub) -> None:
     )
     p.add_argument("data", help="record (CSV with header, or NPZ)")
     p.add_argument("--json", required=True, help="output JSON file")
-    p.add_argument("--method", choices=["adaptive", "conventional"], default="adaptive")
+    p.add_argument("--method", choices=["adaptive", "conventional", "joint"], default="adaptive",
+                   help="adaptive: the paper's (slopes, then radii); conventional: preset radii, "
+                   "least-squares weights; joint: weights and radii estimated together")
     p.add_argument("--plays", type=int, default=None,
                    help="number of plays (default: BIC on the slopes; conventional: 10)")
     p.add_argument("--gains", type=float_list, default=None,
