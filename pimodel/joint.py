@@ -13,25 +13,25 @@ and measured output ``y[k]`` (output unit):
    branch that ended at ``v_rev``, ``Y[k] = c_b + g(x[k])`` with
    ``g(x) = sum_j p_j max(0, x - 2 r_j)`` and ``c_b`` constant on the branch, whatever came
    before (major or minor loop). Only these samples are used;
-3. when ``refit_every`` branches have ended (at the sample where the last reversal is
-   declared, i.e. ``v`` has moved back by more than ``h``), each of them is centred,
-   ``Y - c_b`` with ``c_b = mean(Y - ghat(x))`` (``ghat`` the estimate in force; before the
-   first estimate, the offsets and the shape are fitted together on the first
-   ``FIRST_FIT_BRANCHES`` branches), and added to ``bins`` equal-width bins of x on
+3. when a branch ends (at the sample where the next reversal is declared, i.e. ``v`` has moved
+   back by more than ``h``) it is centred, ``Y - c_b`` with ``c_b = mean(Y - ghat(x))``
+   (``ghat`` the estimate in force), and added to ``bins`` equal-width bins of x on
    ``[0, travel_range]`` (count, sum x, sum Y); the older statistics are multiplied by
-   ``forgetting`` per branch;
-4. the estimate is updated: ``c + sum_j p_j max(0, x - 2 r_j)`` (with ``p_1 x`` for a linear
-   play) is fitted to the bin means weighted by the counts, with every ``p_j >= 0``
-   (:func:`pimodel.segmented.fit_hinges`: hinges from dynamic programming and from the previous
-   estimate, coordinate sweeps over a grid, then continuous least squares; the better start
-   is kept).
+   ``forgetting`` per branch. Before any estimate exists the branches are kept raw, and the
+   first update, after ``min(refit_every, FIRST_FIT_BRANCHES)`` branches, fits their offsets and
+   the shape together;
+4. every ``refit_every`` branches the estimate is updated:
+   ``c + sum_j p_j max(0, x - 2 r_j)`` (with ``p_1 x`` for a linear play) is fitted to the bin
+   means weighted by the counts, with every ``p_j >= 0`` (:func:`pimodel.segmented.fit_hinges`:
+   hinges from dynamic programming and from the previous estimate, coordinate sweeps over a
+   grid, then continuous least squares; the better start is kept).
 
 ``weights[k]``, ``radii[k]`` are the estimate in force at sample k (held between updates), so
 the estimate after sample k uses ``v[0..k]``, ``y[0..k]`` only. The statistics are sufficient
-for the fit, so memory is bounded (``refit_every`` branches of raw samples) and the result does
-not depend on how the record is cut into chunks. With ``forgetting = 1`` every used sample
-counts equally (the estimate converges like least squares, as 1/sqrt(samples) under white
-output noise).
+for the fit, so memory is bounded (the bins and one running branch of raw samples) and the
+result does not depend on how the record is cut into chunks. With ``forgetting = 1`` every used
+sample counts equally (the estimate converges like least squares, as 1/sqrt(samples) under
+white output noise).
 """
 
 from __future__ import annotations
@@ -56,9 +56,9 @@ class JointEstimate:
 
     ``update_index[u]`` is the sample at which update u was made (the estimate
     ``weight_history[u]``, ``radius_history[u]`` is in force from the next sample on).
-    ``fit_rms`` is the RMS of the samples of the branches of the last update about the fitted
-    branch shape, each branch with its own offset (output unit): an estimate of the output noise
-    once the model fits.
+    ``fit_rms`` is the RMS of the samples of the branches added since the previous update about
+    the estimate in force when each ended, each branch with its own offset (output unit): a
+    prediction check, and an estimate of the output noise once the model fits.
     """
 
     weights: np.ndarray
@@ -116,7 +116,9 @@ class JointEstimator:
         self._buf_start = 0            # absolute index of _buf_v[0]
         self._from_reversal = False    # the buffered branch starts at a reversal
         self._prev_travel = 0.0
-        self._pending: list[tuple[np.ndarray, np.ndarray]] = []  # (x, Y) of branches not yet added
+        self._pending: list[tuple[np.ndarray, np.ndarray]] = []  # (x, Y) before the first fit
+        self._since_update = 0         # branches added since the last update
+        self._sse, self._sse_count = 0.0, 0
         self._fitted = False
         self._updates: list[tuple[int, np.ndarray, np.ndarray]] = []
         self.branches_used = 0
@@ -151,7 +153,7 @@ class JointEstimator:
     def finish(self) -> JointEstimate:
         """End of record: update with the branches completed since the last update (the branch
         still running is left out: its end, hence its travel, is unknown)."""
-        if self._pending:
+        if self._pending or self._since_update:
             self._update(self._k - 1)
         if not self._updates:
             warnings.warn("JointEstimator: no usable branch (a branch between two reversals, "
@@ -172,7 +174,11 @@ class JointEstimator:
             self._close_branch(bv[:b + 1], by[:b])
             bv, by = bv[b:], by[b:]
             self._buf_start = int(e)
-            if len(self._pending) >= self.refit_every:
+            if self._fitted:
+                due = self._since_update >= self.refit_every
+            else:
+                due = len(self._pending) >= min(self.refit_every, FIRST_FIT_BRANCHES)
+            if due:
                 self._update(int(d))
         self._buf_v, self._buf_y = [bv], [by]
 
@@ -188,46 +194,55 @@ class JointEstimator:
             inside = keep & (xs <= self.travel_range)
             self.samples_outside += int(np.count_nonzero(keep & ~inside))
             if np.count_nonzero(inside) >= 2:
-                self._pending.append((xs[inside], s * y[inside]))
+                if self._fitted:
+                    self._add_branch(xs[inside], s * y[inside])
+                else:
+                    self._pending.append((xs[inside], s * y[inside]))
         self._from_reversal = True
         self._prev_travel = travel
 
     def _update(self, k: int) -> None:
         if not self._fitted:
             self._first_fit()
-        else:
-            self._accumulate(self._pending)
         self._fit_bins()
-        self.fit_rms = self._rms_about_fit(self._pending)
-        self._pending = []
+        self.fit_rms = float(np.sqrt(self._sse / self._sse_count)) if self._sse_count else \
+            float("nan")
+        self._sse, self._sse_count, self._since_update = 0.0, 0, 0
         self._updates.append((k, self.weights.copy(), self.radii.copy()))
 
     def _first_fit(self) -> None:
         """Before any estimate exists: offsets fitted jointly with the shape on the raw samples of
-        the first pending branches (at most ``FIRST_FIT_BRANCHES``)."""
-        first = self._pending[:FIRST_FIT_BRANCHES]
-        x = np.concatenate([b[0] for b in first])
-        Y = np.concatenate([b[1] for b in first])
-        groups = np.concatenate([np.full(b[0].size, i) for i, b in enumerate(first)])
+        the pending branches."""
+        x = np.concatenate([b[0] for b in self._pending])
+        Y = np.concatenate([b[1] for b in self._pending])
+        groups = np.concatenate([np.full(b[0].size, i) for i, b in enumerate(self._pending)])
         fit = fit_segmented(x, Y, groups, segments=self._segments(), increasing=True)
-        self._set_estimate(fit.slopes, fit.breakpoints)
+        p, r = plays_from_slopes(fit.slopes, np.sort(fit.breakpoints),
+                                 linear_play=self.linear_play)
+        self.weights, self.radii = np.maximum(p, 0.0), np.maximum(r, 0.0)
         self._fitted = True
-        self._accumulate(self._pending)
+        for x, Y in self._pending:
+            self._add_branch(x, Y)
+        self._pending = []
 
     def _segments(self) -> int:
         return self.n if self.linear_play else self.n + 1
 
-    def _accumulate(self, branches: list[tuple[np.ndarray, np.ndarray]]) -> None:
-        h = self.travel_range / self.bins
-        for x, Y in branches:
-            c = float(np.mean(Y - branch_shape(x, self.weights, self.radii)))
-            Yc = Y - c
-            idx = np.minimum((x / h).astype(np.int64), self.bins - 1)
-            self._stats *= self.forgetting
-            for row, w in enumerate((None, x, Yc)):
-                self._stats[row] += np.bincount(idx, weights=w, minlength=self.bins)
-            self.branches_used += 1
-            self.samples_used += x.size
+    def _add_branch(self, x: np.ndarray, Y: np.ndarray) -> None:
+        """Centre a finished branch on the estimate in force and add it to the bins."""
+        e = Y - branch_shape(x, self.weights, self.radii)
+        c = float(np.mean(e))
+        e -= c
+        self._sse += float(e @ e)
+        self._sse_count += e.size
+        Yc = Y - c
+        idx = np.minimum((x * (self.bins / self.travel_range)).astype(np.int64), self.bins - 1)
+        self._stats *= self.forgetting
+        for row, w in enumerate((None, x, Yc)):
+            self._stats[row] += np.bincount(idx, weights=w, minlength=self.bins)
+        self.branches_used += 1
+        self.samples_used += x.size
+        self._since_update += 1
 
     def _fit_bins(self) -> None:
         cnt, sx, sy = self._stats
@@ -240,21 +255,6 @@ class JointEstimator:
         b, a, c, _ = fit_hinges(xb, yb, wb, hinges, linear_term=self.linear_play, start=start)
         self.weights = a.copy()
         self.radii = np.concatenate(([0.0], b / 2)) if self.linear_play else b / 2
-
-    def _rms_about_fit(self, branches: list[tuple[np.ndarray, np.ndarray]]) -> float:
-        """RMS of ``Y - c_b - ghat(x)`` over the given branches, ``c_b`` their own offsets."""
-        sse, count = 0.0, 0
-        for x, Y in branches:
-            e = Y - branch_shape(x, self.weights, self.radii)
-            e -= e.mean()
-            sse += float(e @ e)
-            count += e.size
-        return float(np.sqrt(sse / count)) if count else float("nan")
-
-    def _set_estimate(self, slopes: np.ndarray, breakpoints: np.ndarray) -> None:
-        p, r = plays_from_slopes(slopes, np.sort(breakpoints), linear_play=self.linear_play)
-        self.weights = np.maximum(p, 0.0)
-        self.radii = np.maximum(r, 0.0)
 
     def result(self) -> JointEstimate:
         """Everything so far as a :class:`JointEstimate`."""
