@@ -151,7 +151,8 @@ def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification)
     threshold = 0.01 * float(np.ptp(v))
     est = JointEstimator(slopes.weights.size, linear_play=slopes.linear_play,
                          initial_weights=np.maximum(slopes.weights, 0.0),
-                         initial_radii=slopes.radii_guess, threshold=threshold)
+                         initial_radii=slopes.radii_guess, threshold=threshold,
+                         refit_every=1_000_000)  # offline: the first update and the final one
     est.run(v, y)
     res = est.finish()
     op = PIOperator(res.weights, res.radii)
