@@ -135,20 +135,26 @@ def _sweep_breakpoints(xb, yb, wb, bps, *, linear_term: bool = True, candidates:
 
 
 def fit_hinges(xb, yb, wb, hinges: int, *, linear_term: bool,
-               start: np.ndarray | None = None, bins: int = 300):
-    """Weighted fit of ``Y(x) = c + [a_0 x] + sum_j a_j max(0, x - b_j)`` with every ``a >= 0``
-    (a PI operator's branch: ``a_j = p_j``, ``b_j = 2 r_j``) to binned data (mean x ``xb``, mean
-    Y ``yb``, weights ``wb``). Hinges from the dynamic programme (and from ``start`` when given:
-    the better of the two is kept), coordinate sweeps over a grid, then continuous least squares.
+               start: np.ndarray | None = None, bins: int = 300, increasing: bool = True,
+               linear_nonneg: bool = True):
+    """Weighted fit of ``Y(x) = c + [a_0 x] + sum_j a_j max(0, x - b_j)`` to binned data (mean x
+    ``xb``, mean Y ``yb``, weights ``wb``) with ``a_j >= 0`` for the hinges when ``increasing``
+    and ``a_0 >= 0`` when ``linear_nonneg`` (a PI operator's branch: ``a_j = p_j``,
+    ``b_j = 2 r_j``). Hinges from the dynamic programme (and from ``start`` when given: the
+    better of the two is kept), coordinate sweeps over a grid, then continuous least squares.
     Returns ``(b, a, c, sse)``: hinges ascending, ``a`` (with ``a_0`` first when
     ``linear_term``), offset and weighted SSE."""
     sw = np.sqrt(wb)
+    lead = 2 if linear_term else 1
+    lb = np.full(lead + hinges, -np.inf)
+    if increasing:
+        lb[lead:] = 0.0
+    if linear_term and linear_nonneg:
+        lb[1] = 0.0
 
     def solve(b):
         cols = [np.ones_like(xb)] + ([xb] if linear_term else [])
         A = np.column_stack(cols + [np.maximum(0.0, xb - h) for h in b]) * sw[:, None]
-        lb = np.zeros(A.shape[1])
-        lb[0] = -np.inf
         sol = lsq_linear(A, yb * sw, bounds=(lb, np.inf), method="bvls")
         return sol.x, A @ sol.x - yb * sw
 
@@ -156,58 +162,31 @@ def fit_hinges(xb, yb, wb, hinges: int, *, linear_term: bool,
         b = _sweep_breakpoints(xb, yb, wb, b, linear_term=linear_term)
         xmax = float(xb.max())
         sol = least_squares(lambda h: solve(np.sort(h))[1], b, bounds=(0.0, xmax),
-                            x_scale=max(xmax, 1e-12) / 10, max_nfev=100 * max(hinges, 1))
+                            x_scale=max(xmax, 1e-12) / 10, max_nfev=100 * (hinges + 1))
         b = np.sort(sol.x)
         coef, r = solve(b)
         return b, coef, float(r @ r)
 
-    starts = []
     if hinges > 0:
         dp = _dp_breakpoints(xb, yb, hinges + 1, min(bins, xb.size))
         if dp.size != hinges:
             dp = np.quantile(xb, np.linspace(0, 1, hinges + 2)[1:-1])
-        starts.append(dp)
-        if start is not None:
-            starts.append(np.sort(np.asarray(start, float)))
-        best = min((refine(b) for b in starts), key=lambda f: f[2])
+        starts = [dp] if start is None else [dp, np.sort(np.asarray(start, float))]
+        b, coef, sse = min((refine(s) for s in starts), key=lambda f: f[2])
     else:
         coef, r = solve(np.empty(0))
-        best = (np.empty(0), coef, float(r @ r))
-    b, coef, sse = best
+        b, sse = np.empty(0), float(r @ r)
     return b, coef[1:], float(coef[0]), sse
 
 
 def fit_binned(xb, yb, wb, segments: int, increasing: bool = True, bins: int = 300):
-    """Continuous fit on binned data: bin mean x ``xb``, mean Y ``yb``, weights ``wb`` (counts).
-
-    Breakpoints from the dynamic programme over at most ``bins`` quantile bins, then coordinate
-    sweeps over a grid, then continuous least squares. Returns ``(breakpoints, coef)`` with
-    ``coef = (s_1, s_2 - s_1, ..., s_m - s_{m-1}, offset)``.
-    """
-    sw = np.sqrt(wb)
-    ones = np.zeros(xb.size, dtype=int)
-
-    def solve(bps):
-        A = _design(xb, ones, 1, bps) * sw[:, None]
-        m = bps.size + 1
-        lb = np.full(A.shape[1], -np.inf)
-        if increasing:
-            lb[1:m] = 0.0
-        sol = lsq_linear(A, yb * sw, bounds=(lb, np.inf), method="bvls")
-        return sol.x, A @ sol.x - yb * sw
-
-    bps = np.empty(0)
-    if segments > 1:
-        bps = _dp_breakpoints(xb, yb, segments, min(bins, xb.size))
-        if bps.size != segments - 1:
-            bps = np.quantile(xb, np.linspace(0, 1, segments + 1)[1:-1])
-        bps = _sweep_breakpoints(xb, yb, wb, bps, linear_term=True)
-        xmax = float(xb.max())
-        sol = least_squares(lambda b: solve(np.sort(b))[1], bps, bounds=(0.0, xmax),
-                            x_scale=max(xmax, 1e-12) / 10, max_nfev=100 * segments)
-        bps = np.sort(sol.x)
-    coef, _ = solve(bps)
-    return bps, coef
+    """Continuous piecewise-linear fit of ``m = segments`` segments on binned data (bin mean x
+    ``xb``, mean Y ``yb``, weights ``wb``): :func:`fit_hinges` with a free first slope.
+    Returns ``(breakpoints, coef)`` with ``coef = (s_1, s_2 - s_1, ..., s_m - s_{m-1},
+    offset)``."""
+    b, a, c, _ = fit_hinges(xb, yb, wb, segments - 1, linear_term=True, bins=bins,
+                            increasing=increasing, linear_nonneg=False)
+    return b, np.concatenate((a, [c]))
 
 
 def fit_segmented(x, Y, groups=None, *, segments: int, increasing: bool = True,
