@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from .checks import as_signal
+from .checks import as_signal, integer_in
 from .operator import PIOperator
 
 
@@ -37,9 +37,7 @@ def fit_conventional(v, y, n_plays: int, *, span: float | None = None) -> Conven
     y = as_signal(y, "y", min_length=2)
     if v.size != y.size:
         raise ValueError(f"v and y: expected equal lengths, got {v.size} and {y.size}")
-    if int(n_plays) != n_plays or n_plays < 1:
-        raise ValueError(f"n_plays: expected an integer >= 1, got {n_plays!r}")
-    n = int(n_plays)
+    n = integer_in(n_plays, "n_plays", 1)
     span = float(np.ptp(v)) / 2 if span is None else float(span)
     if not np.isfinite(span) or span <= 0:
         raise ValueError(f"span: expected a radius span > 0 (input units), got {span!r}; "

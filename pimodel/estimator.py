@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _native
-from .checks import as_signal, as_vector, positive_scalar
+from .checks import as_signal, as_vector, integer_in, positive_scalar
 
 _lib = _native.lib
 _F64 = _native.F64
@@ -246,8 +246,7 @@ def stream_tail_average(estimator: RadiusEstimator, chunks: Iterable[tuple], *, 
     is bounded by the chunk size, so records of 10^8 samples are fine
     (:mod:`pimodel.long_records` makes such chunks).
     """
-    if int(total) != total or total < 2:
-        raise ValueError(f"total: expected an integer >= 2, got {total!r}")
+    total = integer_in(total, "total", 2)
     if not 0 < tail <= 1:
         raise ValueError(f"tail: expected a fraction in (0, 1], got {tail!r}")
     start = int(total * (1 - tail))

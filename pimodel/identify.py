@@ -14,6 +14,7 @@ the joint estimator (:class:`~pimodel.joint.JointEstimator`, one pass). All mode
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -155,8 +156,13 @@ def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification)
                          refit_every=1_000_000)  # offline: the first update and the final one
     est.run(v, y)
     res = est.finish()
-    op = PIOperator(res.weights, res.radii)
-    exc = check_excitation(v, res.weights, res.radii)
+    keep = res.weights > 0
+    if not np.all(keep):
+        warnings.warn(f"joint estimation: {int((~keep).sum())} play(s) got weight 0 (no slope "
+                      f"change at their radius) and were dropped; the model has "
+                      f"{int(keep.sum())} plays", RuntimeWarning, stacklevel=3)
+    op = PIOperator(res.weights[keep], res.radii[keep])
+    exc = check_excitation(v, op.weights, op.radii)
     offset, rms, mx = _errors(op, v, y)
     settings = {"threshold": threshold, "updates": int(res.update_index.size),
                 "branches_used": res.branches_used, "samples_used": res.samples_used,

@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from .checks import positive_scalar
+from .checks import integer_in, positive_scalar
 from .operator import PIOperator
 
 
@@ -45,17 +45,16 @@ def noisy_output_chunks(op: PIOperator, input_at: Callable[[np.ndarray], np.ndar
     for ``duration`` [s]; ``input_at(t)`` maps times [s] to inputs; ``op`` starts from its
     initial state. See the module docstring for the noise."""
     n = record_length(fs, duration)
-    if int(chunk) != chunk or chunk < 2:
-        raise ValueError(f"chunk: expected an integer >= 2, got {chunk!r}")
+    chunk = integer_in(chunk, "chunk", 2)
     if not np.isfinite(snr_db):
         raise ValueError(f"snr_db: expected a finite number, got {snr_db!r}")
     count, mean, m2 = 0, 0.0, 0.0
-    for _, y in _clean_chunks(op, input_at, fs, n, int(chunk)):  # Chan et al. pairwise variance
+    for _, y in _clean_chunks(op, input_at, fs, n, chunk):  # Chan et al. pairwise variance
         nb, mb = y.size, float(y.mean())
         delta = mb - mean
         m2 += float(((y - mb) ** 2).sum()) + delta**2 * count * nb / (count + nb)
         mean += delta * nb / (count + nb)
         count += nb
     sigma = np.sqrt(m2 / count / 10 ** (snr_db / 10))
-    for v, y in _clean_chunks(op, input_at, fs, n, int(chunk)):
+    for v, y in _clean_chunks(op, input_at, fs, n, chunk):
         yield v, y + rng.normal(0.0, sigma, y.size)

@@ -205,3 +205,14 @@ def test_no_reversal_gives_no_update_and_says_so():
         res = estimate_jointly(v, 2 * v, 3, initial_weights=[1, 1, 1], initial_radii=[0, 1, 2])
     assert res.update_index.size == 0 and res.branches_used == 0
     assert np.array_equal(res.radii, [0, 1, 2])
+
+
+def test_identify_joint_drops_plays_with_zero_weight():
+    """Four plays asked of a two-play record: a play the fit gives weight 0 is dropped with a
+    warning (a PIOperator needs positive weights), not a crash."""
+    _, v = sinusoid(5, 1, fs=1000, duration=10)
+    y = PIOperator([1.0, 0.5], [0.5, 1.5]).simulate(v)
+    with pytest.warns(RuntimeWarning, match="got weight 0"):
+        idn = identify(v, y, dt=1e-3, n_plays=4, method="joint")
+    assert idn.operator.n < 4 and np.all(idn.weights > 0)
+    assert idn.rms_error < 1e-6
