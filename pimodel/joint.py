@@ -119,7 +119,6 @@ class JointEstimator:
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []  # (x, Y) before the first fit
         self._since_update = 0         # branches added since the last update
         self._sse, self._sse_count = 0.0, 0
-        self._fitted = False
         self._updates: list[tuple[int, np.ndarray, np.ndarray]] = []
         self.branches_used = 0
         self.samples_used = 0
@@ -174,7 +173,7 @@ class JointEstimator:
             self._close_branch(bv[:b + 1], by[:b])
             bv, by = bv[b:], by[b:]
             self._buf_start = int(e)
-            if self._fitted:
+            if self._updates:  # an estimate exists
                 due = self._since_update >= self.refit_every
             else:
                 due = len(self._pending) >= min(self.refit_every, FIRST_FIT_BRANCHES)
@@ -194,7 +193,7 @@ class JointEstimator:
             inside = keep & (xs <= self.travel_range)
             self.samples_outside += int(np.count_nonzero(keep & ~inside))
             if np.count_nonzero(inside) >= 2:
-                if self._fitted:
+                if self._updates:  # an estimate exists
                     self._add_branch(xs[inside], s * y[inside])
                 else:
                     self._pending.append((xs[inside], s * y[inside]))
@@ -202,7 +201,7 @@ class JointEstimator:
         self._prev_travel = travel
 
     def _update(self, k: int) -> None:
-        if not self._fitted:
+        if not self._updates:
             self._first_fit()
         self._fit_bins()
         self.fit_rms = float(np.sqrt(self._sse / self._sse_count)) if self._sse_count else \
@@ -220,7 +219,6 @@ class JointEstimator:
         p, r = plays_from_slopes(fit.slopes, np.sort(fit.breakpoints),
                                  linear_play=self.linear_play)
         self.weights, self.radii = np.maximum(p, 0.0), np.maximum(r, 0.0)
-        self._fitted = True
         for x, Y in self._pending:
             self._add_branch(x, Y)
         self._pending = []
