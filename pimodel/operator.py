@@ -14,11 +14,15 @@ no role, only the sequence of input values. Units: ``v`` and the radii share the
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import _native
 from .checks import as_signal, as_vector
+
+if TYPE_CHECKING:
+    from .describing import PIDescribingFunction
 
 
 def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -202,6 +206,27 @@ class PIOperator:
             )
         pinv, rinv, zinv = res
         return PIOperator(pinv, rinv, initial_state=zinv, signed_weights=True)
+
+    def describing_function(self) -> PIDescribingFunction:
+        """This operator as a python-control describing-function nonlinearity.
+
+        Returns
+        -------
+        pimodel.describing.PIDescribingFunction
+            A ``control.DescribingFunctionNonlinearity``: ``F.describing_function(A)`` is the
+            exact ``sum_i p_i N_{r_i}(A)`` (a play of radius r is a backlash of width 2 r),
+            usable with ``control.describing_function_response`` and
+            ``control.describing_function_plot``; see :mod:`pimodel.describing`.
+
+        Examples
+        --------
+        >>> F = PIOperator([1.0, 0.5], [0.0, 0.2]).describing_function()
+        >>> abs(F.describing_function(1e-3))  # only the linear play moves
+        1.0
+        """
+        from .describing import PIDescribingFunction
+
+        return PIDescribingFunction(self)
 
     def inverse_state(self, state) -> np.ndarray:
         """Inverse-operator state consistent with forward play states ``state``."""
