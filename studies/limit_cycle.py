@@ -193,7 +193,8 @@ def run(out: Path, quick: bool = False) -> StudyResult:
                 errs = (f"{100 * c['amplitude_error']:+.2f} % / "
                         f"{100 * c['frequency_error']:+.2f} %")
             else:
-                simtxt = f"settles (final half range {swing:.1e} {unit})"
+                size = "< 1e-12" if swing < 1e-12 else f"{swing:.1e}"
+                simtxt = f"settles (final half range {size} {unit})"
                 errs = "-"
             rows.append([pname, cname, f"[{sec[0]:.4g}, {sec[1]:.4g}]",
                          f"{'holds' if cc.holds else 'fails'} ({cc.margin:.3g})", pred, simtxt,
