@@ -12,7 +12,8 @@ times the nominal gain). For each case: the sector (Lemma 1) and the circle crit
 harmonic balance ``1 + N(A) L(e^{jw dt}) = 0`` (amplitude, frequency, stability by Loeb's
 criterion), and the simulation: a small reference step (a stable limit cycle is reached, or the
 loop settles) and, for an unstable limit cycle, the threshold amplitude found by bisection on a
-burst injected at the nonlinearity's input. ``--quick`` runs fewer bisection steps.
+burst injected at the nonlinearity's input. ``--quick`` runs 1 s instead of 2 s of step response
+and 14 instead of 30 bisection steps.
 """
 
 from __future__ import annotations
