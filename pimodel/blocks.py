@@ -210,10 +210,12 @@ def _operator_settings(op: PIOperator, name: str):
     n = op.n
 
     def build(s: dict) -> PIOperator:
+        for key in ("weights", "radii"):
+            size = as_vector(s[key], key).size
+            if size != n:
+                raise ValueError(f"{key}: expected {n} plays (the block's states), got {size}")
         new = PIOperator(s["weights"], s["radii"], initial_state=s["initial_state"],
                          signed_weights=op.signed_weights)
-        if new.n != n:
-            raise ValueError(f"expected {n} plays (the block's states), got {new.n}")
         if not np.array_equal(new.radii, as_vector(s["radii"], "radii")):
             raise ValueError("radii: expected non-decreasing radii (they fix the state order)")
         return new
@@ -678,7 +680,7 @@ def adaptive_compensator_block(weights, dt: float, *, name: str = "adaptive_inv"
         if not np.isfinite(u[0]):
             raise ValueError(f"{input}: input sample is {u[0]!r}; expected a finite number")
         v = lib.pim_adaptive_inverse_step(n, w, r, zm, float(u[0]))
-        if np.isnan(v):
+        if np.isnan(v) or np.any(np.diff(r) < 0):
             raise ValueError(f"{name}: radii {r} not invertible (need {radius_prefix}[1] = 0, "
                              "sorted)")
         return v, zm, z0

@@ -36,7 +36,7 @@ def _signals(unit: FMUUnit, causality: str) -> list[str]:
 
 
 def fmu_block(path, dt: float, *, start: dict | None = None, inputs=None, outputs=None,
-              name: str | None = None) -> control.NonlinearIOSystem:
+              name: str | None = None, feedthrough: bool = True) -> control.NonlinearIOSystem:
     """Wrap the FMU at ``path`` (communication step ``dt``) as a python-control block.
 
     Parameters
@@ -52,6 +52,13 @@ def fmu_block(path, dt: float, *, start: dict | None = None, inputs=None, output
         order; FMI 3 arrays element-wise as ``name[1]`` ...).
     name : str, optional
         Block and instance name (default: the model identifier).
+    feedthrough : bool
+        True (default): the outputs at step k are those after ``doStep`` with ``u[k]`` (FMU
+        state rolled back). False: the outputs the FMU holds before that step (after step
+        k-1, the initial values at k = 0), so the block has no direct feedthrough. Use False for
+        the RadiusEstimator FMU feeding an adaptive compensator: its ``r_hat`` is then the
+        estimate used at step k, as the native :func:`~pimodel.blocks.estimator_block`'s, and
+        the loop has no algebraic cycle (``y_hat`` and ``e`` are then those of step k-1).
 
     Returns
     -------
@@ -104,6 +111,8 @@ def fmu_block(path, dt: float, *, start: dict | None = None, inputs=None, output
 
     def out(t, x, u, params):
         sync(x)
+        if not feedthrough:
+            return unit.get(outs)
         saved = unit.get_state()
         advance(u)
         y = unit.get(outs)
