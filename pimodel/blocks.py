@@ -81,31 +81,40 @@ def _labels(base: str, n: int) -> list[str]:
     return [f"{base}[{i}]" for i in range(1, n + 1)]
 
 
-def _equal(a, b) -> bool:
-    if a is b:
-        return True
-    if a is None or b is None:
-        return False
-    try:
-        return bool(np.array_equal(np.asarray(a), np.asarray(b)))
-    except (TypeError, ValueError):  # pragma: no cover - exotic values: compare directly
-        return bool(a == b)
+def _fingerprint(value):
+    """A cheap, comparable summary of a setting's value (arrays by their bytes, so a setting
+    changed in place is seen as changed)."""
+    if isinstance(value, (list, tuple)):
+        try:
+            value = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            return repr(value)
+    if isinstance(value, np.ndarray):
+        return value.dtype.str, value.shape, value.tobytes()
+    return value
 
 
 class _Settings:
     """A block's settings read from python-control's ``params`` under ``"<name>.<setting>"``.
 
     ``build(settings)`` validates them and returns what the update function needs; it runs at
-    construction and again only when a value changes, so reading params costs a comparison.
+    construction and again only when a value changes, so reading params costs a comparison of
+    fingerprints (a few microseconds).
     """
 
     def __init__(self, name: str, defaults: dict, build: Callable[[dict], object]):
         self.name = name
-        self.defaults = dict(defaults)
+        self.defaults = {k: np.array(v, dtype=float) if isinstance(v, (list, np.ndarray)) else v
+                         for k, v in defaults.items()}
+        for v in self.defaults.values():
+            if isinstance(v, np.ndarray):
+                v.setflags(write=False)  # shared through sys.params: never changed in place
+        self._default_fp = {k: _fingerprint(v) for k, v in self.defaults.items()}
         self.keys = {k: f"{name}.{k}" for k in self.defaults}
         self.build = build
-        self._seen = self.defaults
-        self._last_params = None
+        self._known = set(self.keys.values())
+        self._last_keys: set = set()
+        self._seen = tuple(self._default_fp.values())
         self.value = self._build(self.defaults)
 
     @property
@@ -116,30 +125,30 @@ class _Settings:
         try:
             return self.build(values)
         except ValueError as err:
-            raise ValueError(f"block {self.name!r}, params {sorted(self.keys.values())}: "
+            raise ValueError(f"block {self.name!r}, params {sorted(self._known)}: "
                              f"{err}") from err
 
     def _check_names(self, params: dict) -> None:
+        if params.keys() == self._last_keys:
+            return
         prefix = f"{self.name}."
-        known = set(self.keys.values())
         unknown = [k for k in params if isinstance(k, str) and k.startswith(prefix)
-                   and k not in known]
+                   and k not in self._known]
         if unknown:
             raise ValueError(f"params: unknown setting(s) {sorted(unknown)} for block "
-                             f"{self.name!r}; known: {sorted(known)}")
+                             f"{self.name!r}; known: {sorted(self._known)}")
+        self._last_keys = set(params.keys())
 
     def get(self, params: dict | None):
         """The built settings for ``params`` (missing keys: construction values)."""
-        if not params:
-            params = {}
-        if params is not self._last_params:
-            self._check_names(params)
-            self._last_params = params
+        params = params or {}
+        self._check_names(params)
         values = {k: params.get(key, self.defaults[k]) for k, key in self.keys.items()}
-        if not all(_equal(values[k], self._seen[k]) for k in values):
+        seen = tuple(self._default_fp[k] if v is self.defaults[k] else _fingerprint(v)
+                     for k, v in values.items())
+        if seen != self._seen:
             self.value = self._build(values)
-            self._seen = {k: np.array(v, copy=True) if isinstance(v, (list, np.ndarray)) else v
-                          for k, v in values.items()}
+            self._seen = seen
         return self.value
 
 
@@ -209,7 +218,7 @@ def _operator_settings(op: PIOperator, name: str):
     """Build function for a PI operator's params: weights, radii, initial play state."""
     n = op.n
 
-    def build(s: dict) -> PIOperator:
+    def build(s: dict) -> _Stepper:
         for key in ("weights", "radii"):
             size = as_vector(s[key], key).size
             if size != n:
@@ -218,17 +227,35 @@ def _operator_settings(op: PIOperator, name: str):
                          signed_weights=op.signed_weights)
         if not np.array_equal(new.radii, as_vector(s["radii"], "radii")):
             raise ValueError("radii: expected non-decreasing radii (they fix the state order)")
-        return new
+        return _Stepper(new)
 
     return _Settings(name, {"weights": op.weights.copy(), "radii": op.radii.copy(),
                             "initial_state": op.initial_state.copy()}, build)
 
 
-def _pi_step(p, r, x, v) -> tuple[float, np.ndarray]:
-    if not np.isfinite(v):
-        raise ValueError(f"v: input sample is {v!r}; expected a finite number")
-    z = np.array(x, dtype=float)
-    return _native.pi_step(p, r, z, v), z
+# pim_pi_step on raw pointers: the blocks call it a few times per sample, and numpy's checked
+# argument conversion (pimodel._native.pi_step) costs more than the step itself.
+_raw_pi_step = _native.lib["pim_pi_step"]
+_raw_pi_step.restype = ctypes.c_double
+_raw_pi_step.argtypes = [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+                         ctypes.c_double]
+
+
+class _Stepper:
+    """A PI operator ready for the C step: raw pointers to its (read-only, kept alive) arrays."""
+
+    def __init__(self, op: PIOperator):
+        self.op = op
+        self.n = op.n
+        self.initial_state = op.initial_state
+        self._p, self._r = op.weights.ctypes.data, op.radii.ctypes.data
+
+    def step(self, x, v) -> tuple[float, np.ndarray]:
+        """``(y[k], z[k])`` from the play states ``x = z[k-1]`` and the input ``v = v[k]``."""
+        if not np.isfinite(v):
+            raise ValueError(f"v: input sample is {v!r}; expected a finite number")
+        z = np.array(x, dtype=float)
+        return _raw_pi_step(self.n, self._p, self._r, z.ctypes.data, float(v)), z
 
 
 def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
@@ -291,12 +318,12 @@ def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
 
     def upd(t, x, u, params):
         cur = settings.get(params)
-        return _pi_step(cur.weights, cur.radii, x, u[0])[1]
+        return cur.step(x, u[0])[1]
 
     def out(t, x, u, params):
         cur = settings.get(params)
         _warn_if_zero_start(name, t, x, cur.initial_state)
-        return np.array([_pi_step(cur.weights, cur.radii, x, u[0])[0]])
+        return np.array([cur.step(x, u[0])[0]])
 
     return _Block(upd, out, own_state=lambda params: settings.get(params).initial_state,
                   aliases={f"{name}_z{i}": f"z[{i}]" for i in range(1, op.n + 1)},
@@ -360,20 +387,20 @@ def inverse_pi_block(op: PIOperator, dt: float, *, name: str = "pi_inv", input: 
     forward = _operator_settings(op, name)
     inverse_of = {}
 
-    def inv(params) -> PIOperator:
+    def inv(params) -> _Stepper:
         model = forward.get(params)
         if inverse_of.get("model") is not model:
-            inverse_of.update(model=model, inverse=model.inverse())
+            inverse_of.update(model=model, inverse=_Stepper(model.op.inverse()))
         return inverse_of["inverse"]
 
     def upd(t, x, u, params):
         cur = inv(params)
-        return _pi_step(cur.weights, cur.radii, x, u[0])[1]
+        return cur.step(x, u[0])[1]
 
     def out(t, x, u, params):
         cur = inv(params)
         _warn_if_zero_start(name, t, x, cur.initial_state)
-        return np.array([_pi_step(cur.weights, cur.radii, x, u[0])[0]])
+        return np.array([cur.step(x, u[0])[0]])
 
     try:
         inv(forward.params)

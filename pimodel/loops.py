@@ -156,7 +156,8 @@ def run_loop(ref, plant: PIOperator, dt: float, *, dynamics=None, feedforward="n
     elif feedforward == "adaptive":
         if not isinstance(estimator, RadiusEstimator):
             raise ValueError("estimator: feedforward='adaptive' needs a RadiusEstimator")
-        if not getattr(estimator, "linear_play", getattr(estimator, "known_linear_play", False)):
+        holds_r1 = getattr(estimator, "linear_play", None)  # the name before: known_linear_play
+        if not (estimator.known_linear_play if holds_r1 is None else holds_r1):
             raise ValueError("estimator: the adaptive inverse needs linear_play=True")
         nm = estimator.n
         L.ff_mode, L.nm = 2, nm
