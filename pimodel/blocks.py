@@ -285,17 +285,17 @@ def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
     -----
     Params (defaults from ``op``):
 
-    ======================= ==========================================================
-    ``"<name>.weights"``    weights ``p_i`` (n values)
-    ``"<name>.radii"``      radii ``r_i`` (n values, non-decreasing, >= 0)
-    ``"<name>.initial_state"`` play states before the first sample ``z_i[-1]`` (scalar or n)
-    ======================= ==========================================================
+    ``"<name>.weights"``
+        weights ``p_i`` (n values)
+    ``"<name>.radii"``
+        radii ``r_i`` (n values, non-decreasing, >= 0)
+    ``"<name>.initial_state"``
+        play states before the first sample ``z_i[-1]`` (scalar or n)
 
     State layout (``sys.state_labels``):
 
-    ============== ======================================================
-    ``z[i]``        state of play i after the previous sample (``z_i[k-1]``)
-    ============== ======================================================
+    ``z[i]``
+        state of play i after the previous sample (``z_i[k-1]``)
 
     The own initial state is ``"<name>.initial_state"`` (:func:`initial_state`).
 
@@ -356,11 +356,12 @@ def inverse_pi_block(op: PIOperator, dt: float, *, name: str = "pi_inv", input: 
     -----
     Params are those of the forward model; the inverse is recomputed when they change:
 
-    ========================== =====================================================
-    ``"<name>.weights"``        forward weights ``p_i``
-    ``"<name>.radii"``          forward radii ``r_i`` (non-decreasing, ``r_1 = 0``)
-    ``"<name>.initial_state"``  forward play states before the first sample
-    ========================== =====================================================
+    ``"<name>.weights"``
+        forward weights ``p_i``
+    ``"<name>.radii"``
+        forward radii ``r_i`` (non-decreasing, ``r_1 = 0``)
+    ``"<name>.initial_state"``
+        forward play states before the first sample
 
     State layout: ``z_inv[i]``, the state of play i of the inverse operator after the previous
     sample. The own initial state is the inverse state consistent with the forward one, so
@@ -543,23 +544,36 @@ def estimator_block(weights, dt: float, *, gains=10.0, initial_radii=None,
 
     State layout (``sys.state_labels``, ``3 n + 138`` values, the estimator's flat state):
 
-    ================= =======================================================
-    ``r_hat[j]``       radius estimate used at the next sample (n)
-    ``z_hat[j]``       model play states (n)
-    ``sat[j]``         1 if play j was saturated at the last reversal (n)
-    ``v_first``        first input sample
-    ``v_start``        start of the current monotone segment
-    ``v_ext``          running extreme of the segment
-    ``v_rev``          input at the last reversal
-    ``dir``            segment direction +1 / -1 (0 before the first move)
-    ``have_rev``       1 once a reversal has been seen
-    ``started``        1 once a sample has been processed
-    ``time``           elapsed time k dt [s] (gain annealing)
-    ``nseg``           samples since the last reversal
-    ``head``           ring-buffer position
-    ``v_buf[i]``       last inputs (slope check ring buffer, 64)
-    ``y_buf[i]``       last outputs (slope check ring buffer, 64)
-    ================= =======================================================
+    ``r_hat[j]``
+        radius estimate used at the next sample (n)
+    ``z_hat[j]``
+        model play states (n)
+    ``sat[j]``
+        1 if play j was saturated at the last reversal (n)
+    ``v_first``
+        first input sample
+    ``v_start``
+        start of the current monotone segment
+    ``v_ext``
+        running extreme of the segment
+    ``v_rev``
+        input at the last reversal
+    ``dir``
+        segment direction +1 / -1 (0 before the first move)
+    ``have_rev``
+        1 once a reversal has been seen
+    ``started``
+        1 once a sample has been processed
+    ``time``
+        elapsed time k dt [s] (gain annealing)
+    ``nseg``
+        samples since the last reversal
+    ``head``
+        ring-buffer position
+    ``v_buf[i]``
+        last inputs (slope check ring buffer, 64)
+    ``y_buf[i]``
+        last outputs (slope check ring buffer, 64)
 
     At its first sample (``started == 0``) the block warns (:class:`InitialStateWarning`) when
     the state differs from its own initial state.
