@@ -228,6 +228,20 @@ def test_zero_state_that_is_not_the_blocks_own_warns():
         control.input_output_response(pi_block(PIOperator([1, 0.5], [0, 0.3]), 1e-3), t, t)
 
 
+def test_params_changed_in_place_between_runs_are_seen():
+    pb = pi_block(PIOperator([1.0, 0.5], [0.0, 0.3]), 1e-3, name="plant")
+    t, v = sinusoid(1, 5, fs=1000, duration=0.2)
+    radii = np.array([0.0, 0.1])
+    params = {"plant.radii": radii}
+    first = control.input_output_response(pb, t, v, params=params).outputs
+    radii[1] = 0.4  # the same array, changed
+    second = control.input_output_response(pb, t, v, params=params).outputs
+    close(first, PIOperator([1.0, 0.5], [0.0, 0.1]).simulate(v))
+    close(second, PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v))
+    with pytest.raises(ValueError, match="read-only"):
+        pb.params["plant.radii"][1] = 0.2  # the defaults cannot change behind the block
+
+
 def test_params_are_checked_by_name():
     pb = pi_block(STAGE, 1e-3, name="plant")
     t = np.arange(3) * 1e-3
