@@ -283,3 +283,16 @@ def test_deprecated_names_still_work():
 def test_docstring_examples_run(module):
     failures, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
     assert tried > 0 and failures == 0
+
+
+def test_linearize_at_the_blocks_own_state_with_params():
+    """python-control's analysis tools take the same state and params: at an interior play
+    state the PI block is linear with D = p_1 (the linear play) and C_i = p_i for i > 1."""
+    pb = pi_block(PIOperator([1.0, 0.5, 0.25], [0.0, 0.3, 0.8], initial_state=[0.0, 0.1, -0.2]),
+                  1e-3, name="pi")
+    params = {"pi.weights": [2.0, 0.5, 0.75]}
+    lin = control.linearize(pb, initial_state(pb, params), 0.0, params=params)
+    np.testing.assert_allclose(lin.D, [[2.0]], atol=1e-9)
+    np.testing.assert_allclose(lin.C, [[0.0, 0.5, 0.75]], atol=1e-9)
+    np.testing.assert_allclose(lin.A, np.diag([0.0, 1.0, 1.0]), atol=1e-9)
+    np.testing.assert_allclose(lin.B, [[1.0], [0.0], [0.0]], atol=1e-9)
