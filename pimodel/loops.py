@@ -122,7 +122,7 @@ def run_loop(ref, plant: PIOperator, dt: float, *, dynamics=None, feedforward="n
     ``feedforward``: ``"none"`` (``v = ff_gain * ref``; default gain ``1 / sum p`` of the
     plant), a :class:`PIOperator` model (its exact inverse), or ``"adaptive"`` (with
     ``estimator``, a :class:`RadiusEstimator` whose weights define the compensator's model;
-    ``known_linear_play=True``). ``dynamics``: discrete SISO state space after the hysteresis
+    ``linear_play=True``). ``dynamics``: discrete SISO state space after the hysteresis
     (``dt`` equal to the loop's). ``pid``: :class:`PID` gains or None.
     """
     r = as_signal(ref, "ref", min_length=1)
@@ -156,8 +156,9 @@ def run_loop(ref, plant: PIOperator, dt: float, *, dynamics=None, feedforward="n
     elif feedforward == "adaptive":
         if not isinstance(estimator, RadiusEstimator):
             raise ValueError("estimator: feedforward='adaptive' needs a RadiusEstimator")
-        if not estimator.known_linear_play:
-            raise ValueError("estimator: the adaptive inverse needs known_linear_play=True")
+        holds_r1 = getattr(estimator, "linear_play", None)  # the name before: known_linear_play
+        if not (estimator.known_linear_play if holds_r1 is None else holds_r1):
+            raise ValueError("estimator: the adaptive inverse needs linear_play=True")
         nm = estimator.n
         L.ff_mode, L.nm = 2, nm
         _fill(L.pm, estimator.weights)
@@ -187,7 +188,12 @@ def loop_system(plant: PIOperator, dt: float, *, dynamics=None, feedforward="non
     """The same loop as :func:`run_loop`, interconnected from python-control blocks.
 
     Input ``y_d``; outputs ``y``, ``v``, ``e`` (tracking error). For ``"adaptive"`` pass
-    ``estimator_options`` (weights, gains, initial_radii, ... as for ``estimator_block``).
+    ``estimator_options`` (weights, gains, initial_radii, linear_play, ... as for
+    ``estimator_block``). Blocks: ``plant`` (PI, ``v -> h``), ``dynamics`` (``h -> y``), ``ff``
+    (feedforward ``y_d -> v_ff``), ``est`` (adaptive: radii ``r_hat[i]``, ``est_y_hat``,
+    ``est_e``), ``err``, ``pid``, ``sum_v``; their params are ``"plant.radii"``,
+    ``"est.gains"``, ``"pid.ki"`` ... (:mod:`pimodel.blocks`), and the loop's initial state is
+    :func:`pimodel.blocks.initial_state` ``(loop)``.
     """
     blocks: list = [pi_block(plant, dt, name="plant", input="v", output="h")]
     dyn = _check_dynamics(dynamics, dt, pid)
@@ -202,7 +208,8 @@ def loop_system(plant: PIOperator, dt: float, *, dynamics=None, feedforward="non
     elif feedforward == "adaptive":
         opts = dict(estimator_options or {})
         w = opts.pop("weights")
-        blocks.append(estimator_block(w, dt, name="est", inputs=("v", "y"), **opts))
+        blocks.append(estimator_block(w, dt, name="est", inputs=("v", "y"),
+                                      outputs=("est_y_hat", "est_e"), **opts))
         blocks.append(adaptive_compensator_block(w, dt, name="ff", input="y_d", output="v_ff"))
     else:
         gain = 1.0 / float(plant.weights.sum()) if ff_gain is None else float(ff_gain)

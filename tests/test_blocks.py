@@ -7,7 +7,7 @@ import control
 import numpy as np
 import pytest
 
-from pimodel import PIOperator, RadiusEstimator, estimate_radii
+from pimodel import PIOperator
 from pimodel.actuators import creep_lags, creep_per_decade, second_order_mode, stage_dynamics
 from pimodel.blocks import (
     adaptive_compensator_block,
@@ -15,6 +15,7 @@ from pimodel.blocks import (
     inverse_pi_block,
     pi_block,
     pid_block,
+    radius_estimator,
 )
 from pimodel.compensation import STAGE, compensation_table, identified_models, reference
 from pimodel.loops import PID, loop_system, run_loop
@@ -29,7 +30,7 @@ def test_pi_block_equals_operator():
     t, v = sinusoid(2, 5, fs=1000, duration=1)
     res = simulate(pi_block(op, 1e-3), t, {"v": v})
     np.testing.assert_allclose(res["y"], op.simulate(v), rtol=0, atol=1e-12)
-    np.testing.assert_allclose([res[f"pi_z{i}"][-1] for i in (1, 2, 3)],
+    np.testing.assert_allclose([res[f"z[{i}]"][-1] for i in (1, 2, 3)],
                                op.simulate(v[:-1], return_state=True)[1], atol=1e-12)
 
 
@@ -45,13 +46,13 @@ def test_exact_inverse_compensation_follows_reference():
 def test_estimator_block_equals_batch_estimator_and_converges():
     t, v = triangle(2, 1, fs=1000, duration=6)
     y = STAGE.simulate(v)
-    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
-    blk = estimator_block(STAGE.weights, 1e-3, **kw)
+    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8])
+    blk = estimator_block(STAGE.weights, 1e-3, linear_play=True, **kw)
     res = simulate(blk, t, {"v": v, "y": y})
-    batch = estimate_radii(v, y, STAGE.weights, dt=1e-3, **kw)
-    R = np.column_stack([res[f"r_hat[{i}]"] for i in range(4)])
+    batch = radius_estimator(STAGE.weights, dt=1e-3, linear_play=True, **kw).run(v, y)
+    R = np.column_stack([res[f"r_hat[{i}]"] for i in range(1, 5)])
     np.testing.assert_allclose(R, batch.history, atol=1e-12)
-    np.testing.assert_allclose(res["estimator_y_hat"], batch.model_output, atol=1e-12)
+    np.testing.assert_allclose(res["y_hat"], batch.model_output, atol=1e-12)
     err0 = np.max(np.abs(R[0] - STAGE.radii))
     assert np.max(np.abs(R[-1] - STAGE.radii)) < 0.2 * err0
 
@@ -70,8 +71,8 @@ def test_compiled_loop_equals_python_control(ff, pid):
 
 def test_compiled_adaptive_loop_equals_python_control():
     t, yd = sinusoid(8, 20, fs=1 / DT, duration=0.05)
-    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
-    est = RadiusEstimator(STAGE.weights, dt=DT, **kw)
+    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], linear_play=True)
+    est = radius_estimator(STAGE.weights, dt=DT, **kw)
     fast = run_loop(yd, STAGE, DT, feedforward="adaptive", estimator=est)
     sys = loop_system(STAGE, DT, feedforward="adaptive",
                       estimator_options=dict(weights=STAGE.weights, **kw))
@@ -84,8 +85,8 @@ def test_adaptive_compensator_reaches_exact_inverse():
     a factor 2 of the exact inverse's + 0.01 % of range (both on the static plant)."""
     dt = 1e-3
     t, yd = triangle(8, 1, fs=1 / dt, duration=60)
-    est = RadiusEstimator(STAGE.weights, dt=dt, gains=20.0, initial_radii=[0, 0.4, 0.5, 0.9],
-                          known_linear_play=True)
+    est = radius_estimator(STAGE.weights, dt=dt, gains=20.0, initial_radii=[0, 0.4, 0.5, 0.9],
+                           linear_play=True)
     adaptive = run_loop(yd, STAGE, dt, feedforward="adaptive", estimator=est)
     wrong = run_loop(yd, STAGE, dt, feedforward=PIOperator(STAGE.weights, [0, 0.4, 0.5, 0.9]))
     last = yd.size - 1000

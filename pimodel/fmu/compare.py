@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ..actuators import stage_dynamics
+from ..blocks import radius_estimator
 from ..compensation import STAGE
-from ..estimator import RadiusEstimator
 from ..loops import LoopResult, run_loop
 from ..plotting import new_figure, save_figure
 from ..signals import triangle
@@ -48,8 +48,8 @@ def compare_with_native(fmu_dir, *, duration: float, weights, initial_radii,
                                   initial_radii=initial_radii, dynamics=G,
                                   fmi_version=fmi_version)
     t_co = time.perf_counter() - t0
-    est = RadiusEstimator(weights, dt=DT, gains=gain, initial_radii=initial_radii,
-                          known_linear_play=True)
+    est = radius_estimator(weights, dt=DT, gains=gain, initial_radii=initial_radii,
+                           linear_play=True)
     t0 = time.perf_counter()
     native = run_loop(yd, STAGE, DT, dynamics=G, feedforward="adaptive", estimator=est)
     t_native = time.perf_counter() - t0

@@ -10,10 +10,12 @@ InversePI gets ``y_d[k]`` and the estimator's ``r_hat`` (the estimate after step
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import control
 import numpy as np
+from fmpy import read_model_description
 
 from ..loops import LoopResult
 from ..operator import PIOperator
@@ -25,12 +27,54 @@ def _arrays(prefix: str, values) -> dict:
     return {f"{prefix}[{i + 1}]": float(x) for i, x in enumerate(values)}
 
 
+def _estimator_unit(path, start: dict) -> FMUUnit:
+    """The RadiusEstimator FMU; ``linear_play`` goes to the FMU's variable of that name, or to
+    ``known_linear`` in FMUs built before the rename."""
+    names = {v.name for v in read_model_description(str(path)).modelVariables}
+    if "linear_play" not in names and "known_linear" in names:
+        start = dict(start)
+        start["known_linear"] = start.pop("linear_play")
+    return FMUUnit(path, start, instance_name="estimator")
+
+
 def cosimulate_adaptive_loop(fmu_dir, ref, dt: float, plant: PIOperator, *, weights, gain: float,
-                             initial_radii, dynamics=None, known_linear: bool = True,
+                             initial_radii, dynamics=None, linear_play: bool = True,
                              guard: float = 0.0, slope_window: int = 8,
-                             fmi_version: str = "2.0") -> LoopResult:
-    """Run the adaptive compensation loop with the three FMUs in ``fmu_dir`` (as written by
-    :func:`~pimodel.fmu.build_fmus` for that ``fmi_version``)."""
+                             fmi_version: str = "2.0", estimator_start: dict | None = None,
+                             known_linear: bool | None = None) -> LoopResult:
+    """Run the adaptive compensation loop with the three FMUs in ``fmu_dir``.
+
+    Parameters
+    ----------
+    fmu_dir : str or Path
+        Folder with the FMUs as written by :func:`~pimodel.fmu.build_fmus` for ``fmi_version``.
+    ref : array_like
+        Reference ``y_d[k]`` (desired output).
+    dt : float
+        Sample and communication step [s] (every unit's ``Ts``).
+    plant : PIOperator
+        The plant's hysteresis (PIHysteresis FMU).
+    weights, gain, initial_radii, linear_play, guard, slope_window
+        RadiusEstimator FMU settings (``linear_play`` holds ``r_hat[1] = 0``); ``weights`` is
+        also the adaptive inverse's model.
+    dynamics : control.StateSpace or LTI, optional
+        Discrete SISO stage dynamics after the hysteresis, stepped by the master.
+    fmi_version : str
+        "2.0" or "3.0".
+    estimator_start : dict, optional
+        Further RadiusEstimator FMU start values by variable name (new settings pass through).
+    known_linear : bool, optional
+        Deprecated name of ``linear_play``.
+
+    Returns
+    -------
+    LoopResult
+        ``radii[k]`` is the estimate ``r_hat[1..n]`` the compensator used at step k.
+    """
+    if known_linear is not None:
+        warnings.warn("cosimulate_adaptive_loop: known_linear is deprecated; use linear_play",
+                      DeprecationWarning, stacklevel=2)
+        linear_play = known_linear
     fmu_dir = Path(fmu_dir)
     files = {name: fmu_dir / fmu_filename(name, fmi_version)
              for name in ("PIHysteresis", "RadiusEstimator", "InversePI")}
@@ -40,10 +84,10 @@ def cosimulate_adaptive_loop(fmu_dir, ref, dt: float, plant: PIOperator, *, weig
     plant_fmu = FMUUnit(files["PIHysteresis"], {
         "Ts": dt, "n": plant.n, **_arrays("p", plant.weights), **_arrays("r", plant.radii)},
         instance_name="plant")
-    est = FMUUnit(files["RadiusEstimator"], {
-        "Ts": dt, "n": n, "gain": gain, "known_linear": known_linear, "guard": guard,
-        "slope_window": slope_window, **_arrays("p", w), **_arrays("r", initial_radii)},
-        instance_name="estimator")
+    est = _estimator_unit(files["RadiusEstimator"], {
+        "Ts": dt, "n": n, "gain": gain, "linear_play": linear_play, "guard": guard,
+        "slope_window": slope_window, **_arrays("p", w), **_arrays("r", initial_radii),
+        **(estimator_start or {})})
     inv = FMUUnit(files["InversePI"], {
         "Ts": dt, "n": n, "adaptive": True, **_arrays("p", w)}, instance_name="inverse")
     if dynamics is not None:
