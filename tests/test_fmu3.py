@@ -18,6 +18,7 @@ from pimodel import PIOperator, RadiusEstimator, estimate_radii
 from pimodel.actuators import stage_dynamics
 from pimodel.fmu import MODELS, build_fmus
 from pimodel.fmu.block import fmu_block
+from pimodel.fmu.build import NMAX
 from pimodel.fmu.cosim import cosimulate_adaptive_loop
 from pimodel.fmu.unit import FMUUnit
 from pimodel.loops import run_loop
@@ -47,7 +48,7 @@ def test_fmi3_validates(fmus, name):
     md = fmpy.read_model_description(str(path(fmus, name)))
     assert md.fmiVersion == "3.0"
     p = next(v for v in md.modelVariables if v.name == "p")
-    assert [int(d.start) for d in p.dimensions] == [16]  # a real array, not 16 scalars
+    assert [int(d.start) for d in p.dimensions] == [NMAX]  # a real array, not scalars
     exe = shutil.which("fmutool", path=str(Path(sys.executable).parent))
     if exe is None:
         pytest.skip("fmutool (fmu-manipulation-toolbox) is not installed")
@@ -63,8 +64,8 @@ def test_simulate_fmu_with_arrays_matches_operator(fmus):
     v = 2 * np.sin(2 * np.pi * 3 * t) * np.exp(-t)
     inp = np.array(list(zip(t, v, strict=True)), dtype=[("time", float), ("v", float)])
     res = fmpy.simulate_fmu(str(path(fmus, "PIHysteresis")), input=inp, output=["y"],
-                            start_values={"Ts": TS, "n": 3, "p": np.array(P + [1.0] * 13),
-                                          "r": np.array(R + [0.6] * 13)},
+                            start_values={"Ts": TS, "n": 3, "p": np.array(P + [1.0] * (NMAX - 3)),
+                                          "r": np.array(R + [0.6] * (NMAX - 3))},
                             stop_time=t[-1] + TS, output_interval=TS)
     np.testing.assert_allclose(res["y"][1:], PIOperator(P, R).simulate(v), rtol=0, atol=1e-12)
 
@@ -147,7 +148,7 @@ def test_rollback_and_serialisation(fmus):
 @pytest.mark.parametrize(
     ("name", "start", "message"),
     [
-        ("PIHysteresis", {"n": 17}, "parameter n = 17 out of range"),
+        ("PIHysteresis", {"n": 65}, "parameter n = 65 out of range"),
         ("PIHysteresis", {"n": 2, "r": [0.5, 0.2]}, "not sorted"),
         ("PIHysteresis", {"n": 1, "r": [-0.5]}, "negative"),
         ("PIHysteresis", {"n": 2, "p": [1.0, 0.0]}, "not positive"),
@@ -164,18 +165,18 @@ def test_bad_parameters_give_fmi3error_with_log(fmus, name, start, message):
 def test_nan_input_and_late_parameter_give_error(fmus):
     unit = FMUUnit(path(fmus, "PIHysteresis"), {"n": 1})
     unit.set({"v": float("nan")})
-    with pytest.raises(ValueError, match="input is not finite"):
+    with pytest.raises(ValueError, match="input v = nan is not finite"):
         unit.step(TS)
     with pytest.raises(fmpy.fmi1.FMICallException):
         unit.set({"p": [2.0]})  # parameters are fixed after initialisation
-    assert "parameter after initialization" in unit.log[-1]
+    assert "cannot set parameter p (value reference 100) after initialization" in unit.log[-1]
     unit.close()
 
 
 def test_fmu_block_and_cosimulation(fmus):
     blk = fmu_block(path(fmus, "RadiusEstimator"), TS, name="est3",
                     start={"Ts": TS, "n": 2, "p": [1.0, 0.5], "r": [0.0, 0.3]})
-    assert blk.output_labels == ["y_hat", "e", *[f"r_hat[{i}]" for i in range(1, 17)]]
+    assert blk.output_labels == ["y_hat", "e", *[f"r_hat[{i}]" for i in range(1, NMAX + 1)]]
     assert blk.input_labels == ["v", "y"]
     dt = 1e-4
     _, yd = sinusoid(8, 20, fs=1 / dt, duration=0.05)

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import escape
 
-NMAX = 16  # declared array variables per FMU (p[1..16], r[1..16], r_hat[1..16])
+NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
 HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
@@ -61,7 +61,7 @@ def _arrays(prefix: str, base: int, causality: str, start: str, what: str) -> li
 
 def _common() -> list[Var]:
     return [
-        Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (> 0)"),
+        Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (>= 1e-12)"),
         Var("n", 1, "Integer", "parameter", "1", f"number of plays, 1 <= n <= {NMAX}"),
         Var("z0", 2, "Real", "parameter", "0", "initial play state (input unit)"),
         *_arrays("p", 100, "parameter", "1", "weight p (> 0), play"),
