@@ -323,6 +323,17 @@ static void unit_sample(pim_unit *u)
 #endif
 }
 
+/* Whether the outputs (and the estimator's radii) are finite. */
+static int unit_outputs_finite(const pim_unit *u)
+{
+    if (!isfinite(u->out1) || !isfinite(u->out2)) return 0;
+#if PIM_MODEL == 2
+    for (int i = 0; i < u->n; ++i)
+        if (!isfinite(u->rhat_out[i])) return 0;
+#endif
+    return 1;
+}
+
 /* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
 static int unit_do_step(pim_unit *u, double t, double h)
 {
@@ -348,11 +359,39 @@ static int unit_do_step(pim_unit *u, double t, double h)
         return unit_error(u, "step h = %g spans %lld samples of Ts = %g; at most %lld per doStep "
                              "(use shorter communication steps)", h,
                           (long long)(k1 - u->k_next), u->Ts, PIM_MAX_SUBSTEPS);
-    if (k1 > u->k_next && unit_check_inputs(u) != 0) return -1;
-    for (; u->k_next < k1; ++u->k_next) unit_sample(u);
+    if (k1 <= u->k_next) {
+        u->time = t_end;
+        return 0;
+    }
+    if (unit_check_inputs(u) != 0) return -1;
+    /* a step that overflows is not taken: the states it changes are restored */
+    const int64_t k_saved = u->k_next;
+    const double out_saved[2] = {u->out1, u->out2};
+#if PIM_MODEL == 2
+    const pim_estimator est_saved = u->est;
+#else
+    double z_saved[PIM_MAX_PLAYS];
+    memcpy(z_saved, u->z, (size_t)u->n * sizeof(double));
+#endif
+    for (; u->k_next < k1; ++u->k_next) {
+        unit_sample(u);
+        if (!unit_outputs_finite(u)) {
+            const double y1 = u->out1, y2 = u->out2;
+            u->k_next = k_saved;
+            u->out1 = out_saved[0];
+            u->out2 = out_saved[1];
+#if PIM_MODEL == 2
+            u->est = est_saved;
+            for (int i = 0; i < u->n; ++i) u->rhat_out[i] = u->est.rhat[i];
+#else
+            memcpy(u->z, z_saved, (size_t)u->n * sizeof(double));
+#endif
+            return unit_error(u, "the outputs overflowed (%g, %g) at sample %lld with the "
+                                 "inputs held over this step; the step was not taken", y1, y2,
+                              (long long)u->k_next);
+        }
+    }
     u->time = t_end;
-    if (!isfinite(u->out1) || !isfinite(u->out2))
-        return unit_error(u, "output is not finite (overflow): %g, %g", u->out1, u->out2);
     return 0;
 }
 
@@ -530,8 +569,6 @@ static int unit_all_finite(const double *x, size_t n)
 static int unit_check_states(pim_unit *u, pim_unit *s)
 {
     const size_t n = (size_t)s->n;
-    if (!isfinite(s->out1) || !isfinite(s->out2))
-        return unit_error(u, "FMU state rejected: an output is not finite");
     const double k = unit_first_sample(s, s->time);
     if (!(k < PIM_MAX_SAMPLE_INDEX) || s->k_next != (int64_t)k)
         return unit_error(u, "FMU state rejected: sample counter %lld does not match time %g "
@@ -603,6 +640,8 @@ static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
         rc = unit_error(u, "FMU state rejected: unknown mode %d", s->mode);
     else if (!isfinite(s->time) || s->time < 0.0)
         rc = unit_error(u, "FMU state rejected: time %g must be finite and >= 0", s->time);
+    else if (!isfinite(s->out1) || !isfinite(s->out2))
+        rc = unit_error(u, "FMU state rejected: an output is not finite");
     else if (s->mode >= PIM_STEP_MODE) {
         if (unit_check_parameters(s) != 0)
             rc = unit_error(u, "FMU state rejected: %s", s->msg);
