@@ -224,3 +224,57 @@ def test_bad_build_and_cosim_version(tmp_path):
     with pytest.raises(ValueError, match="fmi_version: expected one of"):
         cosimulate_adaptive_loop(tmp_path, [0.0, 1.0], 1e-3, STAGE, weights=STAGE.weights,
                                  gain=1.0, initial_radii=STAGE.radii, fmi_version="1.0")
+
+
+def _c_variable_table() -> dict[int, list[tuple[str, int, str, str, int]]]:
+    """unit_vars of fmu/src/pim_unit.h per unit id: (name, vr, type, causality, size)."""
+    import re
+
+    from pimodel.fmu.build import source_dir
+
+    text = (source_dir() / "pim_unit.h").read_text()
+    enum = {k: int(v) for k, v in re.findall(r"\bvr_(\w+) = (\d+)", text)}
+    nmax = int(re.search(r"#define PIM_MAX_PLAYS (\d+)", (source_dir() / "pim_core.h")
+                         .read_text()).group(1))
+    body = text[text.index("static const pim_var unit_vars[] = {"):]
+    body = body[: body.index("};")]
+    row = re.compile(r"\{\"(\w+)\", vr_(\w+), '(\w)', PIM_(\w+), (\w+), PIM_AT\(\w+\)\}")
+    tables: dict[int, list] = {1: [], 2: [], 3: []}
+    current = None  # None: rows of every unit
+    for line in body.splitlines():
+        m = re.match(r"#(?:el)?if PIM_MODEL == (\d)", line.strip())
+        if m or line.strip() in ("#else", "#endif"):
+            current = int(m.group(1)) if m else 3 if line.strip() == "#else" else None
+            continue
+        for name, vr, typ, causality, size in row.findall(line):
+            entry = (name, enum[vr], typ, causality.lower(),
+                     nmax if size == "PIM_NMAX" else int(size))
+            for unit in tables if current is None else [current]:
+                tables[unit].append(entry)
+    return tables
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_model_descriptions_match_the_c_value_references(fmus, name):
+    """One source of truth: every variable of the built modelDescription.xml (FMI 2 and 3) has
+    the name, value reference, type, causality and size of pim_unit.h's table, and back."""
+    table = _c_variable_table()[MODELS[name]["id"]]
+    assert NMAX == max(size for *_, size in table)
+    types2 = {"R": "Real", "I": "Integer", "B": "Boolean"}
+    types3 = {"R": "Float64", "I": "Int32", "B": "Boolean"}
+    want2, want3 = set(), set()
+    for vname, vr, typ, causality, size in table:
+        want3.add((vname, vr, types3[typ], causality, size))
+        if causality == "independent":
+            continue  # FMI 2 Co-Simulation has no time variable
+        if size == 1:
+            want2.add((vname, vr, types2[typ], causality, 1))
+        else:
+            want2 |= {(f"{vname}[{i + 1}]", vr + i, types2[typ], causality, 1)
+                      for i in range(size)}
+    for file, want in ((fmus / f"{name}.fmu", want2), (path(fmus, name), want3)):
+        md = fmpy.read_model_description(str(file))
+        got = {(v.name, v.valueReference, v.type, v.causality,
+                int(np.prod([int(d.start) for d in v.dimensions])) if v.dimensions else 1)
+               for v in md.modelVariables}
+        assert got == want, (file.name, got ^ want)

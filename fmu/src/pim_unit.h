@@ -18,7 +18,7 @@
  *   h finite and > 0, and t + h > t.
  *
  * Value references: the enum ValueReference and, per unit, the table unit_vars (name, reference,
- * type, causality, size) are the one source of truth in C; tests/test_fmu_vr.py holds every
+ * type, causality, size) are the one source of truth in C; tests/test_fmu3.py holds every
  * built modelDescription.xml (FMI 2 and 3) equal to unit_vars.  In FMI 2 array element
  * p[i+1] has reference 100 + i (r 200 + i, r_hat 300 + i); in FMI 3 an array is one variable.
  */
@@ -26,6 +26,7 @@
 #define PIM_UNIT_H
 
 #include <math.h>
+#include <stddef.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -73,40 +74,10 @@ typedef struct {
     unsigned vr;
     char type; /* 'R' Real/Float64, 'I' Integer/Int32, 'B' Boolean */
     pim_causality causality;
-    int size; /* 1, or PIM_NMAX for an array */
+    int size;      /* 1, or PIM_NMAX for an array */
+    size_t offset; /* of the value(s) in pim_unit */
 } pim_var;
 
-/* The variables of the unit (the model description is generated to the same list). */
-static const pim_var unit_vars[] = {
-    {"time", vr_time, 'R', PIM_INDEPENDENT, 1},
-    {"Ts", vr_Ts, 'R', PIM_PARAMETER, 1},
-    {"n", vr_n, 'I', PIM_PARAMETER, 1},
-    {"z0", vr_z0, 'R', PIM_PARAMETER, 1},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX},
-#if PIM_MODEL == 1
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX},
-    {"v", vr_in1, 'R', PIM_INPUT, 1},
-    {"y", vr_out1, 'R', PIM_OUTPUT, 1},
-#elif PIM_MODEL == 2
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX},
-    {"gain", vr_gain, 'R', PIM_PARAMETER, 1},
-    {"known_linear", vr_known_linear, 'B', PIM_PARAMETER, 1},
-    {"guard", vr_guard, 'R', PIM_PARAMETER, 1},
-    {"slope_window", vr_slope_window, 'I', PIM_PARAMETER, 1},
-    {"v", vr_in1, 'R', PIM_INPUT, 1},
-    {"y", vr_in2, 'R', PIM_INPUT, 1},
-    {"y_hat", vr_out1, 'R', PIM_OUTPUT, 1},
-    {"e", vr_out2, 'R', PIM_OUTPUT, 1},
-    {"r_hat", vr_r_hat, 'R', PIM_OUTPUT, PIM_NMAX},
-#else
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX},
-    {"adaptive", vr_adaptive, 'B', PIM_PARAMETER, 1},
-    {"y_d", vr_in1, 'R', PIM_INPUT, 1},
-    {"v", vr_out1, 'R', PIM_OUTPUT, 1},
-    {"r_hat", vr_r_hat, 'R', PIM_INPUT, PIM_NMAX},
-#endif
-};
-#define PIM_NVARS (sizeof unit_vars / sizeof unit_vars[0])
 
 /* Life cycle (FMI 2 and 3 Co-Simulation): instantiated -> initialization mode -> step mode
  * (after a successful exitInitializationMode) -> terminated; reset goes back to instantiated. */
@@ -130,6 +101,41 @@ typedef struct {
     pim_estimator est;
     char msg[256]; /* reason of the last failure */
 } pim_unit;
+
+#define PIM_AT(field) offsetof(pim_unit, field)
+
+/* The variables of the unit (the model description is generated to the same list); inputs and
+ * outputs first, as the accessors scan it on every call. */
+static const pim_var unit_vars[] = {
+#if PIM_MODEL == 1
+    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+#elif PIM_MODEL == 2
+    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_in2, 'R', PIM_INPUT, 1, PIM_AT(in2)},
+    {"y_hat", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"e", vr_out2, 'R', PIM_OUTPUT, 1, PIM_AT(out2)},
+    {"r_hat", vr_r_hat, 'R', PIM_OUTPUT, PIM_NMAX, PIM_AT(rhat_out)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"gain", vr_gain, 'R', PIM_PARAMETER, 1, PIM_AT(gain)},
+    {"known_linear", vr_known_linear, 'B', PIM_PARAMETER, 1, PIM_AT(known_linear)},
+    {"guard", vr_guard, 'R', PIM_PARAMETER, 1, PIM_AT(guard)},
+    {"slope_window", vr_slope_window, 'I', PIM_PARAMETER, 1, PIM_AT(slope_window)},
+#else
+    {"y_d", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"v", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r_hat", vr_r_hat, 'R', PIM_INPUT, PIM_NMAX, PIM_AT(rhat_in)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"adaptive", vr_adaptive, 'B', PIM_PARAMETER, 1, PIM_AT(adaptive)},
+#endif
+    {"Ts", vr_Ts, 'R', PIM_PARAMETER, 1, PIM_AT(Ts)},
+    {"n", vr_n, 'I', PIM_PARAMETER, 1, PIM_AT(n)},
+    {"z0", vr_z0, 'R', PIM_PARAMETER, 1, PIM_AT(z0)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"time", vr_time, 'R', PIM_INDEPENDENT, 1, PIM_AT(time)},
+};
+#define PIM_NVARS (sizeof unit_vars / sizeof unit_vars[0])
 
 static int unit_error(pim_unit *u, const char *fmt, ...)
 {
@@ -342,8 +348,9 @@ static int unit_do_step(pim_unit *u, double t, double h)
         return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
     if (!isfinite(h) || !(h > 0.0))
         return unit_error(u, "communication step size h = %g: must be finite and > 0", h);
-    const double tol = fmin(1e-9 * fmax(1.0, fabs(u->time)), 1e-3 * u->Ts);
-    if (fabs(t - u->time) > tol)
+    const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
+    const double tol = 1e-9 * scale < 1e-3 * u->Ts ? 1e-9 * scale : 1e-3 * u->Ts;
+    if (t != u->time && fabs(t - u->time) > tol)
         return unit_error(u, "communication point t = %.17g does not match the FMU's time "
                              "%.17g (the end of the last step)", t, u->time);
     const double t_end = t + h;
@@ -371,7 +378,7 @@ static int unit_do_step(pim_unit *u, double t, double h)
     const pim_estimator est_saved = u->est;
 #else
     double z_saved[PIM_MAX_PLAYS];
-    memcpy(z_saved, u->z, (size_t)u->n * sizeof(double));
+    for (int i = 0; i < u->n; ++i) z_saved[i] = u->z[i];
 #endif
     for (; u->k_next < k1; ++u->k_next) {
         unit_sample(u);
@@ -401,17 +408,19 @@ static int unit_do_step(pim_unit *u, double t, double h)
  * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
 static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
+    /* FMI 2 array elements: base 100, 200, 300 plus an index below PIM_NMAX */
+    const unsigned base = elements && vr >= 100 && vr < 400 ? vr - vr % 100 : vr;
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
-        if (elements && v->causality == PIM_INDEPENDENT) continue; /* FMI 2 has no time */
-        if (vr == v->vr && !(elements && v->size > 1)) {
-            *elem = -1;
-            return v;
+        if (v->vr != base) continue;
+        if (v->size > 1 && elements) {
+            if (vr - base >= (unsigned)v->size) return NULL;
+            *elem = (int)(vr - base);
+        } else {
+            if (vr != base || (elements && v->causality == PIM_INDEPENDENT)) return NULL;
+            *elem = -1; /* FMI 2 has no time variable */
         }
-        if (elements && v->size > 1 && vr >= v->vr && vr < v->vr + (unsigned)v->size) {
-            *elem = (int)(vr - v->vr);
-            return v;
-        }
+        return v;
     }
     return NULL;
 }
@@ -426,29 +435,6 @@ static const char *unit_label(const pim_var *v, int elem, char *buf, size_t size
     return buf;
 }
 
-static void *unit_storage(pim_unit *u, const pim_var *v)
-{
-    switch ((ValueReference)v->vr) {
-    case vr_time: return &u->time;
-    case vr_Ts: return &u->Ts;
-    case vr_n: return &u->n;
-    case vr_z0: return &u->z0;
-    case vr_adaptive: return &u->adaptive;
-    case vr_gain: return &u->gain;
-    case vr_known_linear: return &u->known_linear;
-    case vr_guard: return &u->guard;
-    case vr_slope_window: return &u->slope_window;
-    case vr_in1: return &u->in1;
-    case vr_out1: return &u->out1;
-    case vr_in2: return &u->in2;
-    case vr_out2: return &u->out2;
-    case vr_p: return u->p;
-    case vr_r: return u->r;
-    case vr_r_hat: return PIM_MODEL == 2 ? u->rhat_out : u->rhat_in;
-    }
-    return NULL;
-}
-
 /*
  * Storage of the variable with reference vr, checked against the model description (exists,
  * has type `type`) and, for set != 0, against the mode (parameters before initialization,
@@ -457,8 +443,7 @@ static void *unit_storage(pim_unit *u, const pim_var *v)
  */
 static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set, size_t *count)
 {
-    static const char *const type_names[] = {"Real", "Integer", "Boolean"};
-    const char *tname = type_names[type == 'R' ? 0 : type == 'I' ? 1 : 2];
+    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : "Boolean";
     int elem;
     const pim_var *v = unit_var(vr, elements, &elem);
     if (!v) {
@@ -466,29 +451,28 @@ static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set
                    vr);
         return NULL;
     }
-    char name[40];
-    unit_label(v, elem, name, sizeof name);
+    char name[40]; /* formatted only on an error (the accessors are on the hot path) */
     if (v->type != type) {
-        unit_error(u, "variable %s (value reference %u) is not a %s", name, vr, tname);
+        unit_error(u, "variable %s (value reference %u) is not a %s",
+                   unit_label(v, elem, name, sizeof name), vr, tname);
         return NULL;
     }
     if (set) {
         int rc = 0;
         if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT)
             rc = unit_error(u, "variable %s (value reference %u) is an output and cannot be set",
-                            name, vr);
+                            unit_label(v, elem, name, sizeof name), vr);
         else if (v->causality == PIM_PARAMETER &&
                  !(u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE))
             rc = unit_error(u, "cannot set parameter %s (value reference %u) after "
-                               "initialization", name, vr);
+                               "initialization", unit_label(v, elem, name, sizeof name), vr);
         else if (u->mode == PIM_TERMINATED)
-            rc = unit_error(u, "cannot set input %s (value reference %u) after terminate", name,
-                            vr);
+            rc = unit_error(u, "cannot set input %s (value reference %u) after terminate",
+                            unit_label(v, elem, name, sizeof name), vr);
         if (rc) return NULL;
     }
     *count = elem >= 0 ? 1 : (size_t)v->size;
-    char *base = (char *)unit_storage(u, v);
-    return base + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
+    return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
 }
 
 /* ---- FMU state: a checked, versioned byte format ------------------------------------------ */
