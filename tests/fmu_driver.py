@@ -318,6 +318,13 @@ class Driver:
             rec["changed"] = new != blob
             ctypes.memmove(handle.value, new, len(new))
             return 0, None
+        if name == "_segfault":  # proves that run_job turns a crash into a failure
+            ctypes.string_at(1)
+        if name == "_sleep":  # proves that run_job turns a hang into a failure
+            import time
+
+            time.sleep(args[0])
+            return 0, None
         raise ValueError(f"unknown action {name!r}")
 
 

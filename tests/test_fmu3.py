@@ -258,8 +258,14 @@ def _c_variable_table() -> dict[int, list[tuple[str, int, str, str, int]]]:
 def test_model_descriptions_match_the_c_value_references(fmus, name):
     """One source of truth: every variable of the built modelDescription.xml (FMI 2 and 3) has
     the name, value reference, type, causality and size of pim_unit.h's table, and back."""
+    import re
+
+    from pimodel.fmu.build import MAX_SUBSTEPS, source_dir
+
     table = _c_variable_table()[MODELS[name]["id"]]
     assert NMAX == max(size for *_, size in table)
+    header = (source_dir() / "pim_unit.h").read_text()
+    assert int(re.search(r"#define PIM_MAX_SUBSTEPS (\d+)LL", header).group(1)) == MAX_SUBSTEPS
     types2 = {"R": "Real", "I": "Integer", "B": "Boolean"}
     types3 = {"R": "Float64", "I": "Int32", "B": "Boolean"}
     want2, want3 = set(), set()

@@ -27,6 +27,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from fmu_driver import (  # noqa: E402
     NMAX,
     STATUS_SKIPPED,
+    DriverFailure,
     StateHeader,
     UnitPrefix,
     read_field,
@@ -206,6 +207,15 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
             (["exit_init"], ERROR, "parameter n = 65 out of range: 1 <= n <= 64")],
     }
     return cases
+
+
+def test_driver_reports_crashes_and_hangs(fmu_dir):
+    """The harness itself: a segfault or a hang in the child fails with the run named."""
+    fmu = fmu_path(fmu_dir, "PIHysteresis", "2.0")
+    with pytest.raises(DriverFailure, match=r"crash: exit status -?\d+ after 1 of 2 runs"):
+        run_job(fmu, [[["get_real", VR["out1"]]], [["_segfault"]]])
+    with pytest.raises(DriverFailure, match=r"hang: no answer within 3 s; run 0"):
+        run_job(fmu, [[["_sleep", 60]]], timeout=3)
 
 
 @pytest.mark.parametrize(("name", "fmi"), CONFIGS, ids=IDS)

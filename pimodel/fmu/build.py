@@ -18,6 +18,7 @@ from pathlib import Path
 from xml.sax.saxutils import escape
 
 NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
+MAX_SUBSTEPS = 10_000_000  # samples per doStep; PIM_MAX_SUBSTEPS in fmu/src/pim_unit.h
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
 HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
@@ -206,7 +207,10 @@ def _documentation(name: str) -> str:
     return (f"<html><body><h1>{name}</h1><p>{escape(spec['description'])}.</p>"
             f"<p>{escape(SAMPLING)} Arrays are declared up to index {NMAX}; the first n are "
             "used. Bad parameters or non-finite inputs return an error status (fmi2Error, "
-            "fmi3Error) with a logged message."
+            "fmi3Error) with a logged message, as do a call in the wrong state, an unknown "
+            "value reference, a doStep whose t is not the FMU's time, a step of more than "
+            f"{MAX_SUBSTEPS:,} samples, and an FMU state that fails its checks (format, "
+            "checksum, parameters, finite states)."
             f"</p><table>{rows}</table></body></html>\n")
 
 
