@@ -46,7 +46,7 @@ class UnitPrefix(ctypes.Structure):
 
     _fields_ = [("Ts", ctypes.c_double), ("z0", ctypes.c_double), ("gain", ctypes.c_double),
                 ("guard", ctypes.c_double), ("n", ctypes.c_int), ("adaptive", ctypes.c_int),
-                ("known_linear", ctypes.c_int), ("slope_window", ctypes.c_int),
+                ("linear_play", ctypes.c_int), ("slope_window", ctypes.c_int),
                 ("p", ctypes.c_double * NMAX), ("r", ctypes.c_double * NMAX),
                 ("in1", ctypes.c_double), ("in2", ctypes.c_double), ("out1", ctypes.c_double),
                 ("out2", ctypes.c_double), ("rhat_in", ctypes.c_double * NMAX),
@@ -55,7 +55,7 @@ class UnitPrefix(ctypes.Structure):
                 ("z", ctypes.c_double * NMAX)]
 
 
-FIELD_FORMAT = {"n": "i", "adaptive": "i", "known_linear": "i", "slope_window": "i",
+FIELD_FORMAT = {"n": "i", "adaptive": "i", "linear_play": "i", "slope_window": "i",
                 "mode": "i", "k_next": "q"}  # others are doubles
 
 

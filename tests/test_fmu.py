@@ -95,7 +95,7 @@ def test_estimator_fmu_matches_python(fmus):
     kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
     ref = estimate_radii(v, y, STAGE.weights, dt=TS, **kw)
     unit = FMUUnit(fmus / "RadiusEstimator.fmu", {
-        "Ts": TS, "n": 4, "gain": 20.0, "known_linear": True, **arr("p", STAGE.weights),
+        "Ts": TS, "n": 4, "gain": 20.0, "linear_play": True, **arr("p", STAGE.weights),
         **arr("r", kw["initial_radii"])})
     names = [f"r_hat[{i + 1}]" for i in range(4)] + ["y_hat", "e"]
     out = []
@@ -108,6 +108,17 @@ def test_estimator_fmu_matches_python(fmus):
     np.testing.assert_allclose(out[:, :4], np.vstack((ref.history[1:], ref.radii)), atol=1e-12)
     np.testing.assert_allclose(out[:, 4], ref.model_output, atol=1e-12)
     np.testing.assert_allclose(out[:, 5], ref.error, atol=1e-12)
+
+
+def test_old_variable_name_known_linear_warns_and_works(fmus):
+    start = {"Ts": TS, "n": 2, "p[1]": 1.0, "p[2]": 0.5, "r[1]": 0.3, "r[2]": 0.5}
+    with pytest.warns(DeprecationWarning, match="'known_linear' is now 'linear_play'"):
+        unit = FMUUnit(fmus / "RadiusEstimator.fmu", {**start, "known_linear": True})
+    np.testing.assert_array_equal(unit.get(["r_hat[1]", "r_hat[2]"]), [0.0, 0.5])  # held at 0
+    unit.close()
+    unit = FMUUnit(fmus / "RadiusEstimator.fmu", start)
+    np.testing.assert_array_equal(unit.get(["r_hat[1]", "r_hat[2]"]), [0.3, 0.5])
+    unit.close()
 
 
 def test_inverse_fmu_fixed_and_adaptive_match_python(fmus):

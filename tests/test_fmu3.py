@@ -96,7 +96,7 @@ def test_estimator_and_inverse_match_python(fmus):
     kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
     ref = estimate_radii(v, y, STAGE.weights, dt=TS, **kw)
     est = FMUUnit(path(fmus, "RadiusEstimator"), {
-        "Ts": TS, "n": 4, "gain": 20.0, "known_linear": True, "p": STAGE.weights,
+        "Ts": TS, "n": 4, "gain": 20.0, "linear_play": True, "p": STAGE.weights,
         "r": kw["initial_radii"]})
     out = []
     for a, b in zip(v, y, strict=True):

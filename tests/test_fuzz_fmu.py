@@ -44,7 +44,7 @@ P, R = [1.0, 0.5, 0.3], [0.0, 0.2, 0.6]
 CONFIGS = [(name, fmi) for name in MODELS for fmi in ("2.0", "3.0")]
 IDS = [f"{name}-fmi{fmi[0]}" for name, fmi in CONFIGS]
 OK, ERROR = 0, 3
-VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "known_linear": 5, "guard": 6,
+VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "guard": 6,
       "slope_window": 7, "time": 9, "in1": 10, "out1": 11, "in2": 12, "out2": 13, "p": 100,
       "r": 200, "r_hat": 300}
 
@@ -189,7 +189,7 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
             *([(["get_real", VR["gain"]], ERROR, "value reference 4"),
                (["get_real", VR["r_hat"]], ERROR, "value reference 300")]
               if name == "PIHysteresis" else []),
-            *([(["get_bool", VR["known_linear"]], ERROR, "value reference 5")]
+            *([(["get_bool", VR["linear_play"]], ERROR, "value reference 5")]
               if name != "RadiusEstimator" else [])],
         "calls in the wrong state": [
             (["step_next", TS], ERROR, "doStep is not allowed now: the FMU is instantiated"),
@@ -337,7 +337,7 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
                   ["set_real", VR["guard"], _pick_float(rng, rng.uniform(0, 0.1), 0.1 * hostile)],
                   ["set_int", VR["slope_window"], rng.choice([0, 8, 8, 63, 64, -1, 10**9])
                    if hostile else rng.choice([0, 8, 63])],
-                  ["set_bool", VR["known_linear"], rng.random() < 0.5]]
+                  ["set_bool", VR["linear_play"], rng.random() < 0.5]]
     if name == "InversePI":
         extra.append(["set_bool", VR["adaptive"], rng.random() < 0.5])
     acts = init(name, fmi3, n=n, p=p, r=r, Ts=Ts, t0=t0, extra=extra)

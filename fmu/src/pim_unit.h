@@ -54,7 +54,7 @@ typedef enum {
     vr_z0 = 2,
     vr_adaptive = 3,
     vr_gain = 4,
-    vr_known_linear = 5,
+    vr_linear_play = 5,
     vr_guard = 6,
     vr_slope_window = 7,
     vr_time = 9, /* FMI 3 independent variable */
@@ -86,7 +86,7 @@ enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED };
 typedef struct {
     /* parameters */
     double Ts, z0, gain, guard;
-    int n, adaptive, known_linear, slope_window;
+    int n, adaptive, linear_play, slope_window;
     double p[PIM_NMAX], r[PIM_NMAX];
     /* inputs and outputs */
     double in1, in2, out1, out2;
@@ -119,7 +119,7 @@ static const pim_var unit_vars[] = {
     {"r_hat", vr_r_hat, 'R', PIM_OUTPUT, PIM_NMAX, PIM_AT(rhat_out)},
     {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
     {"gain", vr_gain, 'R', PIM_PARAMETER, 1, PIM_AT(gain)},
-    {"known_linear", vr_known_linear, 'B', PIM_PARAMETER, 1, PIM_AT(known_linear)},
+    {"linear_play", vr_linear_play, 'B', PIM_PARAMETER, 1, PIM_AT(linear_play)},
     {"guard", vr_guard, 'R', PIM_PARAMETER, 1, PIM_AT(guard)},
     {"slope_window", vr_slope_window, 'I', PIM_PARAMETER, 1, PIM_AT(slope_window)},
 #else
@@ -226,8 +226,8 @@ static int unit_check_parameters(pim_unit *u)
     if (u->slope_window < 0 || u->slope_window >= PIM_EST_WIN)
         return unit_error(u, "parameter slope_window = %d out of range: 0 <= slope_window <= %d",
                           u->slope_window, PIM_EST_WIN - 1);
-    if (u->known_linear != 0 && u->known_linear != 1)
-        return unit_error(u, "parameter known_linear = %d: must be a Boolean", u->known_linear);
+    if (u->linear_play != 0 && u->linear_play != 1)
+        return unit_error(u, "parameter linear_play = %d: must be a Boolean", u->linear_play);
 #elif PIM_MODEL == 3
     if (u->adaptive != 0 && u->adaptive != 1)
         return unit_error(u, "parameter adaptive = %d: must be a Boolean", u->adaptive);
@@ -245,7 +245,7 @@ static int unit_init_estimator(pim_unit *u, pim_estimator *est)
     double g[PIM_NMAX];
     for (int i = 0; i < u->n; ++i) g[i] = u->gain;
     const char *msg = pim_est_init(est, (size_t)u->n, u->p, g, u->r, u->Ts, u->z0, 0.0, 0.0, 0.0,
-                                   u->guard, u->known_linear);
+                                   u->guard, u->linear_play);
     if (!msg) msg = pim_est_set_slope_check(est, u->slope_window, 0.5);
     return msg ? unit_error(u, "bad parameters: %s", msg) : 0;
 }

@@ -82,8 +82,8 @@ MODELS: dict[str, dict] = {
         "description": "Adaptive estimation of the play radii (gradient law with projection)",
         "vars": [*_common(), *_arrays("r", 200, "parameter", "0", "initial radius estimate, play"),
                  Var("gain", 4, "Real", "parameter", "10", "adaptation gain (>= 0)"),
-                 Var("known_linear", 5, "Boolean", "parameter", "false",
-                     "hold r_hat[1] = 0 (known linear play)"),
+                 Var("linear_play", 5, "Boolean", "parameter", "false",
+                     "the model has a linear play: hold r_hat[1] = 0"),
                  Var("guard", 6, "Real", "parameter", "0", "breakpoint guard band (input unit)"),
                  Var("slope_window", 7, "Integer", "parameter", "8",
                      "slope check window in samples (0: off)"),
@@ -107,10 +107,10 @@ MODELS: dict[str, dict] = {
 
 
 def guid(name: str) -> str:
-    """Fixed GUID of a unit (changes with the interface version)."""
+    """Fixed GUID of a unit (changes with the interface version: v2 has 64 plays, linear_play)."""
     import uuid
 
-    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi2/{name}/v1")) + "}"
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi2/{name}/v2")) + "}"
 
 
 def source_dir() -> Path:

@@ -41,7 +41,7 @@ def cosimulate_adaptive_loop(fmu_dir, ref, dt: float, plant: PIOperator, *, weig
         "Ts": dt, "n": plant.n, **_arrays("p", plant.weights), **_arrays("r", plant.radii)},
         instance_name="plant")
     est = FMUUnit(files["RadiusEstimator"], {
-        "Ts": dt, "n": n, "gain": gain, "known_linear": known_linear, "guard": guard,
+        "Ts": dt, "n": n, "gain": gain, "linear_play": known_linear, "guard": guard,
         "slope_window": slope_window, **_arrays("p", w), **_arrays("r", initial_radii)},
         instance_name="estimator")
     inv = FMUUnit(files["InversePI"], {
