@@ -199,6 +199,8 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
              "cannot set parameter Ts (value reference 0) after initialization"),
             (["set_int", VR["n"], 2], ERROR, "cannot set parameter n"),
             (["set_real", VR["out1"], 1.0], ERROR, "is an output and cannot be set"),
+            *([(["set_real", VR["time"], 1.0], ERROR, "variable time (value reference 9) is "
+                "the independent variable and cannot be set")] if fmi3 else []),
             (["enter_init", 0.0], ERROR, "EnterInitializationMode is not allowed now"),
             *step],
         "indexed parameter messages": expect(init(name, fmi3, p=[1.0, 0.5, -1.0])[:-1]) + [

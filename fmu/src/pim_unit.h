@@ -460,8 +460,9 @@ static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set
     if (set) {
         int rc = 0;
         if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT)
-            rc = unit_error(u, "variable %s (value reference %u) is an output and cannot be set",
-                            unit_label(v, elem, name, sizeof name), vr);
+            rc = unit_error(u, "variable %s (value reference %u) is %s and cannot be set",
+                            unit_label(v, elem, name, sizeof name), vr,
+                            v->causality == PIM_OUTPUT ? "an output" : "the independent variable");
         else if (v->causality == PIM_PARAMETER &&
                  !(u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE))
             rc = unit_error(u, "cannot set parameter %s (value reference %u) after "
