@@ -173,6 +173,14 @@ def test_nan_input_and_late_parameter_give_error(fmus):
     unit.close()
 
 
+def test_short_array_gives_logged_error(fmus):
+    unit = FMUUnit(path(fmus, "PIHysteresis"), {"n": 1})
+    with pytest.raises(fmpy.fmi1.FMICallException):
+        unit.fmu.getFloat64([100], nValues=16)  # p has 64 values
+    assert "nValues = 16 is too small: at least 64 values needed" in unit.log[-1]
+    unit.close()
+
+
 def test_fmu_block_and_cosimulation(fmus):
     blk = fmu_block(path(fmus, "RadiusEstimator"), TS, name="est3",
                     start={"Ts": TS, "n": 2, "p": [1.0, 0.5], "r": [0.0, 0.3]})

@@ -168,9 +168,10 @@ fmi3Status fmi3DoStep(fmi3Instance inst, fmi3Float64 t, fmi3Float64 h, fmi3Boole
         CTYPE *x = (CTYPE *)unit_ref(&c->u, vr[i], TYPE_CHAR, 0, SET, &cnt);                  \
         if (!x) return status(c, -1);                                                         \
         if (k + cnt > nValues)                                                                \
-            return status(c, unit_error(&c->u, "nValues = %llu is too small for the %llu "   \
-                                        "variables", (unsigned long long)nValues,             \
-                                        (unsigned long long)nvr));                            \
+            return status(c, unit_error(&c->u, "nValues = %llu is too small: at least %llu " \
+                                        "values needed (an array moves all its values)",      \
+                                        (unsigned long long)nValues,                          \
+                                        (unsigned long long)(k + cnt)));                      \
         for (size_t j = 0; j < cnt; ++j, ++k) {                                               \
             if (SET) { TO_UNIT; } else { FROM_UNIT; }                                         \
         }                                                                                     \
