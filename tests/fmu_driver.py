@@ -332,8 +332,10 @@ class DriverFailure(AssertionError):
     """The child process crashed, hung or died before reporting every run."""
 
 
-def run_job(fmu_path, runs: list[list], *, timeout: float = 120.0) -> list[list[dict]]:
-    """Run ``runs`` (lists of actions) against the FMU in a child process.
+def run_job(fmu_path, runs: list[list], *, timeout: float = 120.0,
+            env: dict | None = None) -> list[list[dict]]:
+    """Run ``runs`` (lists of actions) against the FMU in a child process (environment
+    ``env``, default this one's).
 
     Returns one result list per run. Raises :class:`DriverFailure` on a crash (signal or
     non-zero exit), a hang (``timeout`` seconds) or missing results, naming the first run
@@ -342,19 +344,25 @@ def run_job(fmu_path, runs: list[list], *, timeout: float = 120.0) -> list[list[
                      default=_json_default)
     try:
         proc = subprocess.run([sys.executable, __file__], input=job, capture_output=True,
-                              text=True, timeout=timeout)
+                              text=True, timeout=timeout, env=env)
     except subprocess.TimeoutExpired as exc:
         done = (exc.stdout or b"").count(b"\n") if isinstance(exc.stdout, bytes) else \
             (exc.stdout or "").count("\n")
         raise DriverFailure(f"hang: no answer within {timeout} s; run {done} did not finish: "
-                            f"{runs[done] if done < len(runs) else '?'}") from None
+                            f"{_short(runs[done] if done < len(runs) else '?')}") from None
     results = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
     if proc.returncode != 0 or len(results) != len(runs):
         k = len(results)
         raise DriverFailure(f"crash: exit status {proc.returncode} after {k} of {len(runs)} "
-                            f"runs; run {k}: {runs[k] if k < len(runs) else '?'}\n"
+                            f"runs; run {k}: {_short(runs[k] if k < len(runs) else '?')}\n"
                             f"{proc.stderr[-2000:]}")
     return results
+
+
+def _short(run) -> str:
+    """The last actions of a run (the crash or hang is at its end)."""
+    text = repr(run)
+    return text if len(text) < 1500 else "[... " + text[-1500:]
 
 
 def _json_default(x):
