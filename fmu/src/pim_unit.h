@@ -343,7 +343,7 @@ static int unit_outputs_finite(const pim_unit *u)
 /* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
 static int unit_do_step(pim_unit *u, double t, double h)
 {
-    if (unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep") != 0) return -1;
+    if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
     if (!isfinite(t) || t < 0.0)
         return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
     if (!isfinite(h) || !(h > 0.0))
@@ -435,43 +435,58 @@ static const char *unit_label(const pim_var *v, int elem, char *buf, size_t size
     return buf;
 }
 
+/* Whether variable v may be set now: parameters before initialization, inputs until
+ * terminate, never outputs or time. */
+static int unit_settable(const pim_unit *u, const pim_var *v)
+{
+    if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT) return 0;
+    if (v->causality == PIM_PARAMETER)
+        return u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE;
+    return u->mode != PIM_TERMINATED;
+}
+
+/* Error paths out of line, so that the accessors stay small (they run on every get/set). */
+#if defined(__GNUC__)
+#define PIM_COLD __attribute__((noinline, cold))
+#else
+#define PIM_COLD
+#endif
+
+/* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
+PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, unsigned vr, char type)
+{
+    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : "Boolean";
+    char name[40];
+    if (!v)
+        unit_error(u, "no %s variable with value reference %u in the model description", tname,
+                   vr);
+    else if (v->type != type)
+        unit_error(u, "variable %s (value reference %u) is not a %s",
+                   unit_label(v, elem, name, sizeof name), vr, tname);
+    else if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT)
+        unit_error(u, "variable %s (value reference %u) is %s and cannot be set",
+                   unit_label(v, elem, name, sizeof name), vr,
+                   v->causality == PIM_OUTPUT ? "an output" : "the independent variable");
+    else if (v->causality == PIM_PARAMETER)
+        unit_error(u, "cannot set parameter %s (value reference %u) after initialization",
+                   unit_label(v, elem, name, sizeof name), vr);
+    else
+        unit_error(u, "cannot set input %s (value reference %u) after terminate",
+                   unit_label(v, elem, name, sizeof name), vr);
+    return NULL;
+}
+
 /*
  * Storage of the variable with reference vr, checked against the model description (exists,
- * has type `type`) and, for set != 0, against the mode (parameters before initialization,
- * inputs until terminate, never outputs or time).  *count: values it holds (1, or PIM_NMAX for
- * an FMI 3 array).  NULL with the reason in u->msg on failure.
+ * has type `type`) and, for set != 0, against the mode (unit_settable).  *count: values it
+ * holds (1, or PIM_NMAX for an FMI 3 array).  NULL with the reason in u->msg on failure.
  */
 static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set, size_t *count)
 {
-    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : "Boolean";
-    int elem;
+    int elem = -1;
     const pim_var *v = unit_var(vr, elements, &elem);
-    if (!v) {
-        unit_error(u, "no %s variable with value reference %u in the model description", tname,
-                   vr);
-        return NULL;
-    }
-    char name[40]; /* formatted only on an error (the accessors are on the hot path) */
-    if (v->type != type) {
-        unit_error(u, "variable %s (value reference %u) is not a %s",
-                   unit_label(v, elem, name, sizeof name), vr, tname);
-        return NULL;
-    }
-    if (set) {
-        int rc = 0;
-        if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT)
-            rc = unit_error(u, "variable %s (value reference %u) is %s and cannot be set",
-                            unit_label(v, elem, name, sizeof name), vr,
-                            v->causality == PIM_OUTPUT ? "an output" : "the independent variable");
-        else if (v->causality == PIM_PARAMETER &&
-                 !(u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE))
-            rc = unit_error(u, "cannot set parameter %s (value reference %u) after "
-                               "initialization", unit_label(v, elem, name, sizeof name), vr);
-        else if (u->mode == PIM_TERMINATED)
-            rc = unit_error(u, "cannot set input %s (value reference %u) after terminate",
-                            unit_label(v, elem, name, sizeof name), vr);
-        if (rc) return NULL;
-    }
+    if (!v || v->type != type || (set && !unit_settable(u, v)))
+        return unit_ref_refused(u, v, elem, vr, type);
     *count = elem >= 0 ? 1 : (size_t)v->size;
     return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
 }
