@@ -1,5 +1,7 @@
 /* Minimal FMI 2.0 host: loads an FMU binary, runs N doStep calls of one sample each (n plays)
- * and prints the time per doStep in ns.  Usage: fmu_host BINARY.so GUID N n */
+ * and prints the time per doStep in ns.  Every call's status is checked (a failing call ends
+ * the run with exit status 1, so no failing call is timed).  Value references: the enum
+ * ValueReference in fmu/src/pim_unit.h.  Usage: fmu_host BINARY.so GUID N n */
 #include <dlfcn.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,31 +36,38 @@ int main(int argc, char **argv)
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component c = fmi2Instantiate("bench", fmi2CoSimulation, argv[2], "", &cb, 0, 0);
     if (!c) return 1;
-    fmi2EnterInitializationMode(c);
+    LOAD(fmi2SetupExperimentTYPE, fmi2SetupExperiment)
+    if (fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) != fmi2OK ||
+        fmi2EnterInitializationMode(c) != fmi2OK) return 1;
     fmi2ValueReference vr_n = 1, vr_ts = 0, vr_v = 10, vr_y = 11;
     fmi2Integer nn = n;
-    fmi2SetInteger(c, &vr_n, 1, &nn);
     double ts = 1e-4;
-    fmi2SetReal(c, &vr_ts, 1, &ts);
+    if (fmi2SetInteger(c, &vr_n, 1, &nn) != fmi2OK || fmi2SetReal(c, &vr_ts, 1, &ts) != fmi2OK)
+        return 1;
     for (int i = 0; i < n; ++i) {
         fmi2ValueReference vp = 100 + i, vrr = 200 + i;
         double p = 1.0 / (i + 1), r = 0.2 * i;
-        fmi2SetReal(c, &vp, 1, &p);
-        fmi2SetReal(c, &vrr, 1, &r);
+        if (fmi2SetReal(c, &vp, 1, &p) != fmi2OK || fmi2SetReal(c, &vrr, 1, &r) != fmi2OK)
+            return 1;
     }
     if (fmi2ExitInitializationMode(c) != fmi2OK) return 1;
     struct timespec t0, t1;
     double acc = 0.0;
+    int failed = 0;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     for (long k = 0; k < N; ++k) {
         double v = 3.0 * ((k % 2000) < 1000 ? (k % 1000) / 1000.0 : 1.0 - (k % 1000) / 1000.0);
-        fmi2SetReal(c, &vr_v, 1, &v);
-        fmi2DoStep(c, k * ts, ts, fmi2True);
-        double y;
-        fmi2GetReal(c, &vr_y, 1, &y);
+        double y = 0.0;
+        failed |= fmi2SetReal(c, &vr_v, 1, &v) != fmi2OK;
+        failed |= fmi2DoStep(c, k * ts, ts, fmi2True) != fmi2OK;
+        failed |= fmi2GetReal(c, &vr_y, 1, &y) != fmi2OK;
         acc += y;
     }
     clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (failed) {
+        fprintf(stderr, "a setReal, doStep or getReal call failed\n");
+        return 1;
+    }
     double ns = ((t1.tv_sec - t0.tv_sec) * 1e9 + (t1.tv_nsec - t0.tv_nsec)) / (double)N;
     printf("%.2f %g\n", ns, acc);
     fmi2FreeInstance(c);

@@ -95,7 +95,7 @@ def test_estimator_fmu_matches_python(fmus):
     kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
     ref = estimate_radii(v, y, STAGE.weights, dt=TS, **kw)
     unit = FMUUnit(fmus / "RadiusEstimator.fmu", {
-        "Ts": TS, "n": 4, "gain": 20.0, "known_linear": True, **arr("p", STAGE.weights),
+        "Ts": TS, "n": 4, "gain": 20.0, "linear_play": True, **arr("p", STAGE.weights),
         **arr("r", kw["initial_radii"])})
     names = [f"r_hat[{i + 1}]" for i in range(4)] + ["y_hat", "e"]
     out = []
@@ -108,6 +108,17 @@ def test_estimator_fmu_matches_python(fmus):
     np.testing.assert_allclose(out[:, :4], np.vstack((ref.history[1:], ref.radii)), atol=1e-12)
     np.testing.assert_allclose(out[:, 4], ref.model_output, atol=1e-12)
     np.testing.assert_allclose(out[:, 5], ref.error, atol=1e-12)
+
+
+def test_old_variable_name_known_linear_warns_and_works(fmus):
+    start = {"Ts": TS, "n": 2, "p[1]": 1.0, "p[2]": 0.5, "r[1]": 0.3, "r[2]": 0.5}
+    with pytest.warns(DeprecationWarning, match="'known_linear' is now 'linear_play'"):
+        unit = FMUUnit(fmus / "RadiusEstimator.fmu", {**start, "known_linear": True})
+    np.testing.assert_array_equal(unit.get(["r_hat[1]", "r_hat[2]"]), [0.0, 0.5])  # held at 0
+    unit.close()
+    unit = FMUUnit(fmus / "RadiusEstimator.fmu", start)
+    np.testing.assert_array_equal(unit.get(["r_hat[1]", "r_hat[2]"]), [0.3, 0.5])
+    unit.close()
 
 
 def test_inverse_fmu_fixed_and_adaptive_match_python(fmus):
@@ -163,7 +174,15 @@ def test_state_rollback_reset_and_instances(fmus):
     fmu.setFMUState(restored)
     fmu.freeFMUState(state)
     fmu.freeFMUState(restored)
-    a.fmu.reset()
+    a.fmu.reset()  # back to instantiated, default parameters: initialise anew
+    a.fmu.setupExperiment(startTime=0.0)
+    a.fmu.enterInitializationMode()
+    a.set(start)
+    a.fmu.exitInitializationMode()
+    a.time = 0.0
+    a.set({"v": 1.0})
+    a.step(TS)
+    np.testing.assert_allclose(a.get(["y"]), PIOperator(P, R).simulate([1.0]), atol=1e-12)
     a.close()
     b.close()
 
@@ -171,7 +190,7 @@ def test_state_rollback_reset_and_instances(fmus):
 @pytest.mark.parametrize(
     ("name", "start", "message"),
     [
-        ("PIHysteresis", {"n": 17}, "parameter n = 17 out of range"),
+        ("PIHysteresis", {"n": 65}, "parameter n = 65 out of range"),
         ("PIHysteresis", {"n": 1, "r[1]": -0.5}, "negative"),
         ("PIHysteresis", {"n": 2, "r[1]": 0.5, "r[2]": 0.2}, "not sorted"),
         ("PIHysteresis", {"n": 2, "p[2]": 0.0}, "not positive"),
@@ -190,7 +209,7 @@ def test_bad_parameters_give_fmi2error_with_log(fmus, name, start, message):
 def test_nan_input_gives_fmi2error(fmus):
     unit = FMUUnit(fmus / "PIHysteresis.fmu", {"n": 1})
     unit.set({"v": float("nan")})
-    with pytest.raises(ValueError, match="input is not finite"):
+    with pytest.raises(ValueError, match="input v = nan is not finite"):
         unit.step(TS)
     with pytest.raises(fmpy.fmi1.FMICallException):
         fmpy.simulate_fmu(str(fmus / "PIHysteresis.fmu"), start_values={"Ts": -1.0},

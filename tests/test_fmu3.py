@@ -18,6 +18,7 @@ from pimodel import PIOperator, RadiusEstimator, estimate_radii
 from pimodel.actuators import stage_dynamics
 from pimodel.fmu import MODELS, build_fmus
 from pimodel.fmu.block import fmu_block
+from pimodel.fmu.build import NMAX
 from pimodel.fmu.cosim import cosimulate_adaptive_loop
 from pimodel.fmu.unit import FMUUnit
 from pimodel.loops import run_loop
@@ -47,7 +48,7 @@ def test_fmi3_validates(fmus, name):
     md = fmpy.read_model_description(str(path(fmus, name)))
     assert md.fmiVersion == "3.0"
     p = next(v for v in md.modelVariables if v.name == "p")
-    assert [int(d.start) for d in p.dimensions] == [16]  # a real array, not 16 scalars
+    assert [int(d.start) for d in p.dimensions] == [NMAX]  # a real array, not scalars
     exe = shutil.which("fmutool", path=str(Path(sys.executable).parent))
     if exe is None:
         pytest.skip("fmutool (fmu-manipulation-toolbox) is not installed")
@@ -63,8 +64,8 @@ def test_simulate_fmu_with_arrays_matches_operator(fmus):
     v = 2 * np.sin(2 * np.pi * 3 * t) * np.exp(-t)
     inp = np.array(list(zip(t, v, strict=True)), dtype=[("time", float), ("v", float)])
     res = fmpy.simulate_fmu(str(path(fmus, "PIHysteresis")), input=inp, output=["y"],
-                            start_values={"Ts": TS, "n": 3, "p": np.array(P + [1.0] * 13),
-                                          "r": np.array(R + [0.6] * 13)},
+                            start_values={"Ts": TS, "n": 3, "p": np.array(P + [1.0] * (NMAX - 3)),
+                                          "r": np.array(R + [0.6] * (NMAX - 3))},
                             stop_time=t[-1] + TS, output_interval=TS)
     np.testing.assert_allclose(res["y"][1:], PIOperator(P, R).simulate(v), rtol=0, atol=1e-12)
 
@@ -95,7 +96,7 @@ def test_estimator_and_inverse_match_python(fmus):
     kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
     ref = estimate_radii(v, y, STAGE.weights, dt=TS, **kw)
     est = FMUUnit(path(fmus, "RadiusEstimator"), {
-        "Ts": TS, "n": 4, "gain": 20.0, "known_linear": True, "p": STAGE.weights,
+        "Ts": TS, "n": 4, "gain": 20.0, "linear_play": True, "p": STAGE.weights,
         "r": kw["initial_radii"]})
     out = []
     for a, b in zip(v, y, strict=True):
@@ -147,7 +148,7 @@ def test_rollback_and_serialisation(fmus):
 @pytest.mark.parametrize(
     ("name", "start", "message"),
     [
-        ("PIHysteresis", {"n": 17}, "parameter n = 17 out of range"),
+        ("PIHysteresis", {"n": 65}, "parameter n = 65 out of range"),
         ("PIHysteresis", {"n": 2, "r": [0.5, 0.2]}, "not sorted"),
         ("PIHysteresis", {"n": 1, "r": [-0.5]}, "negative"),
         ("PIHysteresis", {"n": 2, "p": [1.0, 0.0]}, "not positive"),
@@ -164,18 +165,26 @@ def test_bad_parameters_give_fmi3error_with_log(fmus, name, start, message):
 def test_nan_input_and_late_parameter_give_error(fmus):
     unit = FMUUnit(path(fmus, "PIHysteresis"), {"n": 1})
     unit.set({"v": float("nan")})
-    with pytest.raises(ValueError, match="input is not finite"):
+    with pytest.raises(ValueError, match="input v = nan is not finite"):
         unit.step(TS)
     with pytest.raises(fmpy.fmi1.FMICallException):
         unit.set({"p": [2.0]})  # parameters are fixed after initialisation
-    assert "parameter after initialization" in unit.log[-1]
+    assert "cannot set parameter p (value reference 100) after initialization" in unit.log[-1]
+    unit.close()
+
+
+def test_short_array_gives_logged_error(fmus):
+    unit = FMUUnit(path(fmus, "PIHysteresis"), {"n": 1})
+    with pytest.raises(fmpy.fmi1.FMICallException):
+        unit.fmu.getFloat64([100], nValues=16)  # p has 64 values
+    assert "nValues = 16 is too small: at least 64 values needed" in unit.log[-1]
     unit.close()
 
 
 def test_fmu_block_and_cosimulation(fmus):
     blk = fmu_block(path(fmus, "RadiusEstimator"), TS, name="est3",
                     start={"Ts": TS, "n": 2, "p": [1.0, 0.5], "r": [0.0, 0.3]})
-    assert blk.output_labels == ["y_hat", "e", *[f"r_hat[{i}]" for i in range(1, 17)]]
+    assert blk.output_labels == ["y_hat", "e", *[f"r_hat[{i}]" for i in range(1, NMAX + 1)]]
     assert blk.input_labels == ["v", "y"]
     dt = 1e-4
     _, yd = sinusoid(8, 20, fs=1 / dt, duration=0.05)
@@ -223,3 +232,63 @@ def test_bad_build_and_cosim_version(tmp_path):
     with pytest.raises(ValueError, match="fmi_version: expected one of"):
         cosimulate_adaptive_loop(tmp_path, [0.0, 1.0], 1e-3, STAGE, weights=STAGE.weights,
                                  gain=1.0, initial_radii=STAGE.radii, fmi_version="1.0")
+
+
+def _c_variable_table() -> dict[int, list[tuple[str, int, str, str, int]]]:
+    """unit_vars of fmu/src/pim_unit.h per unit id: (name, vr, type, causality, size)."""
+    import re
+
+    from pimodel.fmu.build import source_dir
+
+    text = (source_dir() / "pim_unit.h").read_text()
+    enum = {k: int(v) for k, v in re.findall(r"\bvr_(\w+) = (\d+)", text)}
+    nmax = int(re.search(r"#define PIM_MAX_PLAYS (\d+)", (source_dir() / "pim_core.h")
+                         .read_text()).group(1))
+    body = text[text.index("static const pim_var unit_vars[] = {"):]
+    body = body[: body.index("};")]
+    row = re.compile(r"\{\"(\w+)\", vr_(\w+), '(\w)', PIM_(\w+), (\w+), PIM_AT\(\w+\)\}")
+    tables: dict[int, list] = {1: [], 2: [], 3: []}
+    current = None  # None: rows of every unit
+    for line in body.splitlines():
+        m = re.match(r"#(?:el)?if PIM_MODEL == (\d)", line.strip())
+        if m or line.strip() in ("#else", "#endif"):
+            current = int(m.group(1)) if m else 3 if line.strip() == "#else" else None
+            continue
+        for name, vr, typ, causality, size in row.findall(line):
+            entry = (name, enum[vr], typ, causality.lower(),
+                     nmax if size == "PIM_NMAX" else int(size))
+            for unit in tables if current is None else [current]:
+                tables[unit].append(entry)
+    return tables
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_model_descriptions_match_the_c_value_references(fmus, name):
+    """One source of truth: every variable of the built modelDescription.xml (FMI 2 and 3) has
+    the name, value reference, type, causality and size of pim_unit.h's table, and back."""
+    import re
+
+    from pimodel.fmu.build import MAX_SUBSTEPS, source_dir
+
+    table = _c_variable_table()[MODELS[name]["id"]]
+    assert NMAX == max(size for *_, size in table)
+    header = (source_dir() / "pim_unit.h").read_text()
+    assert int(re.search(r"#define PIM_MAX_SUBSTEPS (\d+)LL", header).group(1)) == MAX_SUBSTEPS
+    types2 = {"R": "Real", "I": "Integer", "B": "Boolean"}
+    types3 = {"R": "Float64", "I": "Int32", "B": "Boolean"}
+    want2, want3 = set(), set()
+    for vname, vr, typ, causality, size in table:
+        want3.add((vname, vr, types3[typ], causality, size))
+        if causality == "independent":
+            continue  # FMI 2 Co-Simulation has no time variable
+        if size == 1:
+            want2.add((vname, vr, types2[typ], causality, 1))
+        else:
+            want2 |= {(f"{vname}[{i + 1}]", vr + i, types2[typ], causality, 1)
+                      for i in range(size)}
+    for file, want in ((fmus / f"{name}.fmu", want2), (path(fmus, name), want3)):
+        md = fmpy.read_model_description(str(file))
+        got = {(v.name, v.valueReference, v.type, v.causality,
+                int(np.prod([int(d.start) for d in v.dimensions])) if v.dimensions else 1)
+               for v in md.modelVariables}
+        assert got == want, (file.name, got ^ want)

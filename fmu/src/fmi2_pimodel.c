@@ -1,8 +1,9 @@
 /*
  * FMI 2.0 Co-Simulation glue for the pimodel units (pim_unit.h), one source for the three
  * models; the including file defines PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
- * 3 InversePI) and PIM_MODEL_GUID.  Sampling rule and value references: pim_unit.h (array
- * element p[i+1] has reference 100 + i, r[i+1] 200 + i, r_hat[i+1] 300 + i).
+ * 3 InversePI) and PIM_MODEL_GUID.  Sampling rule, limits, modes, value references and the FMU
+ * state format: pim_unit.h (array element p[i+1] has reference 100 + i, r[i+1] 200 + i,
+ * r_hat[i+1] 300 + i).  Every failure returns fmi2Error and logs the reason.
  */
 #include <stdlib.h>
 
@@ -13,7 +14,6 @@ typedef struct {
     pim_unit u;
     fmi2CallbackFunctions cb;
     char name[128];
-    int initialized;
 } Inst;
 
 static void logmsg(Inst *c, fmi2Status st, const char *msg)
@@ -24,13 +24,6 @@ static void logmsg(Inst *c, fmi2Status st, const char *msg)
                                         "logStatusError", msg);
 }
 
-static fmi2Status fail(Inst *c, const char *fmt, const char *detail)
-{
-    unit_error(&c->u, fmt, detail);
-    logmsg(c, fmi2Error, c->u.msg);
-    return fmi2Error;
-}
-
 /* Logs the unit's failure reason when rc != 0. */
 static fmi2Status status(Inst *c, int rc)
 {
@@ -38,6 +31,16 @@ static fmi2Status status(Inst *c, int rc)
     logmsg(c, fmi2Error, c->u.msg);
     return fmi2Error;
 }
+
+static fmi2Status fail(Inst *c, const char *msg)
+{
+    if (!c) return fmi2Error;
+    return status(c, unit_error(&c->u, "%s", msg));
+}
+
+#define INST(comp) Inst *c = (Inst *)(comp); if (!c) return fmi2Error
+#define IN_MODES(mask, call) \
+    if (unit_require_mode(&c->u, (mask), (call)) != 0) return status(c, -1)
 
 /* ---- FMI functions -------------------------------------------------------------------- */
 
@@ -72,150 +75,127 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
 
 void fmi2FreeInstance(fmi2Component c) { free(c); }
 
-fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0,
-                               fmi2Boolean stopDef, fmi2Real tStop)
+fmi2Status fmi2SetupExperiment(fmi2Component comp, fmi2Boolean tolDef, fmi2Real tol,
+                               fmi2Real t0, fmi2Boolean stopDef, fmi2Real tStop)
 {
-    (void)c; (void)tolDef; (void)tol; (void)t0; (void)stopDef; (void)tStop;
-    return fmi2OK;
+    INST(comp);
+    (void)tolDef; (void)tol;
+    IN_MODES(PIM_IN(PIM_INSTANTIATED), "fmi2SetupExperiment");
+    return status(c, unit_start(&c->u, t0, stopDef, tStop));
 }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
+fmi2Status fmi2EnterInitializationMode(fmi2Component comp)
+{
+    INST(comp);
+    IN_MODES(PIM_IN(PIM_INSTANTIATED), "fmi2EnterInitializationMode");
+    c->u.mode = PIM_INIT_MODE;
+    return fmi2OK;
+}
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
 {
-    Inst *c = (Inst *)comp;
+    INST(comp);
+    IN_MODES(PIM_IN(PIM_INIT_MODE), "fmi2ExitInitializationMode");
     fmi2Status st = status(c, unit_setup(&c->u));
-    c->initialized = st == fmi2OK;
+    if (st == fmi2OK) c->u.mode = PIM_STEP_MODE;
     return st;
 }
 
-fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
-
-fmi2Status fmi2Reset(fmi2Component comp)
+fmi2Status fmi2Terminate(fmi2Component comp)
 {
-    Inst *c = (Inst *)comp;
-    unit_defaults(&c->u);
-    c->initialized = 0;
+    INST(comp);
+    IN_MODES(PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) | PIM_IN(PIM_TERMINATED),
+             "fmi2Terminate");
+    c->u.mode = PIM_TERMINATED;
     return fmi2OK;
 }
 
-static double *real_ref(Inst *c, fmi2ValueReference vr)
+fmi2Status fmi2Reset(fmi2Component comp)
 {
-    double *x = unit_scalar(&c->u, vr);
-    if (x) return x;
-    for (unsigned base = 100; base <= 300; base += 100)
-        if (vr >= base && vr < base + NMAX) return unit_array(&c->u, base) + (vr - base);
-    return NULL;
+    INST(comp);
+    unit_defaults(&c->u);
+    return fmi2OK;
 }
+
+/* Get (set = 0) or set values of one type through unit_ref (FMI 2: scalars and elements). */
+#define PIM_ACCESS(TYPE_CHAR, CTYPE, SET, FROM_UNIT, TO_UNIT)                                  \
+    INST(comp);                                                                               \
+    for (size_t i = 0; i < nvr; ++i) {                                                        \
+        size_t cnt;                                                                           \
+        CTYPE *x = (CTYPE *)unit_ref(&c->u, vr[i], TYPE_CHAR, 1, SET, &cnt);                  \
+        if (!x) return status(c, -1);                                                         \
+        if (SET) { TO_UNIT; } else { FROM_UNIT; }                                             \
+    }                                                                                         \
+    return fmi2OK
 
 fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                        fmi2Real value[])
 {
-    Inst *c = (Inst *)comp;
-    for (size_t i = 0; i < nvr; ++i) {
-        double *x = real_ref(c, vr[i]);
-        if (!x) return status(c, unit_error(&c->u, "no Real variable with reference %u", vr[i]));
-        value[i] = *x;
-    }
-    return fmi2OK;
+    PIM_ACCESS('R', double, 0, value[i] = *x, (void)0);
 }
 
 fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[])
 {
-    Inst *c = (Inst *)comp;
-    for (size_t i = 0; i < nvr; ++i) {
-        double *x = real_ref(c, vr[i]);
-        if (!x || !unit_settable(vr[i], c->initialized))
-            return status(c, unit_error(&c->u, "cannot set Real variable %u (an output, or a "
-                                               "parameter after initialization)", vr[i]));
-        *x = value[i];
-    }
-    return fmi2OK;
+    PIM_ACCESS('R', double, 1, (void)0, *x = value[i]);
 }
 
 fmi2Status fmi2GetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Integer value[])
 {
-    Inst *c = (Inst *)comp;
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_int(&c->u, vr[i]);
-        if (!x) return fail(c, "no Integer variable %s", "with this reference");
-        value[i] = *x;
-    }
-    return fmi2OK;
+    PIM_ACCESS('I', int, 0, value[i] = *x, (void)0);
 }
 
 fmi2Status fmi2SetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Integer value[])
 {
-    Inst *c = (Inst *)comp;
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_int(&c->u, vr[i]);
-        if (!x) return fail(c, "no Integer variable %s", "with this reference");
-        if (c->initialized) return fail(c, "parameter %s is fixed after initialization", "n");
-        *x = value[i];
-    }
-    return fmi2OK;
+    PIM_ACCESS('I', int, 1, (void)0, *x = value[i]);
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Boolean value[])
 {
-    Inst *c = (Inst *)comp;
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_bool(&c->u, vr[i]);
-        if (!x) return fail(c, "no Boolean variable %s", "with this reference");
-        value[i] = *x ? fmi2True : fmi2False;
-    }
-    return fmi2OK;
+    PIM_ACCESS('B', int, 0, value[i] = *x ? fmi2True : fmi2False, (void)0);
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Boolean value[])
 {
-    Inst *c = (Inst *)comp;
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_bool(&c->u, vr[i]);
-        if (!x) return fail(c, "no Boolean variable %s", "with this reference");
-        if (c->initialized) return fail(c, "parameter %s is fixed after initialization", "flag");
-        *x = value[i] ? 1 : 0;
-    }
-    return fmi2OK;
+    PIM_ACCESS('B', int, 1, (void)0, *x = value[i] ? 1 : 0);
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                          fmi2String value[])
 {
     (void)vr; (void)value;
-    return nvr ? fail((Inst *)c, "no String variables %s", "") : fmi2OK;
+    return nvr ? fail((Inst *)c, "no String variables") : fmi2OK;
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                          const fmi2String value[])
 {
     (void)vr; (void)value;
-    return nvr ? fail((Inst *)c, "no String variables %s", "") : fmi2OK;
+    return nvr ? fail((Inst *)c, "no String variables") : fmi2OK;
 }
+
+/* ---- FMU state: the checked byte block of pim_unit.h, in memory and serialized ------------ */
 
 fmi2Status fmi2GetFMUstate(fmi2Component comp, fmi2FMUstate *state)
 {
-    Inst *c = (Inst *)comp;
-    Inst *copy = *state ? (Inst *)*state : (Inst *)malloc(sizeof(Inst));
-    if (!copy) return fail(c, "%s", "out of memory");
-    memcpy(copy, c, sizeof(Inst));
-    *state = copy;
+    INST(comp);
+    if (!state) return fail(c, "fmi2GetFMUstate: null state pointer");
+    unsigned char *buf = *state ? (unsigned char *)*state : (unsigned char *)malloc(PIM_STATE_SIZE);
+    if (!buf) return fail(c, "fmi2GetFMUstate: out of memory");
+    unit_state_write(&c->u, buf, PIM_MODEL_GUID, 2);
+    *state = buf;
     return fmi2OK;
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state)
 {
-    Inst *c = (Inst *)comp;
-    if (!state) return fail(c, "%s", "null FMU state");
-    fmi2CallbackFunctions cb = c->cb;
-    memcpy(c, state, sizeof(Inst));
-    c->cb = cb;
-    return fmi2OK;
+    INST(comp);
+    return status(c, unit_state_read(&c->u, (const unsigned char *)state, PIM_STATE_SIZE,
+                                     PIM_MODEL_GUID, 2, &c->u));
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
@@ -228,27 +208,35 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
     return fmi2OK;
 }
 
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *size)
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate s, size_t *size)
 {
-    (void)c; (void)s;
-    *size = sizeof(Inst);
+    INST(comp);
+    (void)s;
+    if (!size) return fail(c, "fmi2SerializedFMUstateSize: null size pointer");
+    *size = PIM_STATE_SIZE;
     return fmi2OK;
 }
 
-fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte bytes[], size_t size)
+fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate s, fmi2Byte bytes[],
+                                 size_t size)
 {
-    if (size < sizeof(Inst)) return fail((Inst *)c, "%s", "serialization buffer too small");
-    memcpy(bytes, s, sizeof(Inst));
+    INST(comp);
+    if (!s || !bytes) return fail(c, "fmi2SerializeFMUstate: null state or buffer");
+    if (size < PIM_STATE_SIZE) return fail(c, "fmi2SerializeFMUstate: buffer too small");
+    memcpy(bytes, s, PIM_STATE_SIZE);
     return fmi2OK;
 }
 
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte bytes[], size_t size,
                                    fmi2FMUstate *s)
 {
-    if (size != sizeof(Inst)) return fail((Inst *)c, "%s", "serialized state has a wrong size");
-    Inst *copy = (Inst *)malloc(sizeof(Inst));
-    if (!copy) return fail((Inst *)c, "%s", "out of memory");
-    memcpy(copy, bytes, sizeof(Inst));
+    INST(comp);
+    if (!s) return fail(c, "fmi2DeSerializeFMUstate: null state pointer");
+    if (unit_state_read(&c->u, (const unsigned char *)bytes, size, PIM_MODEL_GUID, 2, NULL))
+        return status(c, -1);
+    unsigned char *copy = (unsigned char *)malloc(PIM_STATE_SIZE);
+    if (!copy) return fail(c, "fmi2DeSerializeFMUstate: out of memory");
+    memcpy(copy, bytes, PIM_STATE_SIZE);
     *s = copy;
     return fmi2OK;
 }
@@ -258,36 +246,38 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         const fmi2Real dv[], fmi2Real dz[])
 {
     (void)u; (void)nu; (void)z; (void)nz; (void)dv; (void)dz;
-    return fail((Inst *)c, "%s", "directional derivatives are not provided");
+    return fail((Inst *)c, "directional derivatives are not provided");
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                        const fmi2Integer order[], const fmi2Real value[])
 {
     (void)vr; (void)n; (void)order; (void)value;
-    return fail((Inst *)c, "%s", "input derivatives are not supported");
+    return fail((Inst *)c, "input derivatives are not supported");
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                                         const fmi2Integer order[], fmi2Real value[])
 {
     (void)vr; (void)n; (void)order; (void)value;
-    return fail((Inst *)c, "%s", "output derivatives are not provided");
+    return fail((Inst *)c, "output derivatives are not provided");
 }
 
 fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior)
 {
-    Inst *c = (Inst *)comp;
+    INST(comp);
     (void)noSetPrior;
-    if (!c->initialized) return fail(c, "%s", "doStep before a successful initialization");
     return status(c, unit_do_step(&c->u, t, h));
 }
 
-fmi2Status fmi2CancelStep(fmi2Component c) { (void)c; return fmi2Error; }
+fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    return fail((Inst *)c, "fmi2CancelStep: steps are never asynchronous");
+}
 
 static fmi2Status no_status(fmi2Component c)
 {
-    return fail((Inst *)c, "%s", "asynchronous status is not supported");
+    return fail((Inst *)c, "asynchronous status is not supported");
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *v)

@@ -2,9 +2,10 @@
  * FMI 3.0 Co-Simulation glue for the pimodel units (pim_unit.h), one source for the three
  * models; the including file defines PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
  * 3 InversePI) and PIM_MODEL_TOKEN (the instantiation token).  Sampling rule and value
- * references: pim_unit.h.  Here p (100), r (200) and r_hat (300) are real arrays of NMAX
- * elements (the first n are used): getting or setting one moves NMAX values.  Reference 9 is
- * the independent variable time (the end of the last communication step).
+ * references, limits, modes and the FMU state format: pim_unit.h.  Here p (100), r (200) and
+ * r_hat (300) are real arrays of PIM_NMAX elements (the first n are used): getting or setting
+ * one moves PIM_NMAX values.  Reference 9 is the independent variable time (the end of the last
+ * communication step).  Every failure returns fmi3Error and logs the reason.
  */
 #include <stdlib.h>
 
@@ -15,8 +16,6 @@ typedef struct {
     pim_unit u;
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
-    int initialized;
-    double time;
 } Inst;
 
 static fmi3Status status(Inst *c, int rc)
@@ -28,8 +27,13 @@ static fmi3Status status(Inst *c, int rc)
 
 static fmi3Status fail(Inst *c, const char *msg)
 {
+    if (!c) return fmi3Error;
     return status(c, unit_error(&c->u, "%s", msg));
 }
+
+#define INST(inst) Inst *c = (Inst *)(inst); if (!c) return fmi3Error
+#define IN_MODES(mask, call) \
+    if (unit_require_mode(&c->u, (mask), (call)) != 0) return status(c, -1)
 
 /* ---- creation, modes ------------------------------------------------------------------- */
 
@@ -93,144 +97,121 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token
 
 void fmi3FreeInstance(fmi3Instance c) { free(c); }
 
-fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean tolDef, fmi3Float64 tol,
+fmi3Status fmi3EnterInitializationMode(fmi3Instance inst, fmi3Boolean tolDef, fmi3Float64 tol,
                                        fmi3Float64 t0, fmi3Boolean stopDef, fmi3Float64 tStop)
 {
-    (void)tolDef; (void)tol; (void)stopDef; (void)tStop;
-    ((Inst *)c)->time = t0;
+    INST(inst);
+    (void)tolDef; (void)tol;
+    IN_MODES(PIM_IN(PIM_INSTANTIATED), "fmi3EnterInitializationMode");
+    if (unit_start(&c->u, t0, stopDef, tStop) != 0) return status(c, -1);
+    c->u.mode = PIM_INIT_MODE;
     return fmi3OK;
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance inst)
 {
-    Inst *c = (Inst *)inst;
+    INST(inst);
+    IN_MODES(PIM_IN(PIM_INIT_MODE), "fmi3ExitInitializationMode");
     fmi3Status st = status(c, unit_setup(&c->u));
-    c->initialized = st == fmi3OK;
+    if (st == fmi3OK) c->u.mode = PIM_STEP_MODE;
     return st;
 }
 
 fmi3Status fmi3EnterEventMode(fmi3Instance c) { return fail((Inst *)c, "no event mode"); }
-fmi3Status fmi3Terminate(fmi3Instance c) { (void)c; return fmi3OK; }
 
-fmi3Status fmi3Reset(fmi3Instance inst)
+fmi3Status fmi3Terminate(fmi3Instance inst)
 {
-    Inst *c = (Inst *)inst;
-    unit_defaults(&c->u);
-    c->initialized = 0;
+    INST(inst);
+    IN_MODES(PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) | PIM_IN(PIM_TERMINATED),
+             "fmi3Terminate");
+    c->u.mode = PIM_TERMINATED;
     return fmi3OK;
 }
 
-fmi3Status fmi3EnterStepMode(fmi3Instance c) { (void)c; return fmi3OK; }
+fmi3Status fmi3Reset(fmi3Instance inst)
+{
+    INST(inst);
+    unit_defaults(&c->u);
+    return fmi3OK;
+}
+
+fmi3Status fmi3EnterStepMode(fmi3Instance inst)
+{
+    INST(inst);
+    IN_MODES(PIM_IN(PIM_STEP_MODE), "fmi3EnterStepMode");
+    return fmi3OK;
+}
 
 fmi3Status fmi3DoStep(fmi3Instance inst, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
                       fmi3Boolean *eventNeeded, fmi3Boolean *terminate, fmi3Boolean *earlyReturn,
                       fmi3Float64 *lastTime)
 {
-    Inst *c = (Inst *)inst;
+    INST(inst);
     (void)noSetPrior;
     if (eventNeeded) *eventNeeded = fmi3False;
     if (terminate) *terminate = fmi3False;
     if (earlyReturn) *earlyReturn = fmi3False;
-    if (lastTime) *lastTime = t;
-    if (!c->initialized) return fail(c, "doStep before a successful initialization");
     fmi3Status st = status(c, unit_do_step(&c->u, t, h));
-    if (st == fmi3OK) {
-        c->time = t + h;
-        if (lastTime) *lastTime = t + h;
-    }
+    if (lastTime) *lastTime = c->u.time;
     return st;
 }
 
 /* ---- variables --------------------------------------------------------------------------- */
 
+/* Get (SET 0) or set (SET 1) values of one type through unit_ref; an FMI 3 array moves all
+ * PIM_NMAX values. */
+#define PIM_ACCESS(TYPE_CHAR, CTYPE, SET, FROM_UNIT, TO_UNIT)                                  \
+    INST(inst);                                                                               \
+    size_t k = 0;                                                                             \
+    for (size_t i = 0; i < nvr; ++i) {                                                        \
+        size_t cnt;                                                                           \
+        CTYPE *x = (CTYPE *)unit_ref(&c->u, vr[i], TYPE_CHAR, 0, SET, &cnt);                  \
+        if (!x) return status(c, -1);                                                         \
+        if (k + cnt > nValues)                                                                \
+            return status(c, unit_error(&c->u, "nValues = %llu is too small: at least %llu " \
+                                        "values needed (an array moves all its values)",      \
+                                        (unsigned long long)nValues,                          \
+                                        (unsigned long long)(k + cnt)));                      \
+        for (size_t j = 0; j < cnt; ++j, ++k) {                                               \
+            if (SET) { TO_UNIT; } else { FROM_UNIT; }                                         \
+        }                                                                                     \
+    }                                                                                         \
+    return fmi3OK
+
 fmi3Status fmi3GetFloat64(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                           fmi3Float64 values[], size_t nValues)
 {
-    Inst *c = (Inst *)inst;
-    size_t k = 0;
-    for (size_t i = 0; i < nvr; ++i) {
-        double *x = vr[i] == 9 ? &c->time : unit_scalar(&c->u, vr[i]);
-        double *a = x ? NULL : unit_array(&c->u, vr[i]);
-        size_t m = x ? 1 : NMAX;
-        if (!x && !a) return status(c, unit_error(&c->u, "no Float64 variable %u", vr[i]));
-        if (k + m > nValues) return fail(c, "GetFloat64: nValues too small for the variables");
-        memcpy(values + k, x ? x : a, m * sizeof(double));
-        k += m;
-    }
-    return fmi3OK;
+    PIM_ACCESS('R', double, 0, values[k] = x[j], (void)0);
 }
 
 fmi3Status fmi3SetFloat64(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                           const fmi3Float64 values[], size_t nValues)
 {
-    Inst *c = (Inst *)inst;
-    size_t k = 0;
-    for (size_t i = 0; i < nvr; ++i) {
-        double *x = unit_scalar(&c->u, vr[i]);
-        double *a = x ? NULL : unit_array(&c->u, vr[i]);
-        size_t m = x ? 1 : NMAX;
-        if ((!x && !a) || !unit_settable(vr[i], c->initialized))
-            return status(c, unit_error(&c->u, "cannot set Float64 variable %u (an output, or "
-                                               "a parameter after initialization)", vr[i]));
-        if (k + m > nValues) return fail(c, "SetFloat64: nValues too small for the variables");
-        memcpy(x ? x : a, values + k, m * sizeof(double));
-        k += m;
-    }
-    return fmi3OK;
+    PIM_ACCESS('R', double, 1, (void)0, x[j] = values[k]);
 }
 
 fmi3Status fmi3GetInt32(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                         fmi3Int32 values[], size_t nValues)
 {
-    Inst *c = (Inst *)inst;
-    if (nValues < nvr) return fail(c, "GetInt32: nValues too small");
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_int(&c->u, vr[i]);
-        if (!x) return status(c, unit_error(&c->u, "no Int32 variable %u", vr[i]));
-        values[i] = *x;
-    }
-    return fmi3OK;
+    PIM_ACCESS('I', int, 0, values[k] = x[j], (void)0);
 }
 
 fmi3Status fmi3SetInt32(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                         const fmi3Int32 values[], size_t nValues)
 {
-    Inst *c = (Inst *)inst;
-    if (nValues < nvr) return fail(c, "SetInt32: nValues too small");
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_int(&c->u, vr[i]);
-        if (!x) return status(c, unit_error(&c->u, "no Int32 variable %u", vr[i]));
-        if (c->initialized) return fail(c, "Int32 parameters are fixed after initialization");
-        *x = values[i];
-    }
-    return fmi3OK;
+    PIM_ACCESS('I', int, 1, (void)0, x[j] = values[k]);
 }
 
 fmi3Status fmi3GetBoolean(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                           fmi3Boolean values[], size_t nValues)
 {
-    Inst *c = (Inst *)inst;
-    if (nValues < nvr) return fail(c, "GetBoolean: nValues too small");
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_bool(&c->u, vr[i]);
-        if (!x) return status(c, unit_error(&c->u, "no Boolean variable %u", vr[i]));
-        values[i] = *x ? fmi3True : fmi3False;
-    }
-    return fmi3OK;
+    PIM_ACCESS('B', int, 0, values[k] = x[j] ? fmi3True : fmi3False, (void)0);
 }
 
 fmi3Status fmi3SetBoolean(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                           const fmi3Boolean values[], size_t nValues)
 {
-    Inst *c = (Inst *)inst;
-    if (nValues < nvr) return fail(c, "SetBoolean: nValues too small");
-    for (size_t i = 0; i < nvr; ++i) {
-        int *x = unit_bool(&c->u, vr[i]);
-        if (!x) return status(c, unit_error(&c->u, "no Boolean variable %u", vr[i]));
-        if (c->initialized) return fail(c, "Boolean parameters are fixed after initialization");
-        *x = values[i] ? 1 : 0;
-    }
-    return fmi3OK;
+    PIM_ACCESS('B', int, 1, (void)0, x[j] = values[k] ? 1 : 0);
 }
 
 /* Types the units do not use: any access is an error (an empty access is fine). */
@@ -286,26 +267,24 @@ fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nv
     return nvr ? fail((Inst *)c, "no Clock variables") : fmi3OK;
 }
 
-/* ---- FMU state (rollback) ------------------------------------------------------------- */
+/* ---- FMU state: the checked byte block of pim_unit.h, in memory and serialized ------------ */
 
 fmi3Status fmi3GetFMUState(fmi3Instance inst, fmi3FMUState *state)
 {
-    Inst *c = (Inst *)inst;
-    Inst *copy = *state ? (Inst *)*state : (Inst *)malloc(sizeof(Inst));
-    if (!copy) return fail(c, "out of memory");
-    memcpy(copy, c, sizeof(Inst));
-    *state = copy;
+    INST(inst);
+    if (!state) return fail(c, "fmi3GetFMUState: null state pointer");
+    unsigned char *buf = *state ? (unsigned char *)*state : (unsigned char *)malloc(PIM_STATE_SIZE);
+    if (!buf) return fail(c, "fmi3GetFMUState: out of memory");
+    unit_state_write(&c->u, buf, PIM_MODEL_TOKEN, 3);
+    *state = buf;
     return fmi3OK;
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance inst, fmi3FMUState state)
 {
-    Inst *c = (Inst *)inst;
-    if (!state) return fail(c, "null FMU state");
-    const Inst *s = (const Inst *)state;
-    c->u = s->u;
-    c->initialized = s->initialized;
-    return fmi3OK;
+    INST(inst);
+    return status(c, unit_state_read(&c->u, (const unsigned char *)state, PIM_STATE_SIZE,
+                                     PIM_MODEL_TOKEN, 3, &c->u));
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance c, fmi3FMUState *state)
@@ -318,27 +297,35 @@ fmi3Status fmi3FreeFMUState(fmi3Instance c, fmi3FMUState *state)
     return fmi3OK;
 }
 
-fmi3Status fmi3SerializedFMUStateSize(fmi3Instance c, fmi3FMUState s, size_t *size)
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance inst, fmi3FMUState s, size_t *size)
 {
-    (void)c; (void)s;
-    *size = sizeof(Inst);
+    INST(inst);
+    (void)s;
+    if (!size) return fail(c, "fmi3SerializedFMUStateSize: null size pointer");
+    *size = PIM_STATE_SIZE;
     return fmi3OK;
 }
 
-fmi3Status fmi3SerializeFMUState(fmi3Instance c, fmi3FMUState s, fmi3Byte bytes[], size_t size)
+fmi3Status fmi3SerializeFMUState(fmi3Instance inst, fmi3FMUState s, fmi3Byte bytes[],
+                                 size_t size)
 {
-    if (size < sizeof(Inst)) return fail((Inst *)c, "serialization buffer too small");
-    memcpy(bytes, s, sizeof(Inst));
+    INST(inst);
+    if (!s || !bytes) return fail(c, "fmi3SerializeFMUState: null state or buffer");
+    if (size < PIM_STATE_SIZE) return fail(c, "fmi3SerializeFMUState: buffer too small");
+    memcpy(bytes, s, PIM_STATE_SIZE);
     return fmi3OK;
 }
 
-fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte bytes[], size_t size,
+fmi3Status fmi3DeserializeFMUState(fmi3Instance inst, const fmi3Byte bytes[], size_t size,
                                    fmi3FMUState *s)
 {
-    if (size != sizeof(Inst)) return fail((Inst *)c, "serialized state has a wrong size");
-    Inst *copy = (Inst *)malloc(sizeof(Inst));
-    if (!copy) return fail((Inst *)c, "out of memory");
-    memcpy(copy, bytes, sizeof(Inst));
+    INST(inst);
+    if (!s) return fail(c, "fmi3DeserializeFMUState: null state pointer");
+    if (unit_state_read(&c->u, (const unsigned char *)bytes, size, PIM_MODEL_TOKEN, 3, NULL))
+        return status(c, -1);
+    unsigned char *copy = (unsigned char *)malloc(PIM_STATE_SIZE);
+    if (!copy) return fail(c, "fmi3DeserializeFMUState: out of memory");
+    memcpy(copy, bytes, PIM_STATE_SIZE);
     *s = copy;
     return fmi3OK;
 }

@@ -1,27 +1,36 @@
 /*
- * The pimodel FMU units, independent of the FMI version: parameters, inputs, outputs, states,
- * the parameter check, one internal sample and the sub-stepping rule.  Included (static
+ * The pimodel FMU units, independent of the FMI version: variables, modes, the parameter check,
+ * one internal sample, the sub-stepping rule and the checked FMU state format.  Included (static
  * functions) by the FMI 2 and FMI 3 glue after PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
  * 3 InversePI) is defined.  The numerics are the shared C core (pim_pi.c, pim_estimator.c,
  * pim_loops.c).  Functions return 0 on success, or -1 with the reason in u->msg.
  *
- * Sampling rule: internal sample k happens at time k*Ts.  A step from t over h processes every
- * sample with k*Ts in [t, t+h) (tolerance 1e-9*Ts), each with the inputs set before the call
- * (held over the step); outputs are those of the last processed sample and hold between
- * samples.  A step shorter than Ts that contains no sample instant changes nothing.
+ * Sampling rule: internal sample k (an int64 counter) happens at time k*Ts.  A step from t over
+ * h processes every sample with k*Ts in [t, t+h) (tolerance 1e-9*Ts), each with the inputs set
+ * before the call (held over the step); outputs are those of the last processed sample and hold
+ * between samples.  A step shorter than Ts that contains no sample instant changes nothing.
  *
- * Value references: 0 Ts, 1 n, 2 z0 (initial play state), 3 adaptive (InversePI), 4 gain,
- * 5 known_linear, 6 guard, 7 slope_window, 10 main input, 11 main output, 12 second input (y of
- * the estimator), 13 second output (e); arrays p (100), r (200; initial radii for the
- * estimator), r_hat (300; inputs of the adaptive InversePI, outputs of the estimator): in FMI 2
- * element i (0-based) has reference base + i, in FMI 3 the array is one variable.
+ * Limits (each breach is an error with a logged reason, never a crash or a hang):
+ *   n in 1..PIM_NMAX (64) plays; Ts finite and >= PIM_TS_MIN; start time finite and >= 0;
+ *   at most PIM_MAX_SUBSTEPS (10^7) samples per doStep; sample index (t+h)/Ts below
+ *   PIM_MAX_SAMPLE_INDEX (2^52, where k*Ts is still exact in double); doStep needs
+ *   t == the FMU's time (the end of the last step) within min(1e-9 max(1, |t|), 1e-3 Ts),
+ *   h finite and > 0, and t + h > t.
+ *
+ * Value references: the enum ValueReference and, per unit, the table unit_vars (name, reference,
+ * type, causality, size) are the one source of truth in C; tests/test_fmu3.py holds every
+ * built modelDescription.xml (FMI 2 and 3) equal to unit_vars.  In FMI 2 array element
+ * p[i+1] has reference 100 + i (r 200 + i, r_hat 300 + i); in FMI 3 an array is one variable.
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
 
 #include <math.h>
+#include <stddef.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "pim_core.h"
@@ -32,22 +41,101 @@
 #error "define PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator, 3 InversePI)"
 #endif
 
-#define NMAX 16 /* declared array size: p[1..16], r[1..16], r_hat[1..16] */
+#define PIM_NMAX PIM_MAX_PLAYS            /* declared array size: p[1..64], r[..], r_hat[..] */
+#define NMAX PIM_NMAX
+#define PIM_MAX_SUBSTEPS 10000000LL       /* samples per doStep */
+#define PIM_MAX_SAMPLE_INDEX 4503599627370496.0 /* 2^52 */
+#define PIM_TS_MIN 1e-12                  /* smallest sample time [s] */
+#define PIM_SAMPLE_TOL 1e-9               /* tolerance of the sampling rule, in samples */
+
+typedef enum {
+    vr_Ts = 0,
+    vr_n = 1,
+    vr_z0 = 2,
+    vr_adaptive = 3,
+    vr_gain = 4,
+    vr_linear_play = 5,
+    vr_guard = 6,
+    vr_slope_window = 7,
+    vr_time = 9, /* FMI 3 independent variable */
+    vr_in1 = 10,  /* v (PIHysteresis, RadiusEstimator), y_d (InversePI) */
+    vr_out1 = 11, /* y (PIHysteresis), y_hat (RadiusEstimator), v (InversePI) */
+    vr_in2 = 12,  /* y (RadiusEstimator) */
+    vr_out2 = 13, /* e (RadiusEstimator) */
+    vr_p = 100,
+    vr_r = 200,
+    vr_r_hat = 300
+} ValueReference;
+
+typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
+
+typedef struct {
+    const char *name;
+    unsigned vr;
+    char type; /* 'R' Real/Float64, 'I' Integer/Int32, 'B' Boolean */
+    pim_causality causality;
+    int size;      /* 1, or PIM_NMAX for an array */
+    size_t offset; /* of the value(s) in pim_unit */
+} pim_var;
+
+
+/* Life cycle (FMI 2 and 3 Co-Simulation): instantiated -> initialization mode -> step mode
+ * (after a successful exitInitializationMode) -> terminated; reset goes back to instantiated. */
+enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED };
 
 typedef struct {
     /* parameters */
     double Ts, z0, gain, guard;
-    int n, adaptive, known_linear, slope_window;
-    double p[NMAX], r[NMAX];
+    int n, adaptive, linear_play, slope_window;
+    double p[PIM_NMAX], r[PIM_NMAX];
     /* inputs and outputs */
     double in1, in2, out1, out2;
-    double rhat_in[NMAX], rhat_out[NMAX];
+    double rhat_in[PIM_NMAX], rhat_out[PIM_NMAX];
+    /* mode, time and sample counter */
+    int mode;
+    double time;    /* the end of the last communication step (the start time before any) */
+    int64_t k_next; /* index of the next sample to process */
     /* states */
     double z[PIM_MAX_PLAYS];
     double pinv[PIM_MAX_PLAYS], rinv[PIM_MAX_PLAYS];
     pim_estimator est;
     char msg[256]; /* reason of the last failure */
 } pim_unit;
+
+#define PIM_AT(field) offsetof(pim_unit, field)
+
+/* The variables of the unit (the model description is generated to the same list); inputs and
+ * outputs first, as the accessors scan it on every call. */
+static const pim_var unit_vars[] = {
+#if PIM_MODEL == 1
+    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+#elif PIM_MODEL == 2
+    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_in2, 'R', PIM_INPUT, 1, PIM_AT(in2)},
+    {"y_hat", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"e", vr_out2, 'R', PIM_OUTPUT, 1, PIM_AT(out2)},
+    {"r_hat", vr_r_hat, 'R', PIM_OUTPUT, PIM_NMAX, PIM_AT(rhat_out)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"gain", vr_gain, 'R', PIM_PARAMETER, 1, PIM_AT(gain)},
+    {"linear_play", vr_linear_play, 'B', PIM_PARAMETER, 1, PIM_AT(linear_play)},
+    {"guard", vr_guard, 'R', PIM_PARAMETER, 1, PIM_AT(guard)},
+    {"slope_window", vr_slope_window, 'I', PIM_PARAMETER, 1, PIM_AT(slope_window)},
+#else
+    {"y_d", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"v", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r_hat", vr_r_hat, 'R', PIM_INPUT, PIM_NMAX, PIM_AT(rhat_in)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"adaptive", vr_adaptive, 'B', PIM_PARAMETER, 1, PIM_AT(adaptive)},
+#endif
+    {"Ts", vr_Ts, 'R', PIM_PARAMETER, 1, PIM_AT(Ts)},
+    {"n", vr_n, 'I', PIM_PARAMETER, 1, PIM_AT(n)},
+    {"z0", vr_z0, 'R', PIM_PARAMETER, 1, PIM_AT(z0)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"time", vr_time, 'R', PIM_INDEPENDENT, 1, PIM_AT(time)},
+};
+#define PIM_NVARS (sizeof unit_vars / sizeof unit_vars[0])
 
 static int unit_error(pim_unit *u, const char *fmt, ...)
 {
@@ -61,6 +149,26 @@ static int unit_error(pim_unit *u, const char *fmt, ...)
     return -1;
 }
 
+static const char *unit_mode_name(int mode)
+{
+    switch (mode) {
+    case PIM_INSTANTIATED: return "instantiated";
+    case PIM_INIT_MODE: return "in initialization mode";
+    case PIM_STEP_MODE: return "in step mode";
+    case PIM_TERMINATED: return "terminated";
+    default: return "in an unknown mode";
+    }
+}
+
+/* 0 if the unit's mode is one of the bits in `allowed` (1 << mode), else -1 naming the call. */
+static int unit_require_mode(pim_unit *u, unsigned allowed, const char *call)
+{
+    if (u->mode >= PIM_INSTANTIATED && u->mode <= PIM_TERMINATED && (allowed & (1u << u->mode)))
+        return 0;
+    return unit_error(u, "%s is not allowed now: the FMU is %s", call, unit_mode_name(u->mode));
+}
+#define PIM_IN(m) (1u << (m))
+
 static void unit_defaults(pim_unit *u)
 {
     memset(u, 0, sizeof *u);
@@ -68,30 +176,99 @@ static void unit_defaults(pim_unit *u)
     u->gain = 10.0;
     u->n = 1;
     u->slope_window = 8;
-    for (int i = 0; i < NMAX; ++i) u->p[i] = 1.0;
+    u->mode = PIM_INSTANTIATED;
+    for (int i = 0; i < PIM_NMAX; ++i) u->p[i] = 1.0;
 }
 
-/* Checks the parameters and sets up the states. */
-static int unit_setup(pim_unit *u)
+/* Start time (setupExperiment / enterInitializationMode): finite and >= 0. */
+static int unit_start(pim_unit *u, double t0, int stop_defined, double t_stop)
 {
-    if (u->n < 1 || u->n > NMAX)
-        return unit_error(u, "parameter n = %d out of range: 1 <= n <= %d", u->n, NMAX);
-    if (!(u->Ts > 0.0) || !isfinite(u->Ts))
-        return unit_error(u, "parameter Ts = %g: the sample time must be > 0", u->Ts);
-    if (!isfinite(u->z0)) return unit_error(u, "parameter z0: must be finite");
-    const size_t n = (size_t)u->n;
-    const char *msg = pim_pi_check(n, u->p, u->r, 0);
+    if (!isfinite(t0) || t0 < 0.0)
+        return unit_error(u, "start time = %g: must be finite and >= 0", t0);
+    if (stop_defined && (!isfinite(t_stop) || t_stop < t0))
+        return unit_error(u, "stop time = %g: must be finite and >= the start time %g", t_stop,
+                          t0);
+    u->time = t0;
+    return 0;
+}
+
+/* The parameter rules, shared by initialization and by every FMU state that is restored. */
+static int unit_check_parameters(pim_unit *u)
+{
+    if (u->n < 1 || u->n > PIM_NMAX)
+        return unit_error(u, "parameter n = %d out of range: 1 <= n <= %d", u->n, PIM_NMAX);
+    if (!isfinite(u->Ts) || !(u->Ts >= PIM_TS_MIN))
+        return unit_error(u, "parameter Ts = %g: the sample time must be > 0 (finite, >= %g)",
+                          u->Ts, PIM_TS_MIN);
+    if (!isfinite(u->z0)) return unit_error(u, "parameter z0 = %g: must be finite", u->z0);
+    for (int i = 0; i < u->n; ++i) {
+        if (!isfinite(u->p[i]))
+            return unit_error(u, "weight p[%d] = %g is not finite", i + 1, u->p[i]);
+        if (!(u->p[i] > 0.0))
+            return unit_error(u, "weight p[%d] = %g is not positive (weights must be > 0)",
+                              i + 1, u->p[i]);
+        if (!isfinite(u->r[i]))
+            return unit_error(u, "radius r[%d] = %g is not finite", i + 1, u->r[i]);
+        if (u->r[i] < 0.0)
+            return unit_error(u, "radius r[%d] = %g is negative (radii must be >= 0)", i + 1,
+                              u->r[i]);
+        if (i > 0 && u->r[i] < u->r[i - 1])
+            return unit_error(u, "radii not sorted: r[%d] = %g < r[%d] = %g (need r[1] <= ... "
+                                 "<= r[n])", i + 1, u->r[i], i, u->r[i - 1]);
+    }
+    const char *msg = pim_pi_check((size_t)u->n, u->p, u->r, 0);
     if (msg) return unit_error(u, "bad parameters: %s", msg);
 #if PIM_MODEL == 2
     if (!(u->gain >= 0.0) || !isfinite(u->gain))
         return unit_error(u, "parameter gain = %g: must be finite and >= 0", u->gain);
-    double g[NMAX];
-    for (size_t i = 0; i < n; ++i) g[i] = u->gain;
-    msg = pim_est_init(&u->est, n, u->p, g, u->r, u->Ts, u->z0, 0.0, 0.0, 0.0, u->guard,
-                       u->known_linear);
-    if (msg) return unit_error(u, "bad parameters: %s", msg);
-    msg = pim_est_set_slope_check(&u->est, u->slope_window, 0.5);
-    if (msg) return unit_error(u, "bad parameters: %s", msg);
+    if (!(u->guard >= 0.0) || !isfinite(u->guard))
+        return unit_error(u, "parameter guard = %g: must be finite and >= 0", u->guard);
+    if (u->slope_window < 0 || u->slope_window >= PIM_EST_WIN)
+        return unit_error(u, "parameter slope_window = %d out of range: 0 <= slope_window <= %d",
+                          u->slope_window, PIM_EST_WIN - 1);
+    if (u->linear_play != 0 && u->linear_play != 1)
+        return unit_error(u, "parameter linear_play = %d: must be a Boolean", u->linear_play);
+#elif PIM_MODEL == 3
+    if (u->adaptive != 0 && u->adaptive != 1)
+        return unit_error(u, "parameter adaptive = %d: must be a Boolean", u->adaptive);
+    if (!u->adaptive && u->r[0] != 0.0)
+        return unit_error(u, "bad parameters: not invertible (r[1] = %g must be 0 with a "
+                             "positive weight p[1])", u->r[0]);
+#endif
+    return 0;
+}
+
+#if PIM_MODEL == 2
+/* A freshly initialised estimator for the unit's (checked) parameters. */
+static int unit_init_estimator(pim_unit *u, pim_estimator *est)
+{
+    double g[PIM_NMAX];
+    for (int i = 0; i < u->n; ++i) g[i] = u->gain;
+    const char *msg = pim_est_init(est, (size_t)u->n, u->p, g, u->r, u->Ts, u->z0, 0.0, 0.0, 0.0,
+                                   u->guard, u->linear_play);
+    if (!msg) msg = pim_est_set_slope_check(est, u->slope_window, 0.5);
+    return msg ? unit_error(u, "bad parameters: %s", msg) : 0;
+}
+#endif
+
+/* Index of the first sample at or after time t. */
+static double unit_first_sample(const pim_unit *u, double t)
+{
+    return ceil(t / u->Ts - PIM_SAMPLE_TOL);
+}
+
+/* Checks the parameters and sets up the states (exitInitializationMode). */
+static int unit_setup(pim_unit *u)
+{
+    if (unit_check_parameters(u) != 0) return -1;
+    const double k0 = unit_first_sample(u, u->time);
+    if (!(k0 < PIM_MAX_SAMPLE_INDEX))
+        return unit_error(u, "start time %g is beyond the sample counter's range (2^52 samples "
+                             "of Ts = %g)", u->time, u->Ts);
+    u->k_next = (int64_t)k0;
+    const size_t n = (size_t)u->n;
+#if PIM_MODEL == 2
+    if (unit_init_estimator(u, &u->est) != 0) return -1;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
 #else
     for (size_t i = 0; i < n; ++i) u->z[i] = u->z0;
@@ -103,21 +280,40 @@ static int unit_setup(pim_unit *u)
             return unit_error(u, "bad parameters: not invertible (r[1] must be 0 with a "
                                  "positive weight p[1])");
         memcpy(u->z, zinv, n * sizeof(double));
-    } else if (u->r[0] != 0.0 && u->known_linear) {
-        return unit_error(u, "bad parameters: r[1] must be 0");
     }
 #endif
     return 0;
 }
 
-/* One internal sample at the held inputs. */
-static int unit_sample(pim_unit *u)
+/* The inputs held over a step: finite (and admissible radii for the adaptive inverse). */
+static int unit_check_inputs(pim_unit *u)
+{
+    if (!isfinite(u->in1))
+        return unit_error(u, "input %s = %g is not finite (NaN or Inf)",
+                          PIM_MODEL == 3 ? "y_d" : "v", u->in1);
+#if PIM_MODEL == 2
+    if (!isfinite(u->in2)) return unit_error(u, "input y = %g is not finite (NaN or Inf)", u->in2);
+#elif PIM_MODEL == 3
+    if (u->adaptive) {
+        for (int i = 0; i < u->n; ++i) {
+            const double x = u->rhat_in[i];
+            if (!isfinite(x) || x < 0.0 || (i > 0 && x < u->rhat_in[i - 1]))
+                return unit_error(u, "input r_hat[%d] = %g: radii must be finite, >= 0 and "
+                                     "sorted", i + 1, x);
+        }
+        if (u->rhat_in[0] != 0.0)
+            return unit_error(u, "input r_hat[1] = %g: not invertible (r_hat[1] must be 0)",
+                              u->rhat_in[0]);
+    }
+#endif
+    return 0;
+}
+
+/* One internal sample at the held inputs (checked by unit_check_inputs). */
+static void unit_sample(pim_unit *u)
 {
     const size_t n = (size_t)u->n;
-    if (!isfinite(u->in1) || !isfinite(u->in2))
-        return unit_error(u, "input is not finite (NaN or Inf): %g, %g", u->in1, u->in2);
 #if PIM_MODEL == 1
-    (void)n;
     u->out1 = pim_pi_step(n, u->p, u->r, u->z, u->in1);
 #elif PIM_MODEL == 2
     double yh, e, ed;
@@ -126,86 +322,338 @@ static int unit_sample(pim_unit *u)
     u->out2 = e;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
 #else
-    if (u->adaptive) {
-        for (size_t i = 0; i < n; ++i) {
-            if (!isfinite(u->rhat_in[i]) || u->rhat_in[i] < 0.0 ||
-                (i > 0 && u->rhat_in[i] < u->rhat_in[i - 1]))
-                return unit_error(u, "input r_hat[%d] = %g: radii must be finite, >= 0 and "
-                                     "sorted", (int)i + 1, u->rhat_in[i]);
-        }
-        double v = pim_adaptive_inverse_step(n, u->p, u->rhat_in, u->z, u->in1);
-        if (isnan(v)) return unit_error(u, "input r_hat: not invertible (r_hat[1] must be 0)");
-        u->out1 = v;
-    } else {
+    if (u->adaptive)
+        u->out1 = pim_adaptive_inverse_step(n, u->p, u->rhat_in, u->z, u->in1);
+    else
         u->out1 = pim_pi_step(n, u->pinv, u->rinv, u->z, u->in1);
-    }
 #endif
-    return 0;
 }
 
-/* Processes the samples k*Ts in [t, t+h) (the sampling rule above). */
-static int unit_do_step(pim_unit *u, double t, double h)
+/* Whether the outputs (and the estimator's radii) are finite. */
+static int unit_outputs_finite(const pim_unit *u)
 {
-    if (!(h >= 0.0) || !isfinite(t) || !isfinite(h))
-        return unit_error(u, "invalid communication step: t = %g, h = %g", t, h);
-    const double tol = 1e-9;
-    const double k0 = ceil(t / u->Ts - tol), k1 = ceil((t + h) / u->Ts - tol);
-    for (double k = k0; k < k1; k += 1.0)
-        if (unit_sample(u) != 0) return -1;
-    return 0;
-}
-
-/* Scalar Float64 variables by value reference (NULL if none). */
-static double *unit_scalar(pim_unit *u, unsigned vr)
-{
-    switch (vr) {
-    case 0: return &u->Ts;
-    case 2: return &u->z0;
-    case 4: return &u->gain;
-    case 6: return &u->guard;
-    case 10: return &u->in1;
-    case 11: return &u->out1;
-    case 12: return &u->in2;
-    case 13: return &u->out2;
-    default: return NULL;
-    }
-}
-
-/* Array variable (p, r, r_hat) with base reference 100, 200 or 300 (NULL if none). */
-static double *unit_array(pim_unit *u, unsigned base)
-{
-    switch (base) {
-    case 100: return u->p;
-    case 200: return u->r;
+    if (!isfinite(u->out1) || !isfinite(u->out2)) return 0;
 #if PIM_MODEL == 2
-    case 300: return u->rhat_out;
-#else
-    case 300: return u->rhat_in;
+    for (int i = 0; i < u->n; ++i)
+        if (!isfinite(u->rhat_out[i])) return 0;
 #endif
-    default: return NULL;
-    }
-}
-
-/* Whether a Float64 variable may be set: parameters before initialization, inputs always. */
-static int unit_settable(unsigned vr, int initialized)
-{
-    if (vr == 11 || vr == 13 || (PIM_MODEL == 2 && vr >= 300)) return 0;
-    if (initialized && (vr < 10 || (vr >= 100 && vr < 300))) return 0;
     return 1;
 }
 
-static int *unit_int(pim_unit *u, unsigned vr)
+/* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
+static int unit_do_step(pim_unit *u, double t, double h)
 {
-    if (vr == 1) return &u->n;
-    if (vr == 7) return &u->slope_window;
+    if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
+    if (!isfinite(t) || t < 0.0)
+        return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
+    if (!isfinite(h) || !(h > 0.0))
+        return unit_error(u, "communication step size h = %g: must be finite and > 0", h);
+    const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
+    const double tol = 1e-9 * scale < 1e-3 * u->Ts ? 1e-9 * scale : 1e-3 * u->Ts;
+    if (t != u->time && fabs(t - u->time) > tol)
+        return unit_error(u, "communication point t = %.17g does not match the FMU's time "
+                             "%.17g (the end of the last step)", t, u->time);
+    const double t_end = t + h;
+    if (!(t_end > t))
+        return unit_error(u, "no progress: t + h == t at t = %g, h = %g (h is below the time "
+                             "resolution at t)", t, h);
+    const double k_end = unit_first_sample(u, t_end);
+    if (!(k_end < PIM_MAX_SAMPLE_INDEX))
+        return unit_error(u, "time t + h = %g is beyond the sample counter's range (2^52 "
+                             "samples of Ts = %g)", t_end, u->Ts);
+    const int64_t k1 = (int64_t)k_end;
+    if (k1 - u->k_next > PIM_MAX_SUBSTEPS)
+        return unit_error(u, "step h = %g spans %lld samples of Ts = %g; at most %lld per doStep "
+                             "(use shorter communication steps)", h,
+                          (long long)(k1 - u->k_next), u->Ts, PIM_MAX_SUBSTEPS);
+    if (k1 <= u->k_next) {
+        u->time = t_end;
+        return 0;
+    }
+    if (unit_check_inputs(u) != 0) return -1;
+    /* a step that overflows is not taken: the states it changes are restored */
+    const int64_t k_saved = u->k_next;
+    const double out_saved[2] = {u->out1, u->out2};
+#if PIM_MODEL == 2
+    const pim_estimator est_saved = u->est;
+#else
+    double z_saved[PIM_MAX_PLAYS];
+    for (int i = 0; i < u->n; ++i) z_saved[i] = u->z[i];
+#endif
+    for (; u->k_next < k1; ++u->k_next) {
+        unit_sample(u);
+        if (!unit_outputs_finite(u)) {
+            const double y1 = u->out1, y2 = u->out2;
+            u->k_next = k_saved;
+            u->out1 = out_saved[0];
+            u->out2 = out_saved[1];
+#if PIM_MODEL == 2
+            u->est = est_saved;
+            for (int i = 0; i < u->n; ++i) u->rhat_out[i] = u->est.rhat[i];
+#else
+            memcpy(u->z, z_saved, (size_t)u->n * sizeof(double));
+#endif
+            return unit_error(u, "the outputs overflowed (%g, %g) at sample %lld with the "
+                                 "inputs held over this step; the step was not taken", y1, y2,
+                              (long long)u->k_next);
+        }
+    }
+    u->time = t_end;
+    return 0;
+}
+
+/* ---- variables by value reference --------------------------------------------------------- */
+
+/* The variable with reference vr, or NULL.  With elements (FMI 2) an array is addressed by
+ * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
+static const pim_var *unit_var(unsigned vr, int elements, int *elem)
+{
+    /* FMI 2 array elements: base 100, 200, 300 plus an index below PIM_NMAX */
+    const unsigned base = elements && vr >= 100 && vr < 400 ? vr - vr % 100 : vr;
+    for (size_t i = 0; i < PIM_NVARS; ++i) {
+        const pim_var *v = &unit_vars[i];
+        if (v->vr != base) continue;
+        if (v->size > 1 && elements) {
+            if (vr - base >= (unsigned)v->size) return NULL;
+            *elem = (int)(vr - base);
+        } else {
+            if (vr != base || (elements && v->causality == PIM_INDEPENDENT)) return NULL;
+            *elem = -1; /* FMI 2 has no time variable */
+        }
+        return v;
+    }
     return NULL;
 }
 
-static int *unit_bool(pim_unit *u, unsigned vr)
+/* "p[3]" or "Ts" into buf. */
+static const char *unit_label(const pim_var *v, int elem, char *buf, size_t size)
 {
-    if (vr == 3) return &u->adaptive;
-    if (vr == 5) return &u->known_linear;
+    if (elem >= 0)
+        snprintf(buf, size, "%s[%d]", v->name, elem + 1);
+    else
+        snprintf(buf, size, "%s", v->name);
+    return buf;
+}
+
+/* Whether variable v may be set now: parameters before initialization, inputs until
+ * terminate, never outputs or time. */
+static int unit_settable(const pim_unit *u, const pim_var *v)
+{
+    if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT) return 0;
+    if (v->causality == PIM_PARAMETER)
+        return u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE;
+    return u->mode != PIM_TERMINATED;
+}
+
+/* Error paths out of line, so that the accessors stay small (they run on every get/set). */
+#if defined(__GNUC__)
+#define PIM_COLD __attribute__((noinline, cold))
+#else
+#define PIM_COLD
+#endif
+
+/* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
+PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, unsigned vr, char type)
+{
+    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : "Boolean";
+    char name[40];
+    if (!v)
+        unit_error(u, "no %s variable with value reference %u in the model description", tname,
+                   vr);
+    else if (v->type != type)
+        unit_error(u, "variable %s (value reference %u) is not a %s",
+                   unit_label(v, elem, name, sizeof name), vr, tname);
+    else if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT)
+        unit_error(u, "variable %s (value reference %u) is %s and cannot be set",
+                   unit_label(v, elem, name, sizeof name), vr,
+                   v->causality == PIM_OUTPUT ? "an output" : "the independent variable");
+    else if (v->causality == PIM_PARAMETER)
+        unit_error(u, "cannot set parameter %s (value reference %u) after initialization",
+                   unit_label(v, elem, name, sizeof name), vr);
+    else
+        unit_error(u, "cannot set input %s (value reference %u) after terminate",
+                   unit_label(v, elem, name, sizeof name), vr);
     return NULL;
+}
+
+/*
+ * Storage of the variable with reference vr, checked against the model description (exists,
+ * has type `type`) and, for set != 0, against the mode (unit_settable).  *count: values it
+ * holds (1, or PIM_NMAX for an FMI 3 array).  NULL with the reason in u->msg on failure.
+ */
+static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set, size_t *count)
+{
+    int elem = -1;
+    const pim_var *v = unit_var(vr, elements, &elem);
+    if (!v || v->type != type || (set && !unit_settable(u, v)))
+        return unit_ref_refused(u, v, elem, vr, type);
+    *count = elem >= 0 ? 1 : (size_t)v->size;
+    return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
+}
+
+/* ---- FMU state: a checked, versioned byte format ------------------------------------------ */
+
+/*
+ * Layout (native byte order), PIM_STATE_SIZE bytes:
+ *   header  magic "PIMSTATE", format version, byte-order mark 0x01020304, unit (PIM_MODEL),
+ *           FMI major version, PIM_NMAX, PIM_EST_WIN, sizeof(pim_unit), sizeof(pim_estimator),
+ *           GUID / instantiation token (64 bytes, NUL padded)
+ *   payload the pim_unit struct (parameters, inputs, outputs, mode, time, counter, states)
+ *   check   FNV-1a 64 of header and payload
+ * Loading checks every header field, the checksum, the mode, time and counter, every parameter
+ * (unit_check_parameters, as at initialization) and that every state is finite; derived
+ * quantities (inverse parameters, estimator settings, r_hat outputs) are recomputed, not read.
+ * The in-memory FMU state (get/set) is the same byte block, checked again when set.
+ */
+#define PIM_STATE_MAGIC "PIMSTATE"
+#define PIM_STATE_VERSION 1u
+#define PIM_STATE_TOKEN 64
+
+typedef struct {
+    char magic[8];
+    uint32_t version, byte_order, model, fmi, nmax, est_win;
+    uint64_t unit_size, est_size;
+    char token[PIM_STATE_TOKEN];
+} pim_state_header;
+
+#define PIM_STATE_SIZE (sizeof(pim_state_header) + sizeof(pim_unit) + sizeof(uint64_t))
+
+static uint64_t unit_fnv1a(const unsigned char *b, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= b[i];
+        h *= 0x100000001b3ULL;
+    }
+    return h;
+}
+
+static void unit_state_header(pim_state_header *h, const char *token, unsigned fmi)
+{
+    memset(h, 0, sizeof *h);
+    memcpy(h->magic, PIM_STATE_MAGIC, 8);
+    h->version = PIM_STATE_VERSION;
+    h->byte_order = 0x01020304u;
+    h->model = PIM_MODEL;
+    h->fmi = fmi;
+    h->nmax = PIM_NMAX;
+    h->est_win = PIM_EST_WIN;
+    h->unit_size = sizeof(pim_unit);
+    h->est_size = sizeof(pim_estimator);
+    snprintf(h->token, sizeof h->token, "%s", token);
+}
+
+/* Writes the unit's state into buf (PIM_STATE_SIZE bytes). */
+static void unit_state_write(const pim_unit *u, unsigned char *buf, const char *token,
+                             unsigned fmi)
+{
+    pim_state_header h;
+    unit_state_header(&h, token, fmi);
+    memcpy(buf, &h, sizeof h);
+    memcpy(buf + sizeof h, u, sizeof *u);
+    const uint64_t sum = unit_fnv1a(buf, sizeof h + sizeof *u);
+    memcpy(buf + sizeof h + sizeof *u, &sum, sizeof sum);
+}
+
+#if PIM_MODEL != 2
+static int unit_all_finite(const double *x, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(x[i])) return 0;
+    return 1;
+}
+#endif
+
+/* Checks the states of a loaded unit s (parameters already checked) and recomputes what derives
+ * from the parameters; on failure the reason goes to u->msg. */
+static int unit_check_states(pim_unit *u, pim_unit *s)
+{
+    const size_t n = (size_t)s->n;
+    const double k = unit_first_sample(s, s->time);
+    if (!(k < PIM_MAX_SAMPLE_INDEX) || s->k_next != (int64_t)k)
+        return unit_error(u, "FMU state rejected: sample counter %lld does not match time %g "
+                             "and Ts = %g", (long long)s->k_next, s->time, s->Ts);
+#if PIM_MODEL == 2
+    if (s->est.n != n)
+        return unit_error(u, "FMU state rejected: estimator has n = %llu plays, the unit %d",
+                          (unsigned long long)s->est.n, s->n);
+    double flat[PIM_EST_STATE_SIZE(PIM_MAX_PLAYS)];
+    pim_est_get_state(&s->est, flat);
+    pim_estimator fresh;
+    if (unit_init_estimator(s, &fresh) != 0) return unit_error(u, "FMU state rejected: %s",
+                                                               s->msg);
+    const char *msg = pim_est_set_state(&fresh, flat);
+    if (msg) return unit_error(u, "FMU state rejected: estimator %s", msg);
+    s->est = fresh;
+    for (size_t i = 0; i < n; ++i) s->rhat_out[i] = s->est.rhat[i];
+#else
+    if (!unit_all_finite(s->z, n))
+        return unit_error(u, "FMU state rejected: a play state z is not finite");
+#endif
+#if PIM_MODEL == 3
+    if (!s->adaptive && pim_pi_inverse(n, s->p, s->r, NULL, s->pinv, s->rinv, NULL) != 0)
+        return unit_error(u, "FMU state rejected: parameters not invertible");
+#endif
+    return 0;
+}
+
+/*
+ * Checks a serialized state (bytes, size) for this unit and token and, when out != NULL,
+ * loads it into *out.  Returns 0, or -1 with the reason in u->msg (u and out unchanged).
+ */
+static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
+                           const char *token, unsigned fmi, pim_unit *out)
+{
+    if (!bytes) return unit_error(u, "FMU state rejected: null state");
+    if (size != PIM_STATE_SIZE)
+        return unit_error(u, "FMU state rejected: %llu bytes, expected %llu (another FMU or "
+                             "version)", (unsigned long long)size,
+                          (unsigned long long)PIM_STATE_SIZE);
+    pim_state_header h, want;
+    memcpy(&h, bytes, sizeof h);
+    unit_state_header(&want, token, fmi);
+    if (memcmp(h.magic, want.magic, 8) != 0)
+        return unit_error(u, "FMU state rejected: not a pimodel FMU state (bad magic)");
+    if (h.version != want.version)
+        return unit_error(u, "FMU state rejected: format version %u, expected %u", h.version,
+                          want.version);
+    if (h.byte_order != want.byte_order)
+        return unit_error(u, "FMU state rejected: written on a machine of another byte order");
+    if (h.model != want.model || h.fmi != want.fmi || memcmp(h.token, want.token,
+                                                             PIM_STATE_TOKEN) != 0)
+        return unit_error(u, "FMU state rejected: written by another model (unit %u, FMI %u); "
+                             "the GUID / instantiation token does not match", h.model, h.fmi);
+    if (h.nmax != want.nmax || h.est_win != want.est_win || h.unit_size != want.unit_size ||
+        h.est_size != want.est_size)
+        return unit_error(u, "FMU state rejected: sizes differ (written by another build of "
+                             "this FMU)");
+    uint64_t sum;
+    memcpy(&sum, bytes + sizeof h + sizeof(pim_unit), sizeof sum);
+    if (sum != unit_fnv1a(bytes, sizeof h + sizeof(pim_unit)))
+        return unit_error(u, "FMU state rejected: checksum mismatch (corrupted bytes)");
+    pim_unit *s = (pim_unit *)malloc(sizeof *s);
+    if (!s) return unit_error(u, "FMU state rejected: out of memory");
+    memcpy(s, bytes + sizeof h, sizeof *s);
+    s->msg[0] = '\0';
+    int rc = 0;
+    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_TERMINATED)
+        rc = unit_error(u, "FMU state rejected: unknown mode %d", s->mode);
+    else if (!isfinite(s->time) || s->time < 0.0)
+        rc = unit_error(u, "FMU state rejected: time %g must be finite and >= 0", s->time);
+    else if (!isfinite(s->out1) || !isfinite(s->out2))
+        rc = unit_error(u, "FMU state rejected: an output is not finite");
+    else if (s->mode >= PIM_STEP_MODE) {
+        if (unit_check_parameters(s) != 0)
+            rc = unit_error(u, "FMU state rejected: %s", s->msg);
+        else
+            rc = unit_check_states(u, s);
+    }
+    if (rc == 0 && out) {
+        s->msg[0] = '\0';
+        *out = *s;
+    }
+    free(s);
+    return rc;
 }
 
 #endif /* PIM_UNIT_H */

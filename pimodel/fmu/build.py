@@ -17,7 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import escape
 
-NMAX = 16  # declared array variables per FMU (p[1..16], r[1..16], r_hat[1..16])
+NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
+MAX_SUBSTEPS = 10_000_000  # samples per doStep; PIM_MAX_SUBSTEPS in fmu/src/pim_unit.h
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
 HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
@@ -61,7 +62,7 @@ def _arrays(prefix: str, base: int, causality: str, start: str, what: str) -> li
 
 def _common() -> list[Var]:
     return [
-        Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (> 0)"),
+        Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (>= 1e-12)"),
         Var("n", 1, "Integer", "parameter", "1", f"number of plays, 1 <= n <= {NMAX}"),
         Var("z0", 2, "Real", "parameter", "0", "initial play state (input unit)"),
         *_arrays("p", 100, "parameter", "1", "weight p (> 0), play"),
@@ -81,8 +82,8 @@ MODELS: dict[str, dict] = {
         "description": "Adaptive estimation of the play radii (gradient law with projection)",
         "vars": [*_common(), *_arrays("r", 200, "parameter", "0", "initial radius estimate, play"),
                  Var("gain", 4, "Real", "parameter", "10", "adaptation gain (>= 0)"),
-                 Var("known_linear", 5, "Boolean", "parameter", "false",
-                     "hold r_hat[1] = 0 (known linear play)"),
+                 Var("linear_play", 5, "Boolean", "parameter", "false",
+                     "the model has a linear play: hold r_hat[1] = 0"),
                  Var("guard", 6, "Real", "parameter", "0", "breakpoint guard band (input unit)"),
                  Var("slope_window", 7, "Integer", "parameter", "8",
                      "slope check window in samples (0: off)"),
@@ -106,10 +107,10 @@ MODELS: dict[str, dict] = {
 
 
 def guid(name: str) -> str:
-    """Fixed GUID of a unit (changes with the interface version)."""
+    """Fixed GUID of a unit (changes with the interface version: v2 has 64 plays, linear_play)."""
     import uuid
 
-    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi2/{name}/v1")) + "}"
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi2/{name}/v2")) + "}"
 
 
 def source_dir() -> Path:
@@ -206,7 +207,10 @@ def _documentation(name: str) -> str:
     return (f"<html><body><h1>{name}</h1><p>{escape(spec['description'])}.</p>"
             f"<p>{escape(SAMPLING)} Arrays are declared up to index {NMAX}; the first n are "
             "used. Bad parameters or non-finite inputs return an error status (fmi2Error, "
-            "fmi3Error) with a logged message."
+            "fmi3Error) with a logged message, as do a call in the wrong state, an unknown "
+            "value reference, a doStep whose t is not the FMU's time, a step of more than "
+            f"{MAX_SUBSTEPS:,} samples, and an FMU state that fails its checks (format, "
+            "checksum, parameters, finite states)."
             f"</p><table>{rows}</table></body></html>\n")
 
 

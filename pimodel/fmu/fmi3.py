@@ -15,7 +15,7 @@ PLATFORM = "x86_64-linux"
 
 def token(name: str) -> str:
     """Fixed instantiation token of a unit (changes with the interface version)."""
-    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi3/{name}/v1")) + "}"
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi3/{name}/v2")) + "}"
 
 
 def _variables(name: str) -> list[tuple[str, int, str, str, str, str, bool]]:

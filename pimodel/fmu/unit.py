@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,9 @@ from fmpy.fmi2 import (
     fmi2CallbackLoggerTYPE,
 )
 from fmpy.fmi3 import FMU3Slave
+
+# FMU variables renamed in the pimodel FMUs; the old names work for one release with a warning.
+RENAMED = {"known_linear": "linear_play"}
 
 
 class FMUUnit:
@@ -80,6 +84,10 @@ class FMUUnit:
         """(variable, element index or None) for ``name`` or an FMI 3 element ``base[i]``."""
         if name in self.vars:
             return self.vars[name], None
+        if name in RENAMED and RENAMED[name] in self.vars:
+            warnings.warn(f"FMU variable {name!r} is now {RENAMED[name]!r}; the old name will "
+                          "be removed in the next release", DeprecationWarning, stacklevel=3)
+            return self.vars[RENAMED[name]], None
         base, _, rest = name.partition("[")
         v = self.vars.get(base)
         if v is not None and v.dimensions and rest.endswith("]") and rest[:-1].isdigit():
