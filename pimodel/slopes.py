@@ -52,7 +52,7 @@ class SlopeIdentification:
     --------
     >>> from pimodel import PIOperator, identify_slopes
     >>> v = np.sin(np.linspace(0, 6 * np.pi, 3000))
-    >>> s = identify_slopes(v, PIOperator([1.0, 0.5], [0.0, 0.3]).simulate(v))
+    >>> s = identify_slopes(v, PIOperator([1.0, 0.5], [0.0, 0.3]).simulate(v), max_segments=3)
     >>> s.n_plays, s.linear_play, s.to_json()["criterion"][:3]
     (2, True, 'BIC')
     """
@@ -83,7 +83,7 @@ class SlopeIdentification:
         >>> import json
         >>> from pimodel import PIOperator, identify_slopes
         >>> v = np.sin(np.linspace(0, 6 * np.pi, 3000))
-        >>> s = identify_slopes(v, PIOperator([1.0], [0.0]).simulate(v))
+        >>> s = identify_slopes(v, PIOperator([1.0], [0.0]).simulate(v), max_segments=2)
         >>> json.loads(json.dumps(s.to_json()))["n_plays"]
         1
         """
@@ -209,7 +209,8 @@ def identify_slopes(v, y, *, max_segments: int = 8, n_plays: int | None = None,
     --------
     >>> from pimodel import PIOperator, identify_slopes
     >>> v = np.sin(np.linspace(0, 6 * np.pi, 6000))
-    >>> s = identify_slopes(v, PIOperator([1.0, 0.5, 0.25], [0.0, 0.2, 0.5]).simulate(v))
+    >>> y = PIOperator([1.0, 0.5, 0.25], [0.0, 0.2, 0.5]).simulate(v)
+    >>> s = identify_slopes(v, y, max_segments=4)
     >>> s.n_plays, s.weights.round(4), s.radii_guess.round(4)
     (3, array([1.  , 0.5 , 0.25]), array([0. , 0.2, 0.5]))
     """
