@@ -17,7 +17,35 @@ from .checks import positive_scalar
 
 
 def second_order_mode(fn_hz: float, damping: float, gain: float = 1.0) -> control.TransferFunction:
-    """``gain wn^2 / (s^2 + 2 zeta wn s + wn^2)``, ``wn = 2 pi fn_hz`` (continuous time)."""
+    """Second-order mode ``gain wn^2 / (s^2 + 2 zeta wn s + wn^2)``, ``wn = 2 pi fn_hz``.
+
+    Parameters
+    ----------
+    fn_hz : float
+        Natural frequency [Hz], ``> 0``.
+    damping : float
+        Damping ratio ``zeta``, finite, ``>= 0``.
+    gain : float, optional
+        Static gain (output per hysteresis-output unit), finite and non-zero.
+
+    Returns
+    -------
+    control.TransferFunction
+        The continuous-time mode.
+
+    Raises
+    ------
+    ValueError
+        If ``fn_hz``, ``damping`` or ``gain`` is out of range.
+
+    Examples
+    --------
+    >>> import control
+    >>> from pimodel.actuators import second_order_mode
+    >>> G = second_order_mode(1000.0, 0.05)
+    >>> float(control.dcgain(G))
+    1.0
+    """
     fn = positive_scalar(fn_hz, "fn_hz")
     if not np.isfinite(damping) or damping < 0:
         raise ValueError(f"damping: expected a finite number >= 0, got {damping!r}")
@@ -28,8 +56,35 @@ def second_order_mode(fn_hz: float, damping: float, gain: float = 1.0) -> contro
 
 
 def creep_lags(gains: Sequence[float], time_constants: Sequence[float]) -> control.TransferFunction:
-    """Creep as ``1 + sum_i a_i / (tau_i s + 1)``: a step of the hysteresis output is followed
-    by a slow rise of ``sum a_i`` (fractions of the step) with time constants ``tau_i`` [s]."""
+    """Creep as a sum of first-order lags, ``1 + sum_i a_i / (tau_i s + 1)``.
+
+    A step of the hysteresis output is followed by a slow rise of ``sum a_i`` (fractions of
+    the step) with time constants ``tau_i``.
+
+    Parameters
+    ----------
+    gains : sequence of float
+        Lag gains ``a_i``, finite, ``>= 0`` (fractions of the step).
+    time_constants : sequence of float
+        Time constants ``tau_i`` [s], ``> 0``; as many as ``gains``.
+
+    Returns
+    -------
+    control.TransferFunction
+        The continuous-time creep factor (static gain ``1 + sum a_i``).
+
+    Raises
+    ------
+    ValueError
+        If the lengths differ or are 0, or a gain or time constant is out of range.
+
+    Examples
+    --------
+    >>> import control
+    >>> from pimodel.actuators import creep_lags
+    >>> round(float(control.dcgain(creep_lags([0.01, 0.02], [0.1, 1.0]))), 12)
+    1.03
+    """
     a = np.atleast_1d(np.asarray(gains, float))
     tau = np.atleast_1d(np.asarray(time_constants, float))
     if a.shape != tau.shape or a.size == 0:
@@ -47,8 +102,37 @@ def creep_lags(gains: Sequence[float], time_constants: Sequence[float]) -> contr
 
 def creep_per_decade(percent_per_decade: float, t_min: float = 0.01,
                      decades: int = 4) -> control.TransferFunction:
-    """Creep of about ``percent_per_decade`` % of the last move per decade of time, from
-    ``t_min`` for ``decades`` decades: one lag per decade (``tau = t_min 10^i``)."""
+    """Creep of about ``percent_per_decade`` % of the last move per decade of time.
+
+    One lag per decade, ``tau_i = t_min 10^i`` for ``i = 0..decades-1``, each of gain
+    ``percent_per_decade / 100`` (:func:`creep_lags`).
+
+    Parameters
+    ----------
+    percent_per_decade : float
+        Creep per decade of time [% of the move], ``>= 0``.
+    t_min : float, optional
+        First time constant [s], ``> 0``.
+    decades : int, optional
+        Number of decades (lags), ``>= 1``.
+
+    Returns
+    -------
+    control.TransferFunction
+        The continuous-time creep factor.
+
+    Raises
+    ------
+    ValueError
+        If an argument is out of range.
+
+    Examples
+    --------
+    >>> import control
+    >>> from pimodel.actuators import creep_per_decade
+    >>> round(float(control.dcgain(creep_per_decade(1.5))), 12)    # 4 decades of 1.5 %
+    1.06
+    """
     rate = float(percent_per_decade)
     if not np.isfinite(rate) or rate < 0:
         raise ValueError(f"percent_per_decade: expected >= 0, got {percent_per_decade!r}")
@@ -59,7 +143,31 @@ def creep_per_decade(percent_per_decade: float, t_min: float = 0.01,
 
 
 def delay_samples(delay: float, dt: float) -> int:
-    """Whole samples of a pure delay: ``round(delay / dt)``."""
+    """Whole samples of a pure delay: ``round(delay / dt)`` (sub-sample delays are rounded).
+
+    Parameters
+    ----------
+    delay : float
+        Delay [s], finite, ``>= 0``.
+    dt : float
+        Sample time [s], ``> 0``.
+
+    Returns
+    -------
+    int
+        The delay in samples.
+
+    Raises
+    ------
+    ValueError
+        If ``delay`` or ``dt`` is out of range.
+
+    Examples
+    --------
+    >>> from pimodel.actuators import delay_samples
+    >>> delay_samples(250e-6, 1e-4)
+    2
+    """
     dt = positive_scalar(dt, "dt")
     if not np.isfinite(delay) or delay < 0:
         raise ValueError(f"delay: expected a finite number >= 0 (seconds), got {delay!r}")
@@ -72,9 +180,48 @@ def stage_dynamics(dt: float, *, fn_hz: float | None = 1000.0, damping: float = 
                    name: str = "stage") -> control.StateSpace:
     """Discrete-time stage dynamics ``G(z)`` from the hysteresis output ``h`` to ``y``.
 
-    ``fn_hz`` None: no mode (static ``gain``); ``creep`` a continuous factor (see
-    :func:`creep_lags`); ``delay`` [s] rounded to samples. ZOH discretisation; with a mode the
-    result has ``D = 0`` (usable inside a feedback loop).
+    The mode, the creep factor and the delay are combined in continuous time and discretised
+    with a zero-order hold on ``h``; with a mode the result has ``D = 0`` (usable inside a
+    feedback loop).
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s], ``> 0``.
+    fn_hz : float or None, optional
+        Natural frequency of the mode [Hz]; None for no mode (a static ``gain``).
+    damping : float, optional
+        Damping ratio of the mode.
+    gain : float, optional
+        Static gain.
+    creep : control.TransferFunction, optional
+        A continuous creep factor (:func:`creep_lags`, :func:`creep_per_decade`).
+    delay : float, optional
+        Delay [s], rounded to whole samples (:func:`delay_samples`).
+    input : str, optional
+        Name of the input signal.
+    output : str, optional
+        Name of the output signal.
+    name : str, optional
+        Name of the system.
+
+    Returns
+    -------
+    control.StateSpace
+        The discrete-time system (sample time ``dt``) with the given signal names.
+
+    Raises
+    ------
+    ValueError
+        If ``dt`` or a parameter of the mode, creep or delay is out of range.
+
+    Examples
+    --------
+    >>> import control
+    >>> from pimodel.actuators import stage_dynamics
+    >>> G = stage_dynamics(1e-4, fn_hz=1000.0, damping=0.05)
+    >>> G.dt, G.input_labels, G.output_labels, round(float(control.dcgain(G)), 9)
+    (0.0001, ['h'], ['y'], 1.0)
     """
     dt = positive_scalar(dt, "dt")
     G = second_order_mode(fn_hz, damping, gain) if fn_hz is not None else control.tf([gain], [1])

@@ -19,7 +19,29 @@ from .operator import PIOperator
 
 @dataclass
 class ConventionalFit:
-    """Result of :func:`fit_conventional`: the operator, the output offset and the fit RMS."""
+    """Result of :func:`fit_conventional`.
+
+    The model is ``y[k] = operator.simulate(v)[k] + offset``.
+
+    Parameters
+    ----------
+    operator : PIOperator
+        The fitted operator (plays whose weight came out 0 are dropped, the first one kept).
+    offset : float
+        Output offset (output unit).
+    rms : float
+        RMS of the fit residual on the record (output unit).
+    span : float
+        The largest preset radius (input unit).
+
+    Examples
+    --------
+    >>> from pimodel import fit_conventional
+    >>> v = np.sin(np.linspace(0, 4 * np.pi, 2000))
+    >>> fit = fit_conventional(v, 2 * v + 1, 3)
+    >>> round(fit.offset, 6), fit.operator.n
+    (1.0, 1)
+    """
 
     operator: PIOperator
     offset: float
@@ -28,10 +50,42 @@ class ConventionalFit:
 
 
 def fit_conventional(v, y, n_plays: int, *, span: float | None = None) -> ConventionalFit:
-    """Fit weights for ``n_plays`` preset radii spread over ``[0, span]`` (input units).
+    """Conventional PI fit: weights for ``n_plays`` preset radii spread over ``[0, span]``.
 
-    ``span`` defaults to half the input range, ``(max v - min v) / 2``: the largest radius a
-    play can have and still be excited by the record. ``y`` is modelled as ``PI[v] + offset``.
+    ``y`` is modelled as ``PI[v] + offset`` with radii ``r_i = (i - 1) / (n - 1) * span``
+    (module docstring); the weights are bounded least squares, ``p_1 > 0``, ``p_i >= 0``.
+
+    Parameters
+    ----------
+    v : array_like of float, shape (N,)
+        Input samples (input unit).
+    y : array_like of float, shape (N,)
+        Measured output samples (output unit).
+    n_plays : int
+        Number of preset plays, ``>= 1``.
+    span : float, optional
+        Largest radius (input unit). Default: half the input range, ``(max v - min v) / 2``,
+        the largest radius the record can still excite.
+
+    Returns
+    -------
+    ConventionalFit
+        The operator, offset, fit RMS and span.
+
+    Raises
+    ------
+    ValueError
+        If ``v`` or ``y`` is not a finite signal of at least 2 samples, their lengths differ,
+        ``n_plays < 1``, or ``span`` is not ``> 0`` (e.g. a constant input).
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator, fit_conventional
+    >>> v = 2 * np.sin(np.linspace(0, 6 * np.pi, 3000))
+    >>> y = PIOperator([1.0, 0.5, 0.25], [0.0, 0.5, 1.0]).simulate(v)
+    >>> fit = fit_conventional(v, y, 3, span=1.0)   # preset radii 0, 0.5, 1: the true ones
+    >>> fit.operator.weights.round(6), round(fit.rms, 6)
+    (array([1.  , 0.5 , 0.25]), 0.0)
     """
     v = as_signal(v, "v", min_length=2)
     y = as_signal(y, "y", min_length=2)

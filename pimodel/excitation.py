@@ -17,7 +17,30 @@ from .branches import find_reversals
 
 @dataclass
 class ExcitationReport:
-    """What the record can excite; ``ok`` False means convergence cannot be expected."""
+    """Result of :func:`check_excitation`: what the record can excite.
+
+    Parameters
+    ----------
+    input_range : float
+        ``max v - min v`` (input unit).
+    reversals : int
+        Number of input reversals.
+    loop_width : float or None
+        Loop width ``rho = 2 sum p_i r_i / sum p_i`` of the model (Lemma 2); None without one.
+    largest_radius_bound : float or None
+        Lemma 2's bound on ``r_n``: ``(sum p / p_n) rho / 2``; None without a model.
+    ok : bool
+        False when convergence cannot be expected.
+    messages : list of str
+        The reasons, in words.
+
+    Examples
+    --------
+    >>> from pimodel import check_excitation
+    >>> rep = check_excitation(np.sin(np.linspace(0, 4 * np.pi, 400)), [1.0, 0.5], [0.0, 0.3])
+    >>> rep.ok, rep.reversals, round(rep.to_json()["loop_width"], 12)
+    (True, 4, 0.2)
+    """
 
     input_range: float
     reversals: int
@@ -27,6 +50,19 @@ class ExcitationReport:
     messages: list[str]
 
     def to_json(self) -> dict:
+        """The report as a JSON-ready dict (field name to value).
+
+        Returns
+        -------
+        dict
+            The fields of the report.
+
+        Examples
+        --------
+        >>> from pimodel import check_excitation
+        >>> sorted(check_excitation([0.0, 1.0, 0.0]).to_json())[:3]
+        ['input_range', 'largest_radius_bound', 'loop_width']
+        """
         return asdict(self)
 
 
@@ -34,8 +70,43 @@ def check_excitation(v, weights=None, radii=None, *, threshold: float | None = N
                      warn: bool = True) -> ExcitationReport:
     """Check reversals and input range against the loop width of a (guessed) operator.
 
-    ``weights``/``radii``: a model or guess (e.g. from the loop slopes); without them only the
-    reversals are checked. Issues a ``UserWarning`` with the reason when ``ok`` is False.
+    Radius convergence needs reversals and an input range above ``2 r_n`` (Prop. 2); a range
+    below the loop width ``rho`` surely cannot excite every play (Lemma 2).
+
+    Parameters
+    ----------
+    v : array_like of float, shape (N,)
+        Input samples (input unit).
+    weights : array_like of float, optional
+        Weights of a model or guess (e.g. from the loop slopes). Without ``weights`` and
+        ``radii`` only the reversals are checked.
+    radii : array_like of float, optional
+        Radii of the model or guess (input unit), ascending.
+    threshold : float, optional
+        Reversal threshold (input unit; default 1 % of the input range).
+    warn : bool, optional
+        Issue a ``UserWarning`` with the reasons when ``ok`` is False.
+
+    Returns
+    -------
+    ExcitationReport
+        Range, reversals, loop width, the bound on ``r_n``, ``ok`` and the messages.
+
+    Warns
+    -----
+    UserWarning
+        When ``warn`` and the record cannot be expected to identify every play.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from pimodel import check_excitation
+    >>> v = 0.2 * np.sin(np.linspace(0, 4 * np.pi, 400))     # range 0.4 < 2 r_n = 0.6
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     rep = check_excitation(v, [1.0, 0.5], [0.0, 0.3])
+    >>> rep.ok
+    False
     """
     v = np.asarray(v, float)
     rng = float(np.ptp(v))

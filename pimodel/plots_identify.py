@@ -11,7 +11,45 @@ from .plotting import new_figure, save_figure
 
 
 def plot_identification(idn: Identification, t, v, y, out_dir, *, units=("V", "um")) -> list[Path]:
-    """Loop (measured vs model) and residual over time; returns the PNG paths."""
+    """Figures of an identification: loop (measured vs model), residual, branch fit.
+
+    Writes ``identify_<method>.png`` (loop and residual over time) and, when the
+    identification has a slope fit, ``identify_slopes.png`` (the branch shape and its
+    breakpoints).
+
+    Parameters
+    ----------
+    idn : Identification
+        The result of :func:`pimodel.identify`.
+    t : array_like of float, shape (N,)
+        Sample times [s].
+    v : array_like of float, shape (N,)
+        Input samples.
+    y : array_like of float, shape (N,)
+        Measured output samples.
+    out_dir : str or pathlib.Path
+        Folder for the PNG files (created if missing).
+    units : tuple of str, optional
+        Input and output units for the axis labels.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The PNG files written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pimodel import PIOperator, identify
+    >>> from pimodel.plots_identify import plot_identification
+    >>> from pimodel.signals import triangle
+    >>> t, v = triangle(1.0, 1.0, fs=1000.0, duration=3.0)
+    >>> y = PIOperator([1.0, 0.5], [0.0, 0.3]).simulate(v)
+    >>> idn = identify(v, y, dt=1e-3)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     [p.name for p in plot_identification(idn, t, v, y, tmp)]
+    ['identify_adaptive.png', 'identify_slopes.png']
+    """
     uv, uy = units
     yhat = idn.predict(v)
     fig, ax = new_figure(2, 1)

@@ -12,15 +12,59 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def new_figure(ncols: int = 1, nrows: int = 1, size=(6.4, 4.2)):
-    """A figure with ``nrows x ncols`` axes, sized per axis."""
+    """A figure with ``nrows x ncols`` axes, sized per axis.
+
+    Parameters
+    ----------
+    ncols : int, optional
+        Number of columns of axes.
+    nrows : int, optional
+        Number of rows of axes.
+    size : tuple of float, optional
+        Width and height of one axes [inch].
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        The figure.
+    axes : numpy.ndarray of matplotlib.axes.Axes, shape (nrows, ncols)
+        The axes, always two-dimensional.
+
+    Examples
+    --------
+    >>> from pimodel.plotting import new_figure
+    >>> fig, axes = new_figure(2, 1)
+    >>> axes.shape, fig.get_size_inches().round(1).tolist()
+    ((1, 2), [12.8, 4.2])
+    """
     fig, axes = plt.subplots(nrows, ncols, figsize=(size[0] * ncols, size[1] * nrows),
                              squeeze=False)
     return fig, axes
 
 
 def readability_problems(fig) -> list[str]:
-    """What keeps ``fig`` from being readable: axes with data but no x or y label, or with
-    several labelled curves and no legend."""
+    """What keeps ``fig`` from being readable.
+
+    Axes with data but no x or y label, or with several labelled curves and no legend.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure to check.
+
+    Returns
+    -------
+    list of str
+        One message per problem; empty when the figure is readable.
+
+    Examples
+    --------
+    >>> from pimodel.plotting import new_figure, readability_problems
+    >>> fig, ax = new_figure()
+    >>> _ = ax[0, 0].plot([0, 1], [0, 1])
+    >>> readability_problems(fig)
+    ['axes 0 (untitled): no x label', 'axes 0 (untitled): no y label']
+    """
     problems = []
     for i, ax in enumerate(fig.get_axes()):
         if not ax.get_visible() or not (ax.lines or ax.collections or ax.patches or ax.images):
@@ -38,8 +82,38 @@ def readability_problems(fig) -> list[str]:
 
 
 def save_figure(fig, path) -> Path:
-    """Save ``fig`` as PNG (150 dpi, tight) and close it; returns the path. Refuses (ValueError)
-    a figure with unlabelled axes or a missing legend (:func:`readability_problems`)."""
+    """Save ``fig`` as PNG (150 dpi, tight layout) and close it.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or pathlib.Path
+        Where to write it; missing parent folders are created.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    ValueError
+        If the figure has unlabelled axes or a missing legend
+        (:func:`readability_problems`); the figure is closed and nothing is written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from pimodel.plotting import new_figure, save_figure
+    >>> fig, ax = new_figure()
+    >>> _ = ax[0, 0].plot([0, 1], [0, 1])
+    >>> _ = ax[0, 0].set(xlabel="time t [s]", ylabel="y [um]")
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     save_figure(fig, Path(tmp) / "line.png").name
+    'line.png'
+    """
     path = Path(path)
     problems = readability_problems(fig)
     if problems:

@@ -20,7 +20,29 @@ from scipy.optimize import least_squares, lsq_linear
 
 @dataclass
 class SegmentedFit:
-    """A fitted continuous piecewise-linear function of ``m`` segments."""
+    """A fitted continuous piecewise-linear function of ``m`` segments (module docstring).
+
+    Parameters
+    ----------
+    slopes : numpy.ndarray of float, shape (m,)
+        Slopes ``s_1..s_m``, one per segment, ascending ``x``.
+    breakpoints : numpy.ndarray of float, shape (m - 1,)
+        Breakpoints ``b_1..b_{m-1}`` (``x`` units).
+    offsets : numpy.ndarray of float, shape (groups,)
+        Offset ``c_b`` of each group.
+    sse : float
+        Sum of squared residuals.
+    n_points : int
+        Number of points fitted.
+
+    Examples
+    --------
+    >>> from pimodel.segmented import fit_segmented
+    >>> x = np.linspace(0.0, 2.0, 201)
+    >>> fit = fit_segmented(x, x + np.maximum(0.0, x - 1.0), segments=2)
+    >>> fit.segments, fit.slopes.round(6), fit.breakpoints.round(6)
+    (2, array([1., 2.]), array([1.]))
+    """
 
     slopes: np.ndarray       # s_1..s_m, one per segment (ascending x)
     breakpoints: np.ndarray  # b_1..b_{m-1} (x units)
@@ -30,10 +52,32 @@ class SegmentedFit:
 
     @property
     def segments(self) -> int:
+        """Number of segments ``m``."""
         return self.slopes.size
 
     def bic(self, sse_floor: float = 0.0) -> float:
-        """BIC = N ln(SSE/N) + k ln N with k = 2m - 1 + groups (slopes, breakpoints, offsets)."""
+        """Bayesian information criterion of the fit.
+
+        ``BIC = N ln(SSE/N) + k ln N`` with ``k = 2m - 1 + groups`` (slopes, breakpoints,
+        offsets).
+
+        Parameters
+        ----------
+        sse_floor : float, optional
+            Lower bound on ``SSE/N`` (keeps the logarithm finite on exact fits).
+
+        Returns
+        -------
+        float
+            The BIC; lower is better.
+
+        Examples
+        --------
+        >>> from pimodel.segmented import SegmentedFit
+        >>> fit = SegmentedFit(np.array([1.0]), np.array([]), np.array([0.0]), 1.0, 100)
+        >>> round(fit.bic(), 6)     # 100 ln(0.01) + 2 ln(100)
+        -451.306678
+        """
         k = 2 * self.segments - 1 + self.offsets.size
         mse = max(self.sse / self.n_points, sse_floor)
         return float(self.n_points * np.log(mse) + k * np.log(self.n_points))
@@ -137,13 +181,53 @@ def _sweep_breakpoints(xb, yb, wb, bps, *, linear_term: bool = True, candidates:
 def fit_hinges(xb, yb, wb, hinges: int, *, linear_term: bool,
                start: np.ndarray | None = None, bins: int = 300, increasing: bool = True,
                linear_nonneg: bool = True):
-    """Weighted fit of ``Y(x) = c + [a_0 x] + sum_j a_j max(0, x - b_j)`` to binned data (mean x
-    ``xb``, mean Y ``yb``, weights ``wb``) with ``a_j >= 0`` for the hinges when ``increasing``
-    and ``a_0 >= 0`` when ``linear_nonneg`` (a PI operator's branch: ``a_j = p_j``,
-    ``b_j = 2 r_j``). Hinges from the dynamic programme (and from ``start`` when given: the
-    better of the two is kept), coordinate sweeps over a grid, then continuous least squares.
-    Returns ``(b, a, c, sse)``: hinges ascending, ``a`` (with ``a_0`` first when
-    ``linear_term``), offset and weighted SSE."""
+    """Weighted fit of ``Y(x) = c + [a_0 x] + sum_j a_j max(0, x - b_j)`` to binned data.
+
+    A PI operator's branch has this shape with ``a_j = p_j`` and ``b_j = 2 r_j``. The hinges
+    start from the dynamic programme (and from ``start`` when given: the better of the two is
+    kept), move by coordinate sweeps over a grid, and are refined by continuous least squares.
+
+    Parameters
+    ----------
+    xb : numpy.ndarray of float, shape (B,)
+        Mean ``x`` of each bin.
+    yb : numpy.ndarray of float, shape (B,)
+        Mean ``Y`` of each bin.
+    wb : numpy.ndarray of float, shape (B,)
+        Weight of each bin (e.g. its sample count).
+    hinges : int
+        Number of hinges ``b_j``.
+    linear_term : bool
+        Whether the model has the ``a_0 x`` term.
+    start : numpy.ndarray of float, optional
+        Hinge positions to start from as well (e.g. the previous estimate).
+    bins : int, optional
+        Bins of the dynamic programme.
+    increasing : bool, optional
+        Constrain the hinge coefficients ``a_j >= 0``.
+    linear_nonneg : bool, optional
+        Constrain ``a_0 >= 0``.
+
+    Returns
+    -------
+    b : numpy.ndarray of float, shape (hinges,)
+        Hinges, ascending.
+    a : numpy.ndarray of float
+        Coefficients, ``a_0`` first when ``linear_term``.
+    c : float
+        Offset.
+    sse : float
+        Weighted sum of squared residuals.
+
+    Examples
+    --------
+    >>> from pimodel.segmented import fit_hinges
+    >>> x = np.linspace(0.0, 4.0, 401)
+    >>> y = 0.5 + 1.0 * x + 0.5 * np.maximum(0.0, x - 1.0) + 0.25 * np.maximum(0.0, x - 3.0)
+    >>> b, a, c, sse = fit_hinges(x, y, np.ones_like(x), 2, linear_term=True)
+    >>> b.round(6), a.round(6), round(c, 6)
+    (array([1., 3.]), array([1.  , 0.5 , 0.25]), 0.5)
+    """
     sw = np.sqrt(wb)
     lead = 2 if linear_term else 1
     lb = np.full(lead + hinges, -np.inf)
@@ -180,10 +264,40 @@ def fit_hinges(xb, yb, wb, hinges: int, *, linear_term: bool,
 
 
 def fit_binned(xb, yb, wb, segments: int, increasing: bool = True, bins: int = 300):
-    """Continuous piecewise-linear fit of ``m = segments`` segments on binned data (bin mean x
-    ``xb``, mean Y ``yb``, weights ``wb``): :func:`fit_hinges` with a free first slope.
-    Returns ``(breakpoints, coef)`` with ``coef = (s_1, s_2 - s_1, ..., s_m - s_{m-1},
-    offset)``."""
+    """Continuous piecewise-linear fit of ``segments`` segments on binned data.
+
+    :func:`fit_hinges` with a free first slope and ``segments - 1`` hinges.
+
+    Parameters
+    ----------
+    xb : numpy.ndarray of float, shape (B,)
+        Mean ``x`` of each bin.
+    yb : numpy.ndarray of float, shape (B,)
+        Mean ``Y`` of each bin.
+    wb : numpy.ndarray of float, shape (B,)
+        Weight of each bin.
+    segments : int
+        Number of segments ``m >= 1``.
+    increasing : bool, optional
+        Constrain the slope increments ``>= 0``.
+    bins : int, optional
+        Bins of the dynamic programme.
+
+    Returns
+    -------
+    breakpoints : numpy.ndarray of float, shape (m - 1,)
+        Breakpoints, ascending.
+    coef : numpy.ndarray of float, shape (m + 1,)
+        ``(s_1, s_2 - s_1, ..., s_m - s_{m-1}, offset)``.
+
+    Examples
+    --------
+    >>> from pimodel.segmented import fit_binned
+    >>> x = np.linspace(0.0, 2.0, 201)
+    >>> b, coef = fit_binned(x, 1.0 + x + np.maximum(0.0, x - 1.0), np.ones_like(x), 2)
+    >>> b.round(6), coef.round(6)
+    (array([1.]), array([1., 1., 1.]))
+    """
     b, a, c, _ = fit_hinges(xb, yb, wb, segments - 1, linear_term=True, bins=bins,
                             increasing=increasing, linear_nonneg=False)
     return b, np.concatenate((a, [c]))
@@ -191,11 +305,47 @@ def fit_binned(xb, yb, wb, segments: int, increasing: bool = True, bins: int = 3
 
 def fit_segmented(x, Y, groups=None, *, segments: int, increasing: bool = True,
                   bins: int = 300, iterations: int = 3) -> SegmentedFit:
-    """Continuous piecewise-linear fit with ``segments`` segments (see module docstring).
+    """Continuous piecewise-linear fit with ``segments`` segments and an offset per group.
 
     The per-group offsets and the shared curve are fitted alternately (``iterations`` times):
     offsets start at each group's first samples; the curve is fitted on the offset-corrected
     data averaged into ``bins`` equal-width bins of x, which keeps the fit fast on long records.
+
+    Parameters
+    ----------
+    x : array_like of float, shape (N,)
+        Abscissae (e.g. input travel since the reversal), ``>= 0``.
+    Y : array_like of float, shape (N,)
+        Ordinates.
+    groups : array_like of int, shape (N,), optional
+        Group (branch) of each point, ``0..G-1``; one group when omitted.
+    segments : int
+        Number of segments ``m >= 1``.
+    increasing : bool, optional
+        Constrain the slope increments ``>= 0`` (convex curve).
+    bins : int, optional
+        Equal-width bins of ``x``.
+    iterations : int, optional
+        Rounds of offsets and curve.
+
+    Returns
+    -------
+    SegmentedFit
+        Slopes, breakpoints, offsets, SSE.
+
+    See Also
+    --------
+    polish_fit : refines the result on the unbinned data.
+
+    Examples
+    --------
+    >>> from pimodel.segmented import fit_segmented
+    >>> x = np.tile(np.linspace(0.0, 2.0, 101), 2)
+    >>> groups = np.repeat([0, 1], 101)
+    >>> Y = 2.0 * x + np.maximum(0.0, x - 0.5) + np.where(groups == 1, 3.0, 0.0)
+    >>> fit = fit_segmented(x, Y, groups, segments=2)
+    >>> fit.slopes.round(6), fit.offsets.round(6)
+    (array([2., 3.]), array([0., 3.]))
     """
     x = np.asarray(x, float)
     Y = np.asarray(Y, float)
@@ -215,8 +365,41 @@ def fit_segmented(x, Y, groups=None, *, segments: int, increasing: bool = True,
 
 def polish_fit(x, Y, groups, fit: SegmentedFit, *, increasing: bool = True,
                max_points: int = 100_000) -> SegmentedFit:
-    """Refine a binned fit's breakpoints and slopes on the unbinned data (offsets held), then
-    re-estimate the offsets. Removes the small bias that binning leaves near breakpoints."""
+    """Refine a binned fit on the unbinned data.
+
+    The breakpoints and slopes are refined with the offsets held, then the offsets are
+    re-estimated; this removes the small bias that binning leaves near breakpoints.
+
+    Parameters
+    ----------
+    x : array_like of float, shape (N,)
+        Abscissae.
+    Y : array_like of float, shape (N,)
+        Ordinates.
+    groups : array_like of int, shape (N,)
+        Group of each point, as given to :func:`fit_segmented`.
+    fit : SegmentedFit
+        The fit to refine.
+    increasing : bool, optional
+        Constrain the slope increments ``>= 0``.
+    max_points : int, optional
+        The breakpoints are refined on at most this many evenly spaced points.
+
+    Returns
+    -------
+    SegmentedFit
+        The refined fit.
+
+    Examples
+    --------
+    >>> from pimodel.segmented import fit_segmented, polish_fit
+    >>> x = np.linspace(0.0, 2.0, 2001)
+    >>> Y = x + np.maximum(0.0, x - 0.7321)
+    >>> groups = np.zeros(x.size, dtype=int)
+    >>> fit = polish_fit(x, Y, groups, fit_segmented(x, Y, groups, segments=2, bins=20))
+    >>> fit.breakpoints.round(3)
+    array([0.732])
+    """
     x = np.asarray(x, float)
     Y = np.asarray(Y, float)
     groups = np.asarray(groups, dtype=int)

@@ -23,7 +23,39 @@ from .segmented import SegmentedFit, fit_segmented, polish_fit
 
 @dataclass
 class SlopeIdentification:
-    """Result of :func:`identify_slopes` (weights in output/input units, radii in input units)."""
+    """Result of :func:`identify_slopes`.
+
+    Parameters
+    ----------
+    n_plays : int
+        Number of plays.
+    weights : numpy.ndarray of float, shape (n_plays,)
+        Weights ``p_i`` (output unit per input unit), from the slope increments.
+    radii_guess : numpy.ndarray of float, shape (n_plays,)
+        Radii ``r_i`` (input unit), half the breakpoints: a starting point for the estimator.
+    linear_play : bool
+        Whether the first play has ``r_1 = 0``.
+    slopes : numpy.ndarray of float, shape (m,)
+        The branch fit's slopes ``s_1..s_m``.
+    breakpoints : numpy.ndarray of float, shape (m - 1,)
+        The branch fit's breakpoints (input travel).
+    rms : float
+        RMS of the branch fit residual (output unit).
+    r2 : float
+        Coefficient of determination of the branch fit.
+    bic : dict of int to float, optional
+        BIC of each number of segments tried.
+    branches_used : int, optional
+        Number of branches pooled in the fit.
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator, identify_slopes
+    >>> v = np.sin(np.linspace(0, 6 * np.pi, 3000))
+    >>> s = identify_slopes(v, PIOperator([1.0, 0.5], [0.0, 0.3]).simulate(v), max_segments=3)
+    >>> s.n_plays, s.linear_play, s.to_json()["criterion"][:3]
+    (2, True, 'BIC')
+    """
 
     n_plays: int
     weights: np.ndarray
@@ -37,6 +69,24 @@ class SlopeIdentification:
     branches_used: int = 0
 
     def to_json(self) -> dict:
+        """The result as JSON-ready built-in types.
+
+        Returns
+        -------
+        dict
+            ``n_plays``, ``weights``, ``radii_guess``, ``linear_play``, ``slopes``,
+            ``breakpoints``, ``fit_rms``, ``fit_r2``, ``bic`` (keys as strings),
+            ``branches_used`` and the ``criterion`` used.
+
+        Examples
+        --------
+        >>> import json
+        >>> from pimodel import PIOperator, identify_slopes
+        >>> v = np.sin(np.linspace(0, 6 * np.pi, 3000))
+        >>> s = identify_slopes(v, PIOperator([1.0], [0.0]).simulate(v), max_segments=2)
+        >>> json.loads(json.dumps(s.to_json()))["n_plays"]
+        1
+        """
         return {
             "n_plays": self.n_plays,
             "weights": self.weights.tolist(),
@@ -77,9 +127,33 @@ def _pool_branches(v, y, threshold, min_travel_fraction, max_points):
 
 def plays_from_slopes(slopes: np.ndarray, breakpoints: np.ndarray, *,
                       linear_play: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Weights and radii from a branch fit's slopes ``s_1..s_m`` and breakpoints ``b_1..b_{m-1}``
-    (Lemma 1): with a linear play ``p = (s_1, s_2 - s_1, ...)``, ``r = (0, b_1/2, ...)``;
-    without one the first segment is flat and ``p = (s_2 - s_1, ...)``, ``r = (b_1/2, ...)``."""
+    """Weights and radii from a branch fit's slopes and breakpoints (Lemma 1).
+
+    With a linear play ``p = (s_1, s_2 - s_1, ...)`` and ``r = (0, b_1/2, ...)``; without one
+    the first segment is flat and ``p = (s_2 - s_1, ...)``, ``r = (b_1/2, ...)``.
+
+    Parameters
+    ----------
+    slopes : numpy.ndarray of float, shape (m,)
+        Slopes ``s_1..s_m`` of the branch (output unit per input unit), ascending travel.
+    breakpoints : numpy.ndarray of float, shape (m - 1,)
+        Breakpoints ``b_1..b_{m-1}`` (input travel, ``2 r_j``).
+    linear_play : bool
+        Whether the first segment is a play with ``r_1 = 0`` (else it is flat).
+
+    Returns
+    -------
+    weights : numpy.ndarray of float
+        ``p_i``; ``m`` of them with a linear play, ``m - 1`` without.
+    radii : numpy.ndarray of float
+        ``r_i``, same length.
+
+    Examples
+    --------
+    >>> from pimodel.slopes import plays_from_slopes
+    >>> plays_from_slopes(np.array([1.0, 1.5]), np.array([0.6]), linear_play=True)
+    (array([1. , 0.5]), array([0. , 0.3]))
+    """
     if linear_play:
         return np.diff(np.concatenate(([0.0], slopes))), np.concatenate(([0.0], breakpoints / 2))
     return np.diff(slopes), breakpoints / 2
@@ -91,11 +165,54 @@ def identify_slopes(v, y, *, max_segments: int = 8, n_plays: int | None = None,
                     ) -> SlopeIdentification:
     """Number of plays, weights and radius guesses from a record's loop slopes.
 
-    ``v``, ``y``: input and output samples (at least one full reversal). ``n_plays`` fixes the
-    number of plays instead of choosing it by BIC; ``linear_play`` forces the presence (True) or
-    absence (False) of a play with ``r_1 = 0`` (default: present when the smallest slope exceeds
-    5 % of the largest). ``threshold``: reversal threshold (default 1 % of the input range).
-    Branches shorter than ``min_travel_fraction`` of the longest are ignored (minor loops).
+    The branches that start at a reversal are pooled (module docstring) and fitted with
+    ``m = 1..max_segments`` segments; ``m`` is chosen by BIC unless ``n_plays`` is given.
+
+    Parameters
+    ----------
+    v : array_like of float, shape (N,)
+        Input samples (input unit), with at least one full reversal; ``N >= 10``.
+    y : array_like of float, shape (N,)
+        Output samples (output unit).
+    max_segments : int, optional
+        Largest number of segments tried, ``>= 1``.
+    n_plays : int, optional
+        Fix the number of plays instead of choosing it by BIC.
+    linear_play : bool, optional
+        Force the presence (True) or absence (False) of a play with ``r_1 = 0``. Default:
+        present when the smallest slope exceeds 5 % of the largest.
+    threshold : float, optional
+        Reversal threshold (input unit; default 1 % of the input range).
+    min_travel_fraction : float, optional
+        Branches that travel less than this fraction of the longest are ignored (minor loops).
+    max_points : int, optional
+        The pooled branches are subsampled evenly to at most this many points.
+
+    Returns
+    -------
+    SlopeIdentification
+        Number of plays, weights, radius guesses, the fit and its BIC table.
+
+    Raises
+    ------
+    ValueError
+        If ``v`` or ``y`` is not a finite signal of at least 10 samples, their lengths differ,
+        the input is constant or has no reversal, the output is constant or does not increase
+        with the input, or ``max_segments`` or ``n_plays`` is below 1.
+
+    Warns
+    -----
+    UserWarning
+        When segments with no slope change were merged.
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator, identify_slopes
+    >>> v = np.sin(np.linspace(0, 6 * np.pi, 6000))
+    >>> y = PIOperator([1.0, 0.5, 0.25], [0.0, 0.2, 0.5]).simulate(v)
+    >>> s = identify_slopes(v, y, max_segments=4)
+    >>> s.n_plays, s.weights.round(4), s.radii_guess.round(4)
+    (3, array([1.  , 0.5 , 0.25]), array([0. , 0.2, 0.5]))
     """
     v = as_signal(v, "v", min_length=10)
     y = as_signal(y, "y", min_length=10)
