@@ -58,6 +58,8 @@ STRICT_MODULES = [
     "pimodel.plotting",
     "pimodel.plots_identify",
     "pimodel.branches",
+    "pimodel.blocks",
+    "pimodel.describing",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the

@@ -51,6 +51,7 @@ pimodel.signals            test inputs: sinusoid, triangle, minor loops, stairca
 pimodel.blocks             python-control blocks: PI, inverse, estimator, PID
 pimodel.simulation         simulate a python-control system from its initial states
 pimodel.actuators          stage dynamics: mode, creep, delay (discretised)
+pimodel.describing         describing function, sector, circle criterion, limit cycles
 pimodel.loops              compiled loops: feedforward, adaptive inverse, PID
 pimodel.long_records       long noisy records made in chunks
 pimodel.diagnosis          sim-to-real gap diagnosis: where, which effect, how far

@@ -1,5 +1,5 @@
-"""python-control blocks: discrete-time ``NonlinearIOSystem``s for the PI operator, its exact
-inverse, the radius estimator, the adaptive inverse compensator and a PID controller.
+"""python-control blocks: discrete-time ``NonlinearIOSystem`` objects for the PI operator, its
+exact inverse, the radius estimator, the adaptive inverse compensator and a PID controller.
 
 Each block is a self-sufficient python-control system:
 
@@ -58,7 +58,20 @@ _native.lib.pim_adaptive_inverse_step.argtypes = [ctypes.c_size_t, _native.F64, 
 
 class InitialStateWarning(UserWarning):
     """A block is simulated from a state that is not its own initial state (typically
-    python-control's default of zeros); pass ``initial_state=initial_state(sys)``."""
+    python-control's default of zeros); pass ``initial_state=initial_state(sys)``.
+
+    Examples
+    --------
+    >>> import warnings, control
+    >>> from pimodel import PIOperator
+    >>> pb = pi_block(PIOperator([1.0, 0.5], [0.0, 0.3], initial_state=0.7), 1e-3)
+    >>> t = np.arange(3) * 1e-3
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = control.input_output_response(pb, t, 0 * t)   # X0 = 0 is not the block's state
+    >>> any(issubclass(w.category, InitialStateWarning) for w in caught)
+    True
+    """
 
 
 class _Block(control.NonlinearIOSystem):

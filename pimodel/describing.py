@@ -212,7 +212,19 @@ class PIDescribingFunction(control.DescribingFunctionNonlinearity):
         return self.operator.step(float(np.squeeze(x)))
 
     def reset(self) -> None:
-        """Return the streaming state to the operator's initial state."""
+        """Return the streaming state to the operator's initial state.
+
+        Returns
+        -------
+        None
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> F = PIOperator([1.0, 0.5], [0.0, 0.2]).describing_function()
+        >>> F(1.0), F.reset(), F(1.0)
+        (1.4, None, 1.4)
+        """
         self.operator.reset()
 
     def _isstatic(self) -> bool:
@@ -236,6 +248,13 @@ class PIDescribingFunction(control.DescribingFunctionNonlinearity):
         ------
         ValueError
             If an amplitude is negative or not finite.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> F = PIOperator([1.0, 0.5], [0.0, 0.2]).describing_function()
+        >>> F.describing_function([0.1, 1.0]).round(4)
+        array([1.    +0.j    , 1.4288-0.1019j])
         """
         a = _amplitudes(A)
         op = self.operator
@@ -245,11 +264,40 @@ class PIDescribingFunction(control.DescribingFunctionNonlinearity):
         return complex(n) if n.ndim == 0 else n
 
     def sector(self) -> tuple[float, float]:
-        """Incremental-gain sector, see :func:`sector`."""
+        """Incremental-gain sector, see :func:`sector`.
+
+        Returns
+        -------
+        (float, float)
+            ``(k_min, k_max)``, the smallest and largest loop-branch slope.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> PIOperator([1.0, 0.5], [0.0, 0.2]).describing_function().sector()
+        (1.0, 1.5)
+        """
         return sector(self.operator)
 
     def static_gain(self, A):
-        """Static (chord) gain at amplitude ``A``, see :func:`static_gain`."""
+        """Static (chord) gain at amplitude ``A``, see :func:`static_gain`.
+
+        Parameters
+        ----------
+        A : float or array_like
+            Amplitudes ``A > 0`` (input units).
+
+        Returns
+        -------
+        float or ndarray
+            ``phi(A) / A`` (output per input unit).
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> float(PIOperator([1.0, 0.5], [0.0, 0.2]).describing_function().static_gain(1.0))
+        1.4
+        """
         return static_gain(self.operator, A)
 
     def __repr__(self) -> str:
@@ -304,7 +352,7 @@ def _closed_loop_stable(L, gain: float) -> bool:
 class CircleCriterion:
     """Result of :func:`circle_criterion`.
 
-    Attributes
+    Parameters
     ----------
     holds : bool
         True when the criterion proves the loop free of limit cycles.
@@ -317,6 +365,13 @@ class CircleCriterion:
         Frequency [rad/s] of that minimum.
     stable_at_a : bool
         Whether the linear loop closed with the gain ``a`` is stable.
+
+    Examples
+    --------
+    >>> import control
+    >>> res = circle_criterion(control.tf([1.0], [1.0, 1.0, 0.0]), (0.5, 1.5))
+    >>> res.holds, res.sector, res.stable_at_a
+    (True, (0.5, 1.5), True)
     """
 
     holds: bool
@@ -380,7 +435,7 @@ def circle_criterion(L, sector_bounds: tuple[float, float], *, omega=None) -> Ci
 class LimitCycle:
     """A solution of the harmonic balance ``1 + N(A) L(j omega) = 0``.
 
-    Attributes
+    Parameters
     ----------
     amplitude : float
         Amplitude ``A`` of the nonlinearity's input (input units).
@@ -392,6 +447,12 @@ class LimitCycle:
         growth.
     residual : float
         ``|1 + N(A) L(j omega)|`` at the solution.
+
+    Examples
+    --------
+    >>> cycle = LimitCycle(amplitude=0.5, omega=2 * np.pi * 1000, stable=True, residual=0.0)
+    >>> round(cycle.frequency_hz, 6)
+    1000.0
     """
 
     amplitude: float
