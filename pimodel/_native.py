@@ -110,10 +110,11 @@ lib.pim_gpi_run.argtypes = [c_size, c_size, F64, F64, F64, c_int, F64, c_int, F6
 lib.pim_play_solve.restype = c_double
 lib.pim_play_solve.argtypes = [c_size, F64, F64, F64, c_double]
 lib.pim_rdpi_run.restype = None
-lib.pim_rdpi_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, F64, F64, F64, F64]
+lib.pim_rdpi_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64, F64,
+                             F64, F64]
 lib.pim_rdpi_inverse_run.restype = c_int
-lib.pim_rdpi_inverse_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, F64, F64,
-                                     F64, F64]
+lib.pim_rdpi_inverse_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64,
+                                     F64, F64, F64]
 lib.pim_creep_run.restype = None
 lib.pim_creep_run.argtypes = [c_size, c_size, F64, F64, F64, F64, F64]
 lib.pim_creep_inverse_run.restype = None
@@ -135,19 +136,20 @@ def gpi_run(p: np.ndarray, r: np.ndarray, z: np.ndarray, kind_in: int, c_in: np.
     return y, int(bad)
 
 
-def rdpi_run(p: np.ndarray, alpha: np.ndarray, beta: float, Ts: float, z: np.ndarray,
-             hist: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Rate-dependent PI run; ``z`` (n) and ``hist`` (v[k-1], v[k-2]) updated in place."""
+def rdpi_run(p: np.ndarray, alpha: np.ndarray, beta: float, lam: float, Ts: float,
+             z: np.ndarray, hist: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rate-dependent PI run; ``z`` (n) and ``hist`` (v[k-1], rate[k]) updated in place."""
     y = np.empty(v.shape[0])
-    lib.pim_rdpi_run(v.shape[0], p.shape[0], p, alpha, beta, Ts, z, hist, v, y)
+    lib.pim_rdpi_run(v.shape[0], p.shape[0], p, alpha, beta, lam, Ts, z, hist, v, y)
     return y
 
 
-def rdpi_inverse_run(p: np.ndarray, alpha: np.ndarray, beta: float, Ts: float, z: np.ndarray,
-                     hist: np.ndarray, yd: np.ndarray) -> np.ndarray:
+def rdpi_inverse_run(p: np.ndarray, alpha: np.ndarray, beta: float, lam: float, Ts: float,
+                     z: np.ndarray, hist: np.ndarray, yd: np.ndarray) -> np.ndarray:
     """Exact inverse of the rate-dependent PI; the forward state ``z``, ``hist`` advances."""
     v = np.empty(yd.shape[0])
-    if lib.pim_rdpi_inverse_run(yd.shape[0], p.shape[0], p, alpha, beta, Ts, z, hist, yd, v):
+    if lib.pim_rdpi_inverse_run(yd.shape[0], p.shape[0], p, alpha, beta, lam, Ts, z, hist, yd,
+                                v):
         raise ValueError(f"rate-dependent inverse: at most 64 plays, got {p.shape[0]}")
     return v
 

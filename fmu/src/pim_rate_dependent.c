@@ -55,47 +55,41 @@ double pim_play_solve(size_t n, const double *p, const double *r, double *z, dou
     return v;
 }
 
-static void rate_radii(size_t n, const double *alpha, double beta, double Ts, const double *hist,
-                       double *r)
+/* hist = (v[k-1], rate[k]) -> (v[k], rate[k+1]) */
+static void rate_update(double *hist, double v, double lam, double Ts)
 {
-    const double scale = 1.0 + beta * fabs(hist[0] - hist[1]) / Ts;
-    for (size_t i = 0; i < n; ++i) r[i] = alpha[i] * scale;
+    hist[1] = lam * hist[1] + (1.0 - lam) * fabs(v - hist[0]) / Ts;
+    hist[0] = v;
 }
 
 void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
-                  double Ts, double *z, double *hist, const double *v, double *y)
+                  double lam, double Ts, double *z, double *hist, const double *v, double *y)
 {
-    double rl[PIM_MAX_PLAYS];
     for (size_t k = 0; k < N; ++k) {
-        if (n <= PIM_MAX_PLAYS) {
-            rate_radii(n, alpha, beta, Ts, hist, rl);
-            y[k] = pim_pi_step(n, p, rl, z, v[k]);
-        } else { /* radii computed per play, no scratch array */
-            const double scale = 1.0 + beta * fabs(hist[0] - hist[1]) / Ts;
-            double acc = 0.0;
-            for (size_t i = 0; i < n; ++i) {
-                const double ri = alpha[i] * scale;
-                double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
-                z[i] = zi > v[k] - ri ? zi : v[k] - ri;
-                acc += p[i] * z[i];
-            }
-            y[k] = acc;
+        const double scale = 1.0 + beta * hist[1];
+        double acc = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            const double ri = alpha[i] * scale;
+            double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
+            z[i] = zi > v[k] - ri ? zi : v[k] - ri;
+            acc += p[i] * z[i];
         }
-        hist[1] = hist[0];
-        hist[0] = v[k];
+        y[k] = acc;
+        rate_update(hist, v[k], lam, Ts);
     }
 }
 
 int pim_rdpi_inverse_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
-                         double Ts, double *z, double *hist, const double *yd, double *v)
+                         double lam, double Ts, double *z, double *hist, const double *yd,
+                         double *v)
 {
     double rl[PIM_MAX_PLAYS];
     if (n > PIM_MAX_PLAYS) return -1;
     for (size_t k = 0; k < N; ++k) {
-        rate_radii(n, alpha, beta, Ts, hist, rl);
+        const double scale = 1.0 + beta * hist[1];
+        for (size_t i = 0; i < n; ++i) rl[i] = alpha[i] * scale;
         v[k] = pim_play_solve(n, p, rl, z, yd[k]);
-        hist[1] = hist[0];
-        hist[0] = v[k];
+        rate_update(hist, v[k], lam, Ts);
     }
     return 0;
 }

@@ -4,13 +4,14 @@
  *
  * Discrete-time semantics, input v[k] (input unit) sampled every Ts seconds:
  *
- *     rate[k] = |v[k-1] - v[k-2]| / Ts            input unit / s (the rate of the last interval)
+ *     rate[k] = lam rate[k-1] + (1 - lam) |v[k-1] - v[k-2]| / Ts     input unit / s
  *     r_i[k]  = alpha_i (1 + beta rate[k])        beta in s per input unit
  *     z_i[k]  = max(v[k] - r_i[k], min(v[k] + r_i[k], z_i[k-1]))
  *     y[k]    = sum_i p_i z_i[k]
  *
- * v[-1] and v[-2] come from the state (hist[0] = v[k-1], hist[1] = v[k-2]).  The rate is the
- * one of the previous sample interval, so the radii at step k are fixed before v[k] is known:
+ * lam = exp(-Ts / tau) in [0, 1) filters the rate (lam = 0: the rate of the last interval).
+ * The state holds hist[0] = v[k-1] and hist[1] = rate[k].  The rate uses the inputs before
+ * v[k] only, so the radii at step k are fixed before v[k] is known:
  * y[k] is then a continuous, non-decreasing, piecewise-linear function of v[k] (slope
  * sum of p_i over the plays on their envelope), strictly increasing when alpha_1 = 0 and
  * p_1 > 0.  That makes the inverse exact: pim_rdpi_inverse_run solves that function for v[k]
@@ -37,7 +38,7 @@ PIM_API double pim_play_solve(size_t n, const double *p, const double *r, double
 
 /* Forward run (semantics above); z (n) and hist (2) are updated in place. */
 PIM_API void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
-                          double Ts, double *z, double *hist, const double *v, double *y);
+                          double lam, double Ts, double *z, double *hist, const double *v, double *y);
 
 /*
  * Exact inverse run: v[k] such that the forward operator with state (z, hist) outputs yd[k];
@@ -45,7 +46,7 @@ PIM_API void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alp
  * -1 when n > PIM_MAX_PLAYS.
  */
 PIM_API int pim_rdpi_inverse_run(size_t N, size_t n, const double *p, const double *alpha,
-                                 double beta, double Ts, double *z, double *hist,
+                                 double beta, double lam, double Ts, double *z, double *hist,
                                  const double *yd, double *v);
 
 #ifdef __cplusplus
