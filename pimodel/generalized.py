@@ -134,9 +134,9 @@ class GeneralizedPI:
                                  self.output_envelope.coefficients, x)
         if bad:
             k = bad - 1
-            raise ValueError(f"v: sample {k} ({float(x[k])!r}) leaves the domain of an envelope "
-                             f"of {self!r} (input {self.input_envelope!r} or output "
-                             f"{self.output_envelope!r})")
+            raise ValueError(f"v: sample {k} ({float(x[k])!r}) leaves the domain of the input "
+                             f"envelope {self.input_envelope!r} or, through the play sum, of the "
+                             f"output envelope {self.output_envelope!r}")
         return y
 
     def _state(self, value) -> np.ndarray:

@@ -1,0 +1,78 @@
+"""Bad input to the generalized, rate-dependent and creep operators gives clear errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pimodel.creep import CreepOperator
+from pimodel.envelopes import Envelope
+from pimodel.generalized import GeneralizedPI
+from pimodel.rate_dependent import RateDependentPI
+
+
+@pytest.mark.parametrize(
+    ("kind", "coefficients", "match"),
+    [
+        ("cubic", (0, 1, 0), "kind: expected one of"),
+        ("tanh", (1, 1, 0), "coefficients: expected 4 values, got 3"),
+        ("tanh", (-1, 1, 0, 0), "c0 \\(tanh amplitude\\) must be > 0"),
+        ("tanh", (1, 0, 0, 0), "c1 \\(tanh input gain\\) must be > 0"),
+        ("poly2", (0, 0, 0), "c1 must be > 0 when c2 == 0"),
+        ("poly2", (0, np.nan, 0), "coefficients: sample 1 is nan"),
+    ],
+)
+def test_bad_envelopes(kind, coefficients, match):
+    with pytest.raises(ValueError, match=match):
+        Envelope(kind, coefficients)
+
+
+def test_envelope_domain_errors_name_the_sample():
+    with pytest.raises(ValueError, match="x: sample 2 is 30.0, outside the domain"):
+        Envelope.poly2(0, 1, -0.02)([0.0, 1.0, 30.0])
+    with pytest.raises(ValueError, match="x: sample 0 is 2.5, outside the domain"):
+        Envelope.tanh(2, 1).inverse()([2.5])
+
+
+def test_generalized_errors():
+    op = GeneralizedPI([1.0, 0.5], [0.0, 0.2], input_envelope=Envelope.poly2(0, 1, -0.05))
+    with pytest.raises(ValueError, match="v: sample 1 \\(20.0\\) leaves the domain"):
+        op.simulate([0.0, 20.0])
+    with pytest.raises(ValueError, match="v: sample 0 is nan"):
+        op.simulate([np.nan])
+    with pytest.raises(TypeError, match="input_envelope: expected a pimodel.envelopes.Envelope"):
+        GeneralizedPI([1.0], [0.0], input_envelope=np.tanh)
+    with pytest.raises(ValueError, match="radii: radius 1 is -0.1"):
+        GeneralizedPI([1.0, 1.0], [0.0, -0.1])
+    with pytest.raises(ValueError, match="smallest radius is 0.1"):
+        GeneralizedPI([1.0], [0.1]).inverse()
+    inv = GeneralizedPI([1.0], [0.0], output_envelope=Envelope.tanh(1.0, 1.0)).inverse()
+    with pytest.raises(ValueError, match="v: sample 0 \\(1.5\\) leaves the domain"):
+        inv.simulate([1.5])  # beyond the saturation level: no input reaches it
+
+
+def test_rate_dependent_errors():
+    with pytest.raises(ValueError, match="rate_gain: expected a finite number >= 0"):
+        RateDependentPI([1.0], [0.0], rate_gain=-1.0, dt=1e-3)
+    with pytest.raises(ValueError, match="dt: expected a finite number > 0"):
+        RateDependentPI([1.0], [0.0], rate_gain=1.0, dt=0)
+    with pytest.raises(ValueError, match="rate_time_constant: expected a finite number >= 0"):
+        RateDependentPI([1.0], [0.0], rate_gain=1.0, dt=1e-3, rate_time_constant=np.inf)
+    with pytest.raises(ValueError, match="smallest base radius is 0.2"):
+        RateDependentPI([1.0], [0.2], rate_gain=1.0, dt=1e-3).inverse()
+    op = RateDependentPI([1.0, 1.0], [0.0, 0.3], rate_gain=1e-3, dt=1e-3)
+    with pytest.raises(ValueError, match="state: expected 4 finite values"):
+        op.state = [0.0, 0.0]
+    with pytest.raises(ValueError, match="y_d: sample 1 is inf"):
+        op.inverse().simulate([0.0, np.inf])
+
+
+def test_creep_errors():
+    with pytest.raises(ValueError, match="time_constants: tau\\[2\\] is 0.0"):
+        CreepOperator([0.1, 0.1], [1.0, 0.0], dt=1e-3)
+    with pytest.raises(ValueError, match="time_constants: expected 2 values, got 1"):
+        CreepOperator([0.1, 0.1], [1.0], dt=1e-3)
+    with pytest.raises(ValueError, match=r"zero of modulus 1\.5.*\(not minimum phase\)"):
+        CreepOperator([3.0], [1e-4], dt=1e-4)
+    with pytest.raises(ValueError, match="initial_state: expected a scalar or 2 values"):
+        CreepOperator([0.1, 0.1], [1.0, 2.0], dt=1e-3, initial_state=[1, 2, 3])
