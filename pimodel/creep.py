@@ -93,9 +93,10 @@ class CreepOperator:
                 decades: int = 4, initial_state=0.0) -> CreepOperator:
         """Lags that approximate the log law ``y(t) = h (1 + gamma log10(t / t_min))``.
 
-        One lag per decade, ``tau_j = t_min 10^j`` (j = 0..decades), each with gain ``gamma``
-        (``gamma = percent_per_decade / 100``): a step then creeps by about ``gamma h`` per
-        decade between ``t_min`` and ``t_min 10^decades``.
+        One lag per decade, ``tau_j = t_min 10^j`` (j = 0..decades-1), each with gain
+        ``gamma = percent_per_decade / 100``: a step of height h then creeps by about
+        ``gamma h`` per decade between ``t_min`` and ``t_min 10^decades`` (the convention of
+        :func:`pimodel.actuators.creep_per_decade`, discretised with a zero-order hold).
 
         Parameters
         ----------
@@ -115,7 +116,9 @@ class CreepOperator:
         CreepOperator
         """
         gamma = positive_scalar(percent_per_decade, "percent_per_decade") / 100.0
-        tau = positive_scalar(t_min, "t_min") * 10.0 ** np.arange(int(decades) + 1)
+        if int(decades) < 1:
+            raise ValueError(f"decades: expected an integer >= 1, got {decades!r}")
+        tau = positive_scalar(t_min, "t_min") * 10.0 ** np.arange(int(decades))
         return cls(np.full(tau.size, gamma), tau, dt=dt, initial_state=initial_state)
 
     # -- parameters ---------------------------------------------------------------------

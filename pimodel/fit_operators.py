@@ -1,0 +1,366 @@
+"""Identification of the generalized, rate-dependent and creep operators from records.
+
+- :func:`fit_generalized`: weights of a PI operator on a fixed radius grid between a ``tanh``
+  (or affine) input envelope and a quadratic output envelope, all fitted together by bounded
+  nonlinear least squares (``scipy.optimize.least_squares``) from a non-negative least-squares
+  start. The loop shapes (branch curvature, saturation, asymmetry) fix the envelopes.
+- :func:`fit_rate_dependent`: records at several rates; weights by non-negative least squares
+  on a base-radius grid, the rate gain ``beta`` and the grid scale by a bounded search.
+- :func:`fit_creep`: lag gains by non-negative least squares on a log grid of time constants,
+  from the creep input ``u`` (the hysteresis output, e.g. a PI model's) and the measurement;
+  steps with holds excite it best.
+
+Every fit scores the samples after the input has reached both its maximum and its minimum
+(from then on a rate-independent operator's state no longer depends on its initial state);
+the models start with every play at the first input (a relaxed state). Errors are in the output
+unit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares, minimize_scalar, nnls
+
+from .checks import as_signal, integer_in, positive_scalar
+from .creep import CreepOperator
+from .envelopes import Envelope
+from .generalized import GeneralizedPI
+from .operator import PIOperator, TimeDependentPI
+from .rate_dependent import RateDependentPI
+
+__all__ = ["OperatorFit", "fit_creep", "fit_generalized", "fit_rate_dependent"]
+
+
+@dataclass(frozen=True)
+class OperatorFit:
+    """Result of an identification.
+
+    Attributes
+    ----------
+    model : GeneralizedPI, RateDependentPI or CreepOperator
+        The identified operator.
+    rms, max_error : float
+        Residual on the scored samples (output unit).
+    y_range : float
+        Peak-to-peak of the measured output over the scored samples.
+    settings : dict
+        Fit settings and by-products (grid, rate sensitivity, ...).
+    """
+
+    model: object
+    rms: float
+    max_error: float
+    y_range: float
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def relative_rms(self) -> float:
+        """``rms / y_range``."""
+        return self.rms / self.y_range if self.y_range > 0 else float("nan")
+
+
+def _record(v, y, name: str = "") -> tuple[np.ndarray, np.ndarray]:
+    v = as_signal(v, f"v{name}", min_length=10)
+    y = as_signal(y, f"y{name}", min_length=10)
+    if v.size != y.size:
+        raise ValueError(f"v{name} and y{name}: expected equal lengths, got {v.size} and "
+                         f"{y.size}")
+    if np.ptp(v) == 0:
+        raise ValueError(f"v{name}: the input is constant; identification needs a varying input")
+    return v, y
+
+
+def _scored(v: np.ndarray) -> int:
+    """First sample after the input has reached both its extremes."""
+    return int(max(np.argmax(v), np.argmin(v)))
+
+
+def _stats(pred: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
+    e = pred - y
+    return float(np.sqrt(np.mean(e**2))), float(np.max(np.abs(e))), float(np.ptp(y))
+
+
+# -- generalized -----------------------------------------------------------------------------
+
+def _input_envelope(kind: str, theta: np.ndarray, mid: float, half: float) -> Envelope:
+    if kind == "identity":
+        return Envelope.affine(1.0 / half, -mid / half)
+    b1, b2 = np.exp(theta[0]), theta[1]
+    return Envelope.tanh(1.0, b1 / half, b2 - b1 * mid / half, 0.0)
+
+
+def fit_generalized(v, y, *, n_plays: int = 8, input_envelope: str = "tanh",
+                    output_envelope: str = "poly2") -> OperatorFit:
+    """Fit a :class:`~pimodel.generalized.GeneralizedPI` to one record ``(v[k], y[k])``.
+
+    The input is normalised to ``[-1, 1]`` (``vn = (v - mid) / half``); the input envelope is
+    ``h(v) = tanh(b1 vn + b2)`` (or ``vn``), the radii are the grid
+    ``r_i = (i - 1) / n * ptp(h(v)) / 2`` (``r_1 = 0``: invertible), the output envelope
+    ``g(w) = c0 + w + c2 w^2`` (or ``c0 + w``). Weights ``p_i >= 0`` (``p_1 > 0``), ``b1``,
+    ``b2``, ``c0``, ``c2`` minimise the squared output error on the scored samples.
+
+    Parameters
+    ----------
+    v, y : array_like
+        Input and measured output, same length (at least 10 samples).
+    n_plays : int
+        Plays on the radius grid (2..64).
+    input_envelope : {"tanh", "identity"}
+    output_envelope : {"poly2", "identity"}
+
+    Returns
+    -------
+    OperatorFit
+        ``model`` is a GeneralizedPI with ``r_1 = 0`` (so ``model.inverse()`` exists).
+
+    Raises
+    ------
+    ValueError
+        Bad record or settings, or an output envelope that is not increasing over the
+        record's range.
+
+    Examples
+    --------
+    >>> from pimodel.envelopes import Envelope
+    >>> v = 2 * np.sin(np.linspace(0, 30, 3000))
+    >>> truth = GeneralizedPI([1.0, 0.4, 0.3], [0.0, 0.3, 0.8],
+    ...                       output_envelope=Envelope.poly2(0.0, 1.0, 0.05))
+    >>> fit = fit_generalized(v, truth.simulate(v), input_envelope="identity")
+    >>> fit.relative_rms < 0.01
+    True
+    """
+    v, y = _record(v, y)
+    n = integer_in(n_plays, "n_plays", 2, 64)
+    if input_envelope not in ("tanh", "identity"):
+        raise ValueError(f"input_envelope: expected 'tanh' or 'identity', got {input_envelope!r}")
+    if output_envelope not in ("poly2", "identity"):
+        raise ValueError(f"output_envelope: expected 'poly2' or 'identity', got "
+                         f"{output_envelope!r}")
+    mid, half = 0.5 * (v.max() + v.min()), 0.5 * np.ptp(v)
+    k0 = _scored(v)
+    ys = y[k0:]
+    yscale = max(float(np.ptp(ys)), 1e-300)
+    n_h = 2 if input_envelope == "tanh" else 0
+    use_c2 = output_envelope == "poly2"
+
+    def plays(theta_h):
+        h = _input_envelope(input_envelope, theta_h, mid, half)
+        u = h.reference(v)
+        r = np.arange(n) / n * 0.5 * np.ptp(u)
+        F = PIOperator(np.ones(n), r, initial_state=u[0]).play_outputs(u)
+        return h, r, F
+
+    def predict(x):
+        _, r, F = plays(x[:n_h])
+        p = x[n_h:n_h + n]
+        c0 = x[n_h + n]
+        c2 = x[n_h + n + 1] / yscale if use_c2 else 0.0
+        w = F[k0:] @ p
+        return c0 + w + c2 * w * w
+
+    # start: nearly linear input envelope, output offset, non-negative weights
+    theta0 = np.array([np.log(0.5), 0.0])[:n_h]
+    _, _, F0 = plays(theta0)
+    A = np.column_stack((F0[k0:], np.ones(ys.size), -np.ones(ys.size)))
+    sol, _ = nnls(A, ys)
+    p0 = np.maximum(sol[:n], 1e-9 * max(sol[:n].max(), 1e-300))
+    x0 = np.concatenate((theta0, p0, [sol[n] - sol[n + 1]], [0.0] if use_c2 else []))
+    lo = np.concatenate(([np.log(1e-3), -3.0][:n_h], np.full(n, 0.0), [-np.inf],
+                         [-0.45] if use_c2 else []))
+    hi = np.concatenate(([np.log(20.0), 3.0][:n_h], np.full(n, np.inf), [np.inf],
+                         [0.45] if use_c2 else []))
+    lo[n_h] = 1e-6 * p0.sum()  # p_1 > 0: the linear play keeps the model invertible
+    x0 = np.clip(x0, lo, hi)
+    res = least_squares(lambda x: (predict(x) - ys) / yscale, x0, bounds=(lo, hi),
+                        x_scale="jac", max_nfev=200 * (x0.size + 1))
+    x = res.x
+    h, r, F = plays(x[:n_h])
+    p, c0 = x[n_h:n_h + n], float(x[n_h + n])
+    c2 = float(x[n_h + n + 1]) / yscale if use_c2 else 0.0
+    keep = p > 1e-9 * p.sum()
+    keep[0] = True
+    g = Envelope.poly2(c0, 1.0, c2)
+    model = GeneralizedPI(p[keep], r[keep], input_envelope=h, output_envelope=g,
+                          initial_state=float(h.reference(v[:1])[0]))
+    try:
+        pred = model.simulate(v)
+    except ValueError as err:
+        raise ValueError(f"fit_generalized: the fitted output envelope is not increasing over "
+                         f"the record ({err})") from None
+    rms, mx, rng = _stats(pred[k0:], ys)
+    return OperatorFit(model, rms, mx, rng, {"n_plays": n, "input_envelope": input_envelope,
+                                             "output_envelope": output_envelope,
+                                             "scored_from": k0, "nfev": int(res.nfev)})
+
+
+# -- rate-dependent --------------------------------------------------------------------------
+
+def _rates(v: np.ndarray, dt: float, lam: float) -> np.ndarray:
+    """``rate[k]`` of :mod:`pimodel.rate_dependent` (``v[-1] = v[0]``, ``rate[0] = 0``)."""
+    d = np.abs(np.diff(v, prepend=v[0])) / dt  # d[k] = |v[k] - v[k-1]|
+    rate = np.empty(v.size)
+    acc = 0.0
+    for k in range(v.size):
+        rate[k] = acc
+        acc = lam * acc + (1 - lam) * d[k]
+    return rate
+
+
+def fit_rate_dependent(records: Sequence[tuple], *, dt: float, n_plays: int = 8,
+                       rate_time_constant: float = 0.0,
+                       max_rate_gain: float | None = None) -> OperatorFit:
+    """Fit a :class:`~pimodel.rate_dependent.RateDependentPI` to records at several rates.
+
+    Base radii on the grid ``alpha_i = (i - 1) / n * s * ptp(v) / 2`` (``alpha_1 = 0``);
+    for each ``(s, beta)`` the weights ``p_i >= 0`` come from one non-negative least-squares
+    problem over all records (time-dependent plays with radii ``alpha_i (1 + beta rate[k])``);
+    ``beta`` is found by a bounded scalar search on ``log beta`` (and ``beta = 0`` is tried),
+    for a few grid scales ``s``.
+
+    Parameters
+    ----------
+    records : sequence of (v, y)
+        Records sampled every ``dt``, ideally periodic inputs at different rates.
+    dt : float
+        Sample time [s].
+    n_plays : int
+        Plays on the grid (2..64).
+    rate_time_constant : float
+        Rate filter of the model (:class:`~pimodel.rate_dependent.RateDependentPI`).
+    max_rate_gain : float, optional
+        Upper bound of ``beta`` [s per input unit]; default ``100 / max rate``.
+
+    Returns
+    -------
+    OperatorFit
+        ``settings["rate_sensitivity"]`` is the model's rounding-error gain (below 1: the
+        inverse is numerically exact).
+
+    Raises
+    ------
+    ValueError
+        No records, bad records or settings.
+
+    Examples
+    --------
+    >>> t = np.arange(4000) * 1e-3
+    >>> truth = RateDependentPI([1.0, 0.5, 0.3], [0.0, 0.2, 0.5], rate_gain=0.02, dt=1e-3)
+    >>> recs = [(np.sin(2 * np.pi * f * t), None) for f in (1.0, 5.0)]
+    >>> recs = [(v, truth.simulate(v)) for v, _ in recs]
+    >>> fit_rate_dependent(recs, dt=1e-3, n_plays=6).relative_rms < 0.01
+    True
+    """
+    if len(records) == 0:
+        raise ValueError("records: expected at least one (v, y) record")
+    recs = [_record(v, y, f"[{i}]") for i, (v, y) in enumerate(records)]
+    dt = positive_scalar(dt, "dt")
+    n = integer_in(n_plays, "n_plays", 2, 64)
+    tau = float(rate_time_constant)
+    if not np.isfinite(tau) or tau < 0:
+        raise ValueError(f"rate_time_constant: expected a finite number >= 0, got {tau!r}")
+    lam = float(np.exp(-dt / tau)) if tau > 0 else 0.0
+    span = max(np.ptp(v) for v, _ in recs)
+    rates = [_rates(v, dt, lam) for v, _ in recs]
+    top_rate = max(float(r.max()) for r in rates) or 1.0
+    beta_max = 100.0 / top_rate if max_rate_gain is None else positive_scalar(
+        max_rate_gain, "max_rate_gain")
+    starts = [_scored(v) for v, _ in recs]
+    target = np.concatenate([y[k0:] for (_, y), k0 in zip(recs, starts, strict=True)])
+
+    def solve(scale: float, beta: float):
+        alpha = np.arange(n) / n * scale * span / 2
+        F = np.vstack([
+            TimeDependentPI(np.ones(n)).simulate(v, alpha[None, :] * (1 + beta * rt)[:, None],
+                                                 initial_state=v[0], return_plays=True)[1][k0:]
+            for (v, _), rt, k0 in zip(recs, rates, starts, strict=True)])
+        p, _ = nnls(F, target)
+        return float(np.sum((F @ p - target) ** 2)), alpha, p
+
+    best = None
+    for scale in (0.5, 0.8, 1.0):
+        cost0 = solve(scale, 0.0)
+        res = minimize_scalar(lambda lb, s=scale: solve(s, float(np.exp(lb)))[0],
+                              bounds=(np.log(beta_max * 1e-6), np.log(beta_max)),
+                              method="bounded", options={"xatol": 1e-3})
+        for beta, cost in ((0.0, cost0[0]), (float(np.exp(res.x)), float(res.fun))):
+            if best is None or cost < best[0]:
+                best = (cost, scale, beta)
+    _, scale, beta = best
+    _, alpha, p = solve(scale, beta)
+    p = np.maximum(p, 0.0)
+    p[0] = max(p[0], 1e-9 * p.sum())  # keep the linear play: invertible
+    keep = p > 1e-9 * p.sum()
+    keep[0] = True
+    model = RateDependentPI(p[keep], alpha[keep], rate_gain=beta, dt=dt,
+                            rate_time_constant=tau)
+    preds, ys = [], []
+    for (v, y), k0 in zip(recs, starts, strict=True):
+        state = np.concatenate((np.full(model.n, v[0]), [v[0], 0.0]))
+        preds.append(model.simulate(v, state=state)[k0:])
+        ys.append(y[k0:])
+    rms, mx, rng = _stats(np.concatenate(preds), np.concatenate(ys))
+    return OperatorFit(model, rms, mx, rng, {"n_plays": n, "grid_scale": scale,
+                                             "rate_sensitivity": model.rate_sensitivity,
+                                             "scored_from": starts})
+
+
+# -- creep -----------------------------------------------------------------------------------
+
+def fit_creep(u, y, *, dt: float, time_constants=None) -> OperatorFit:
+    """Fit a :class:`~pimodel.creep.CreepOperator` ``y = G[u]`` with non-negative lag gains.
+
+    ``y - u = sum_i c_i x_i[u]`` is linear in ``c`` for fixed time constants (lags started at
+    rest at ``u[0]``), solved by non-negative least squares. ``u`` is the creep's input: the
+    hysteresis output (e.g. ``PIOperator.simulate(v)`` of an identified model); steps with long
+    holds show the creep best.
+
+    Parameters
+    ----------
+    u, y : array_like
+        Creep input and measured output (same unit), sampled every ``dt``.
+    dt : float
+        Sample time [s].
+    time_constants : array_like, optional
+        Lag time constants [s]; default one per decade from ``10 dt`` to a third of the record.
+
+    Returns
+    -------
+    OperatorFit
+        Lags with zero gain are dropped (at least one kept).
+
+    Raises
+    ------
+    ValueError
+        Bad record or time constants.
+
+    Examples
+    --------
+    >>> cr = CreepOperator([0.03, 0.02], [0.01, 0.1], dt=1e-3)
+    >>> u = np.repeat([0.0, 1.0, -0.5, 0.8], 500)
+    >>> fit = fit_creep(u, cr.simulate(u), dt=1e-3, time_constants=[0.01, 0.1, 1.0])
+    >>> np.round(fit.model.gains, 6).tolist()
+    [0.03, 0.02]
+    """
+    u, y = _record(u, y)
+    dt = positive_scalar(dt, "dt")
+    if time_constants is None:
+        lo = np.ceil(np.log10(10 * dt))
+        hi = np.floor(np.log10(u.size * dt / 3))
+        if hi < lo:
+            raise ValueError(f"u: the record ({u.size} samples) is too short for creep lags "
+                             f"above 10 dt; give time_constants")
+        tau = 10.0 ** np.arange(lo, hi + 1)
+    else:
+        tau = np.sort(as_signal(time_constants, "time_constants"))
+    X = np.column_stack([CreepOperator([1.0], [ti], dt=dt, initial_state=u[0]).simulate(u) - u
+                         for ti in tau])
+    c, _ = nnls(X, y - u)
+    keep = c > 1e-9 * max(float(c.max()), 1e-300)
+    if not keep.any():
+        keep[np.argmax(tau)] = True
+    model = CreepOperator(c[keep], tau[keep], dt=dt, initial_state=u[0])
+    rms, mx, rng = _stats(model.simulate(u), y)
+    return OperatorFit(model, rms, mx, rng, {"time_constants": tau.tolist()})
