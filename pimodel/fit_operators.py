@@ -6,7 +6,8 @@
   start. The loop shapes (branch curvature, saturation, asymmetry) fix the envelopes.
 - :func:`fit_rate_dependent`: records at several rates; weights by non-negative least squares
   on a base-radius grid, the rate gain ``beta`` and the grid scale by a bounded search.
-- :func:`fit_creep`: lag gains by non-negative least squares on a log grid of time constants,
+- :func:`fit_creep`: lag gains by non-negative least squares on a grid of time constants (two
+  per decade),
   from the creep input ``u`` (the hysteresis output, e.g. a PI model's) and the measurement;
   steps with holds excite it best.
 
@@ -153,13 +154,43 @@ def fit_generalized(v, y, *, n_plays: int = 8, input_envelope: str = "tanh",
         F = PIOperator(np.ones(n), r, initial_state=u[0]).play_outputs(u)
         return h, r, F
 
+    cache: dict = {}
+
+    def play_block(theta_h):
+        key = tuple(theta_h)
+        if key not in cache:
+            cache.clear()
+            cache[key] = plays(theta_h)[2][k0:]
+        return cache[key]
+
     def predict(x):
-        _, r, F = plays(x[:n_h])
+        F = play_block(x[:n_h])
         p = x[n_h:n_h + n]
-        c0 = x[n_h + n]
         c2 = x[n_h + n + 1] / yscale if use_c2 else 0.0
-        w = F[k0:] @ p
-        return c0 + w + c2 * w * w
+        w = F @ p
+        return x[n_h + n] + w + c2 * w * w
+
+    def residual(x):
+        return (predict(x) - ys) / yscale
+
+    def jacobian(x):
+        """Analytic in weights, c0, c2; central differences in the envelope parameters."""
+        F = play_block(x[:n_h])
+        p = x[n_h:n_h + n]
+        c2 = x[n_h + n + 1] / yscale if use_c2 else 0.0
+        w = F @ p
+        J = np.empty((ys.size, x.size))
+        for j in range(n_h):
+            step = 1e-6 * max(1.0, abs(x[j]))
+            xp, xm = x.copy(), x.copy()
+            xp[j] += step
+            xm[j] -= step
+            J[:, j] = (predict(xp) - predict(xm)) / (2 * step)
+        J[:, n_h:n_h + n] = F * (1.0 + 2.0 * c2 * w)[:, None]
+        J[:, n_h + n] = 1.0
+        if use_c2:
+            J[:, n_h + n + 1] = w * w / yscale
+        return J / yscale
 
     # start: nearly linear input envelope, output offset, non-negative weights
     theta0 = np.array([np.log(0.5), 0.0])[:n_h]
@@ -174,8 +205,8 @@ def fit_generalized(v, y, *, n_plays: int = 8, input_envelope: str = "tanh",
                          [0.45] if use_c2 else []))
     lo[n_h] = 1e-6 * p0.sum()  # p_1 > 0: the linear play keeps the model invertible
     x0 = np.clip(x0, lo, hi)
-    res = least_squares(lambda x: (predict(x) - ys) / yscale, x0, bounds=(lo, hi),
-                        x_scale="jac", max_nfev=200 * (x0.size + 1))
+    res = least_squares(residual, x0, jac=jacobian, bounds=(lo, hi), x_scale="jac",
+                        max_nfev=50 * (x0.size + 1))
     x = res.x
     h, r, F = plays(x[:n_h])
     p, c0 = x[n_h:n_h + n], float(x[n_h + n])
@@ -324,7 +355,7 @@ def fit_creep(u, y, *, dt: float, time_constants=None) -> OperatorFit:
     dt : float
         Sample time [s].
     time_constants : array_like, optional
-        Lag time constants [s]; default one per decade from ``10 dt`` to a third of the record.
+        Lag time constants [s]; default two per decade from ``10 dt`` to the record length.
 
     Returns
     -------
@@ -347,12 +378,11 @@ def fit_creep(u, y, *, dt: float, time_constants=None) -> OperatorFit:
     u, y = _record(u, y)
     dt = positive_scalar(dt, "dt")
     if time_constants is None:
-        lo = np.ceil(np.log10(10 * dt))
-        hi = np.floor(np.log10(u.size * dt / 3))
+        lo, hi = np.log10(10 * dt), np.log10(u.size * dt)
         if hi < lo:
             raise ValueError(f"u: the record ({u.size} samples) is too short for creep lags "
                              f"above 10 dt; give time_constants")
-        tau = 10.0 ** np.arange(lo, hi + 1)
+        tau = 10.0 ** np.arange(lo, hi + 1e-9, 0.5)
     else:
         tau = np.sort(as_signal(time_constants, "time_constants"))
     X = np.column_stack([CreepOperator([1.0], [ti], dt=dt, initial_state=u[0]).simulate(u) - u
