@@ -11,24 +11,15 @@ machine are inflated; the ratios are what counts.
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
+from bench_operator import best_time  # the benchmarks folder is on sys.path when run
 
 from pimodel import PIOperator
 from pimodel.creep import CreepOperator
 from pimodel.envelopes import Envelope
 from pimodel.generalized import GeneralizedPI
 from pimodel.rate_dependent import RateDependentPI
-
-
-def best_time(fn, repeat: int = 3) -> float:
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def random_operators(rng, n: int = 8):
@@ -55,13 +46,13 @@ def main() -> None:
     v = 3 * np.sin(2 * np.pi * 5 * tt) * np.sin(2 * np.pi * 0.3 * tt) + rng.normal(0, 0.02, N)
     gpi, rdpi, creep = random_operators(rng)
     pi = PIOperator(gpi.weights, gpi.radii)
-    t_pi = best_time(lambda: pi.simulate(v))
+    t_pi = best_time(lambda: pi.simulate(v), repeat=3)
     rows = [("PIOperator (baseline)", t_pi)]
     for name, op in (("GeneralizedPI", gpi), ("RateDependentPI", rdpi), ("CreepOperator", creep)):
         y = op.simulate(v)
         inv = op.inverse()
-        rows.append((name, best_time(lambda op=op: op.simulate(v))))
-        rows.append(("  inverse", best_time(lambda inv=inv, y=y: inv.simulate(y))))
+        rows.append((name, best_time(lambda op=op: op.simulate(v), repeat=3)))
+        rows.append(("  inverse", best_time(lambda inv=inv, y=y: inv.simulate(y), repeat=3)))
     print(f"forward and inverse runs, n = 8 plays / 4 lags, N = {N:,} samples (best of 3)")
     print(f"{'operator':<26}{'time [s]':>10}{'ns/sample':>12}{'x PI':>8}")
     for name, t in rows:

@@ -14,19 +14,14 @@ from scipy.linalg import solve_triangular, toeplitz
 from scipy.optimize import brentq
 
 from .envelopes import Envelope
+from .reference import pi_reference, tdpi_reference
 
 
 def gpi_reference(v, weights, radii, input_envelope: Envelope, output_envelope: Envelope,
                   state=0.0) -> np.ndarray:
     """``y[k] = g(sum_i p_i z_i[k])``, ``z_i[k] = clamp(z_i[k-1], h(v[k]) -+ r_i)``."""
-    p, r = np.asarray(weights, float), np.asarray(radii, float)
-    z = np.broadcast_to(np.asarray(state, float), p.shape).copy()
     u = input_envelope.reference(np.asarray(v, float))
-    y = np.empty(len(u))
-    for k, uk in enumerate(u):
-        z = np.maximum(uk - r, np.minimum(uk + r, z))
-        y[k] = p @ z
-    return output_envelope.reference(y)
+    return output_envelope.reference(pi_reference(u, weights, radii, state))
 
 
 def _rates(v_prev: float, rate: float, lam: float, dt: float, v: np.ndarray) -> np.ndarray:
@@ -45,12 +40,7 @@ def rdpi_reference(v, weights, base_radii, rate_gain: float, dt: float, *, lam: 
     p, a = np.asarray(weights, float), np.asarray(base_radii, float)
     v = np.asarray(v, float)
     R = a[None, :] * (1 + rate_gain * _rates(v_prev, rate, lam, dt, v))[:, None]
-    z = np.broadcast_to(np.asarray(state, float), p.shape).copy()
-    y = np.empty(len(v))
-    for k, vk in enumerate(v):
-        z = np.maximum(vk - R[k], np.minimum(vk + R[k], z))
-        y[k] = p @ z
-    return y
+    return tdpi_reference(v, p, R, state)
 
 
 def rdpi_inverse_reference(y_d, weights, base_radii, rate_gain: float, dt: float, *,
