@@ -3,7 +3,8 @@
 
 #include <math.h>
 
-double pim_envelope(int kind, const double *c, double x)
+/* static so that the run loop inlines it (exported functions may be interposed under -fPIC) */
+static inline double envelope(int kind, const double *c, double x)
 {
     switch (kind) {
     case PIM_ENV_POLY2:
@@ -25,6 +26,8 @@ double pim_envelope(int kind, const double *c, double x)
         return NAN;
     }
 }
+
+double pim_envelope(int kind, const double *c, double x) { return envelope(kind, c, x); }
 
 const char *pim_envelope_check(int kind, const double *c)
 {
@@ -58,14 +61,19 @@ size_t pim_gpi_run(size_t N, size_t n, const double *p, const double *r, double 
     }
     size_t bad = 0;
     for (size_t k = 0; k < N; ++k) {
-        const double u = pim_envelope(kind_in, c_in, v[k]);
+        const double u = envelope(kind_in, c_in, v[k]);
         if (isnan(u)) {
             y[k] = NAN;
             bad = k + 1;
             break;
         }
-        const double w = pim_pi_step(n, p, r, zs, u);
-        y[k] = pim_envelope(kind_out, c_out, w);
+        double w = 0.0;
+        for (size_t i = 0; i < n; ++i) { /* play step, as pim_pi_step */
+            double zi = zs[i] < u + r[i] ? zs[i] : u + r[i];
+            zs[i] = zi > u - r[i] ? zi : u - r[i];
+            w += p[i] * zs[i];
+        }
+        y[k] = envelope(kind_out, c_out, w);
         if (isnan(y[k])) {
             bad = k + 1;
             break;
