@@ -63,14 +63,14 @@ class OperatorFit:
         return self.rms / self.y_range if self.y_range > 0 else float("nan")
 
 
-def _record(v, y, name: str = "") -> tuple[np.ndarray, np.ndarray]:
-    v = as_signal(v, f"v{name}", min_length=10)
-    y = as_signal(y, f"y{name}", min_length=10)
+def _record(v, y, name: str = "", *, input: str = "v") -> tuple[np.ndarray, np.ndarray]:
+    a, b = f"{input}{name}", f"y{name}"
+    v = as_signal(v, a, min_length=10)
+    y = as_signal(y, b, min_length=10)
     if v.size != y.size:
-        raise ValueError(f"v{name} and y{name}: expected equal lengths, got {v.size} and "
-                         f"{y.size}")
+        raise ValueError(f"{a} and {b}: expected equal lengths, got {v.size} and {y.size}")
     if np.ptp(v) == 0:
-        raise ValueError(f"v{name}: the input is constant; identification needs a varying input")
+        raise ValueError(f"{a}: the input is constant; identification needs a varying input")
     return v, y
 
 
@@ -375,13 +375,10 @@ def fit_creep(u, y, *, dt: float, time_constants=None) -> OperatorFit:
     >>> np.round(fit.model.gains, 6).tolist()
     [0.03, 0.02]
     """
-    u, y = _record(u, y)
+    u, y = _record(u, y, input="u")
     dt = positive_scalar(dt, "dt")
     if time_constants is None:
-        lo, hi = np.log10(10 * dt), np.log10(u.size * dt)
-        if hi < lo:
-            raise ValueError(f"u: the record ({u.size} samples) is too short for creep lags "
-                             f"above 10 dt; give time_constants")
+        lo, hi = np.log10(10 * dt), np.log10(u.size * dt)  # hi >= lo: at least 10 samples
         tau = 10.0 ** np.arange(lo, hi + 1e-9, 0.5)
     else:
         tau = np.sort(as_signal(time_constants, "time_constants"))

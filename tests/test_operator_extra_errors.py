@@ -76,3 +76,27 @@ def test_creep_errors():
         CreepOperator([3.0], [1e-4], dt=1e-4)
     with pytest.raises(ValueError, match="initial_state: expected a scalar or 2 values"):
         CreepOperator([0.1, 0.1], [1.0, 2.0], dt=1e-3, initial_state=[1, 2, 3])
+
+
+def test_fit_errors():
+    from pimodel.fit_operators import fit_creep, fit_generalized, fit_rate_dependent
+
+    v = np.sin(np.linspace(0, 10, 200))
+    with pytest.raises(ValueError, match="v and y: expected equal lengths, got 200 and 199"):
+        fit_generalized(v, v[:-1])
+    with pytest.raises(ValueError, match="v: the input is constant"):
+        fit_generalized(np.ones(50), np.ones(50))
+    with pytest.raises(ValueError, match="input_envelope: expected 'tanh' or 'identity'"):
+        fit_generalized(v, v, input_envelope="sigmoid")
+    with pytest.raises(ValueError, match="n_plays: expected an integer from 2 to 64"):
+        fit_generalized(v, v, n_plays=1)
+    with pytest.raises(ValueError, match="records: expected at least one"):
+        fit_rate_dependent([], dt=1e-3)
+    with pytest.raises(ValueError, match=r"y\[1\]: sample 3 is nan"):
+        bad = v.copy()
+        bad[3] = np.nan
+        fit_rate_dependent([(v, v), (v, bad)], dt=1e-3)
+    with pytest.raises(ValueError, match="u: expected at least 10 sample"):
+        fit_creep(v[:9], v[:9], dt=1e-3)
+    with pytest.raises(ValueError, match="time_constants: sample 0 is -1.0"):
+        fit_creep(v, v, dt=1e-3, time_constants=[-1.0])
