@@ -98,5 +98,5 @@ def test_fit_errors():
         fit_rate_dependent([(v, v), (v, bad)], dt=1e-3)
     with pytest.raises(ValueError, match="u: expected at least 10 sample"):
         fit_creep(v[:9], v[:9], dt=1e-3)
-    with pytest.raises(ValueError, match="time_constants: sample 0 is -1.0"):
+    with pytest.raises(ValueError, match=r"time_constants: tau\[1\] is -1.0; expected > 0"):
         fit_creep(v, v, dt=1e-3, time_constants=[-1.0])
