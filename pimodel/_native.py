@@ -161,3 +161,27 @@ def creep_run(a: np.ndarray, c: np.ndarray, x: np.ndarray, u: np.ndarray, *,
     fn = lib.pim_creep_inverse_run if inverse else lib.pim_creep_run
     fn(u.shape[0], a.shape[0], a, c, x, u, out)
     return out
+
+
+class AsymParams(ctypes.Structure):
+    """``pim_asym`` (fmu/src/pim_asymmetric.h): direct weight, envelopes and shape function."""
+
+    _fields_ = [("p0", c_double), ("al", c_double), ("dl", c_double), ("ar", c_double),
+                ("dr", c_double), ("kind", c_int), ("c", c_double * 4), ("kind_inv", c_int)]
+
+
+lib.pim_asym_run.restype = c_size
+lib.pim_asym_run.argtypes = [ctypes.POINTER(AsymParams), c_size, c_size, F64, F64, F64, F64, F64]
+lib.pim_asym_inverse_run.restype = c_size
+lib.pim_asym_inverse_run.argtypes = [ctypes.POINTER(AsymParams), c_size, c_size, F64, F64, F64,
+                                     F64, F64]
+
+
+def asym_run(a: AsymParams, p: np.ndarray, r: np.ndarray, z: np.ndarray, x: np.ndarray, *,
+             inverse: bool = False) -> tuple[np.ndarray, int]:
+    """Asymmetric generalized PI (or its inverse) over ``x``; ``z`` updated in place.
+    Returns ``(out, bad)``, ``bad`` = k + 1 of the first failing sample, else 0."""
+    out = np.empty(x.shape[0])
+    fn = lib.pim_asym_inverse_run if inverse else lib.pim_asym_run
+    bad = fn(ctypes.byref(a), x.shape[0], p.shape[0], p, r, z, x, out)
+    return out, int(bad)

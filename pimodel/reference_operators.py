@@ -89,3 +89,42 @@ def creep_inverse_reference(y, gains, time_constants, dt: float) -> np.ndarray:
     g = np.concatenate(([1.0], (c * (1 - a)) @ (a[:, None] ** (j[None, :] - 1))))
     T = toeplitz(g, np.zeros(len(y)))
     return solve_triangular(T, y, lower=True)
+
+
+def asym_reference(v, direct_weight: float, weights, radii, ascending, descending,
+                   shape: Envelope, state=0.0) -> np.ndarray:
+    """``y[k] = p0 s + sum p_i z_i``, ``z_i = max(a_l s + d_l - r_i, min(a_r s + d_r + r_i,
+    z_i))``, ``s = phi(v[k])``."""
+    p, r = np.asarray(weights, float), np.asarray(radii, float)
+    (al, dl), (ar, dr) = ascending, descending
+    z = np.broadcast_to(np.asarray(state, float), p.shape).copy()
+    s = shape.reference(np.asarray(v, float))
+    y = np.empty(len(s))
+    for k, sk in enumerate(s):
+        z = np.maximum(al * sk + dl - r, np.minimum(ar * sk + dr + r, z))
+        y[k] = direct_weight * sk + p @ z
+    return y
+
+
+def asym_inverse_reference(y_d, direct_weight: float, weights, radii, ascending, descending,
+                           shape: Envelope, state=0.0) -> np.ndarray:
+    """Inverse by bracketing (``brentq``) the step equation in ``s``, then ``phi^-1``."""
+    p, r = np.asarray(weights, float), np.asarray(radii, float)
+    (al, dl), (ar, dr) = ascending, descending
+    z = np.broadcast_to(np.asarray(state, float), p.shape).copy()
+    v = np.empty(len(y_d))
+    for k, yk in enumerate(np.asarray(y_d, float)):
+
+        def f(s, z=z, yk=yk):
+            return direct_weight * s + p @ np.maximum(al * s + dl - r,
+                                                      np.minimum(ar * s + dr + r, z)) - yk
+
+        lo, hi = -1.0, 1.0
+        while f(lo) > 0:
+            lo *= 2
+        while f(hi) < 0:
+            hi *= 2
+        sk = brentq(f, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=500)
+        z = np.maximum(al * sk + dl - r, np.minimum(ar * sk + dr + r, z))
+        v[k] = shape.inverse().reference(np.array([sk]))[0]
+    return v

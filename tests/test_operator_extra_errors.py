@@ -100,3 +100,22 @@ def test_fit_errors():
         fit_creep(v[:9], v[:9], dt=1e-3)
     with pytest.raises(ValueError, match=r"time_constants: tau\[1\] is -1.0; expected > 0"):
         fit_creep(v, v, dt=1e-3, time_constants=[-1.0])
+
+
+def test_asymmetric_errors():
+    from pimodel.asymmetric import AsymmetricPI
+
+    with pytest.raises(ValueError, match="direct_weight: expected a finite number > 0"):
+        AsymmetricPI(0.0, [1.0], [0.1])
+    with pytest.raises(ValueError, match="ascending slope a_l: expected a finite number > 0"):
+        AsymmetricPI(1.0, [1.0], [0.1], ascending=(-1.0, 0.0))
+    with pytest.raises(ValueError, match="descending: expected 2 values"):
+        AsymmetricPI(1.0, [1.0], [0.1], descending=(1.0,))
+    with pytest.raises(ValueError, match="weights: weight 2 is negative"):
+        AsymmetricPI(1.0, [1.0, -1.0], [0.1, 0.2])
+    with pytest.raises(TypeError, match="shape: expected a pimodel.envelopes.Envelope"):
+        AsymmetricPI(1.0, [1.0], [0.1], shape=np.tanh)
+    op = AsymmetricPI(1.0, [0.5], [0.1], shape=Envelope.tanh(1.0, 1.0))
+    # the output saturates at p0 + 0.5 (1 + 0.1) = 1.55: a larger y_d has no input
+    with pytest.raises(ValueError, match="y_d: sample 1 \\(2.0\\) has no input"):
+        op.inverse().simulate([0.0, 2.0])

@@ -214,3 +214,54 @@ def test_creep_step_creeps_monotonically_to_static_gain(cr, h):
 def test_creep_is_linear(cr, u, a):
     np.testing.assert_allclose(cr.simulate(a * u + 1.0), a * cr.simulate(u) + cr.simulate(
         np.ones_like(u)), atol=1e-9 * max(1.0, float(np.max(np.abs(u)))))
+
+
+# -- AsymmetricPI (distinct ascending/descending envelopes) ---------------------------------
+
+@st.composite
+def asymmetric(draw):
+    from pimodel.asymmetric import AsymmetricPI
+
+    p, r = draw(pi_parts(linear_play=False))
+    shape = draw(st.sampled_from([None, Envelope.tanh(3.0, 0.3, 0.2), Envelope.poly2(0, 1, 0.05)]))
+    env = st.tuples(st.floats(0.2, 3), st.floats(-1, 1))
+    return AsymmetricPI(draw(st.floats(0.02, 2)), p, r, ascending=draw(env),
+                        descending=draw(env), shape=shape,
+                        initial_state=draw(st.floats(-2, 2)))
+
+
+@given(asymmetric(), signals)
+def test_asymmetric_round_trip(op, v):
+    np.testing.assert_allclose(op.inverse().simulate(op.simulate(v)), v, rtol=0, atol=1e-9)
+
+
+@given(asymmetric(), signals)
+def test_asymmetric_monotone_and_rate_independent(op, v):
+    y = op.simulate(np.sort(v))
+    assert np.all(np.diff(y) >= -1e-12 * max(1.0, float(np.max(np.abs(y)))))
+    reps = np.arange(len(v)) % 3 + 1
+    np.testing.assert_allclose(op.simulate(np.repeat(v, reps)), np.repeat(op.simulate(v), reps),
+                               atol=1e-12)
+
+
+@given(asymmetric(), st.floats(1, V_MAX), st.floats(0.05, 0.95))
+def test_asymmetric_wiping_out(op, amp, frac_down):
+    low = amp - frac_down * 2 * amp
+    ramp = np.linspace(-amp, amp, 150)
+    minor = np.concatenate((np.linspace(amp, low, 40)[1:], np.linspace(low, amp, 40)[1:]))
+    after = np.linspace(amp, -amp, 150)[1:]
+    y1 = op.simulate(np.concatenate((ramp, minor, after)))
+    y2 = op.simulate(np.concatenate((ramp, after)))
+    np.testing.assert_allclose(y1[-len(after):], y2[-len(after):], atol=1e-9)
+
+
+@given(pi_parts(linear_play=False), st.floats(0.05, 2), signals)
+def test_asymmetric_with_equal_envelopes_is_generalized_pi(parts, p0, v):
+    from pimodel.asymmetric import AsymmetricPI
+
+    p, r = parts
+    shape = Envelope.tanh(2.0, 0.3)
+    asym = AsymmetricPI(p0, p, r, shape=shape)
+    gpi = GeneralizedPI(np.concatenate(([p0], p)), np.concatenate(([0.0], r)),
+                        input_envelope=shape)
+    np.testing.assert_allclose(asym.simulate(v), gpi.simulate(v), atol=1e-12)
