@@ -15,7 +15,8 @@ The blocks follow the contract of :mod:`pimodel.blocks`:
 - **Names**: vectors are 1-based (``z[1]..z[n]``, ``x[1]..x[m]``).
 
 Blocks: :func:`generalized_pi_block` (also the inverse, which is again a
-:class:`~pimodel.generalized.GeneralizedPI`), :func:`rate_dependent_pi_block`,
+:class:`~pimodel.generalized.GeneralizedPI`), :func:`asymmetric_pi_block` (forward or exact
+inverse), :func:`rate_dependent_pi_block`,
 :func:`rate_dependent_inverse_block`, :func:`creep_block` (forward or inverse).
 """
 
@@ -27,6 +28,7 @@ import control
 import numpy as np
 
 from . import _native
+from .asymmetric import AsymmetricPI
 from .checks import positive_scalar
 from .creep import CreepOperator
 from .envelopes import Envelope
@@ -34,6 +36,7 @@ from .generalized import GeneralizedPI
 from .rate_dependent import RateDependentPI
 
 __all__ = [
+    "asymmetric_pi_block",
     "block_initial_state",
     "creep_block",
     "generalized_pi_block",
@@ -236,6 +239,78 @@ def generalized_pi_block(op: GeneralizedPI, dt: float, *, name: str = "gpi", inp
                               "output_envelope": op.output_envelope}, build)
     return _make_block(settings, _gpi_step, n_states=n, labels=_labels("z", n), dt=dt,
                        name=name, input=input, output=output)
+
+
+# -- asymmetric generalized PI ---------------------------------------------------------------
+
+def asymmetric_pi_block(op: AsymmetricPI, dt: float, *, inverse: bool = False,
+                        name: str | None = None, input: str | None = None,
+                        output: str | None = None) -> control.NonlinearIOSystem:
+    """Asymmetric generalized PI operator (or, with ``inverse=True``, its exact inverse) as a
+    python-control block; semantics of :mod:`pimodel.asymmetric`.
+
+    Parameters
+    ----------
+    op : AsymmetricPI
+        The forward operator.
+    dt : float
+        Sample time [s].
+    inverse : bool
+        Build the feedforward ``y_d -> v`` (state: the forward play states).
+    name, input, output : str, optional
+        Defaults ``"asym"``, ``"v"``, ``"y"`` (inverse: ``"asym_inv"``, ``"y_d"``, ``"v"``).
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        States ``z[1]..z[n]`` (the forward play states after the previous sample).
+
+    Notes
+    -----
+    Params: ``"<name>.direct_weight"``, ``"<name>.weights"``, ``"<name>.radii"`` (n values),
+    ``"<name>.ascending"``, ``"<name>.descending"`` (``(a, d)`` each), ``"<name>.shape"``
+    (Envelope), ``"<name>.initial_state"`` (scalar or n).
+
+    Examples
+    --------
+    >>> import control, numpy as np
+    >>> op = AsymmetricPI(0.5, [1.0], [0.2], ascending=(1.0, 0.0), descending=(1.5, 0.1))
+    >>> blk = asymmetric_pi_block(op, 1e-3, inverse=True)
+    >>> yd = np.sin(np.linspace(0, 4, 40))
+    >>> res = control.input_output_response(blk, np.arange(40) * 1e-3, yd,
+    ...                                     initial_state=block_initial_state(blk))
+    >>> bool(np.allclose(op.simulate(res.outputs), yd, atol=1e-12))
+    True
+    """
+    if not isinstance(op, AsymmetricPI):
+        raise TypeError(f"op: expected an AsymmetricPI, got {type(op).__name__}")
+    dt = positive_scalar(dt, "dt")
+    name = name or ("asym_inv" if inverse else "asym")
+    input = input or ("y_d" if inverse else "v")
+    output = output or ("v" if inverse else "y")
+    n = op.n
+
+    def build(s: dict) -> AsymmetricPI:
+        new = AsymmetricPI(s["direct_weight"], s["weights"], s["radii"],
+                           ascending=s["ascending"], descending=s["descending"],
+                           shape=s["shape"], initial_state=s["initial_state"])
+        if new.n != n or not np.array_equal(new.radii, np.asarray(s["radii"], float)):
+            raise ValueError(f"radii: expected {n} non-decreasing radii (they fix the states)")
+        return new
+
+    def step(o: AsymmetricPI, x: np.ndarray, u: float):
+        out, bad = _native.asym_run(o._c, o.weights, o.radii, x, np.array([u]),
+                                    inverse=inverse)
+        if bad:
+            raise ValueError(f"{input}: sample {u!r} is outside the range of {o.shape!r}")
+        return float(out[0]), x
+
+    settings = _Params(name, {"direct_weight": op.direct_weight, "weights": op.weights.copy(),
+                              "radii": op.radii.copy(), "ascending": op.ascending,
+                              "descending": op.descending, "shape": op.shape,
+                              "initial_state": op.initial_state.copy()}, build)
+    return _make_block(settings, step, n_states=n, labels=_labels("z", n), dt=dt, name=name,
+                       input=input, output=output)
 
 
 # -- rate-dependent PI -----------------------------------------------------------------------

@@ -8,7 +8,9 @@ import control
 import numpy as np
 import pytest
 
+from pimodel.asymmetric import AsymmetricPI
 from pimodel.blocks_extra import (
+    asymmetric_pi_block,
     block_initial_state,
     creep_block,
     generalized_pi_block,
@@ -28,6 +30,8 @@ GPI = GeneralizedPI([1.0, 0.5, 0.3], [0.0, 0.2, 0.6], input_envelope=Envelope.ta
                     output_envelope=Envelope.poly2(0.1, 1.0, 0.05), initial_state=0.2)
 RDPI = RateDependentPI([1.0, 0.5, 0.3], [0.0, 0.2, 0.6], rate_gain=2e-4, dt=DT,
                        rate_time_constant=2e-3, initial_state=0.1, initial_input=0.05)
+ASYM = AsymmetricPI(0.4, [1.0, 0.5], [0.1, 0.4], ascending=(1.0, 0.0), descending=(1.4, 0.2),
+                    shape=Envelope.tanh(3, 0.3), initial_state=0.1)
 CREEP = CreepOperator([0.03, 0.02], [0.01, 0.2], dt=DT, initial_state=0.3)
 
 
@@ -43,6 +47,8 @@ def _response(sys, u, params=None):
     (generalized_pi_block(GPI.inverse(), DT, name="inv", input="y_d", output="v"),
      GPI.inverse()),
     (rate_dependent_pi_block(RDPI), RDPI),
+    (asymmetric_pi_block(ASYM, DT), ASYM),
+    (asymmetric_pi_block(ASYM, DT, inverse=True), ASYM.inverse()),
     (creep_block(CREEP), CREEP),
     (creep_block(CREEP.inverse()), CREEP.inverse()),
 ])
