@@ -4,6 +4,9 @@
   (or affine) input envelope and a quadratic output envelope, all fitted together by bounded
   nonlinear least squares (``scipy.optimize.least_squares``) from a non-negative least-squares
   start. The loop shapes (branch curvature, saturation, asymmetry) fix the envelopes.
+- :func:`fit_asymmetric`: distinct ascending/descending envelopes (``gamma_r = a_r phi + d_r``
+  against ``gamma_l = phi``) and the shape ``phi`` by least squares, weights and the direct term
+  by non-negative least squares inside (variable projection).
 - :func:`fit_rate_dependent`: records at several rates; weights by non-negative least squares
   on a base-radius grid, the rate gain ``beta`` and the grid scale by a bounded search.
 - :func:`fit_creep`: lag gains by non-negative least squares on a grid of time constants (two
@@ -25,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar, nnls
 
+from .asymmetric import AsymmetricPI
 from .checks import as_signal, integer_in, positive_scalar
 from .creep import CreepOperator
 from .envelopes import Envelope
@@ -32,7 +36,8 @@ from .generalized import GeneralizedPI
 from .operator import PIOperator, TimeDependentPI
 from .rate_dependent import RateDependentPI
 
-__all__ = ["OperatorFit", "fit_creep", "fit_generalized", "fit_rate_dependent"]
+__all__ = ["OperatorFit", "fit_asymmetric", "fit_creep", "fit_generalized",
+           "fit_rate_dependent"]
 
 
 @dataclass(frozen=True)
@@ -225,6 +230,91 @@ def fit_generalized(v, y, *, n_plays: int = 8, input_envelope: str = "tanh",
     return OperatorFit(model, rms, mx, rng, {"n_plays": n, "input_envelope": input_envelope,
                                              "output_envelope": output_envelope,
                                              "scored_from": k0, "nfev": int(res.nfev)})
+
+
+# -- asymmetric ------------------------------------------------------------------------------
+
+def fit_asymmetric(v, y, *, n_plays: int = 8, shape: str = "tanh") -> OperatorFit:
+    """Fit an :class:`~pimodel.asymmetric.AsymmetricPI` to one record ``(v[k], y[k])``.
+
+    ``phi(v) = tanh(b1 vn + b2)`` (or ``vn``) with ``vn = (v - mid) / half``; ascending envelope
+    ``gamma_l = phi``, descending ``gamma_r = a_r phi + d_r``; radii on the grid
+    ``r_i = (i - 1) / n * ptp(phi(v)) / 2``. For each ``(a_r, d_r, b1, b2)`` the direct weight,
+    the play weights (all >= 0) and an output offset come from non-negative least squares on
+    the scored samples; ``scipy.optimize.least_squares`` adjusts the envelope parameters. The
+    offset is moved into both envelopes (``d += offset / sum p_i``).
+
+    Parameters
+    ----------
+    v, y : array_like
+        Input and measured output (at least 10 samples).
+    n_plays : int
+        Plays on the grid (2..64).
+    shape : {"tanh", "identity"}
+
+    Returns
+    -------
+    OperatorFit
+        ``model`` has an exact inverse (``model.inverse()``).
+
+    Raises
+    ------
+    ValueError
+        Bad record or settings, or a fit in which every play weight is zero.
+
+    Examples
+    --------
+    >>> truth = AsymmetricPI(0.3, [1.0, 0.5], [0.0, 0.4], ascending=(1.0, 0.0),
+    ...                      descending=(1.3, 0.1))
+    >>> v = 2 * np.sin(np.linspace(0, 30, 3000))
+    >>> fit_asymmetric(v, truth.simulate(v), shape="identity").relative_rms < 0.01
+    True
+    """
+    v, y = _record(v, y)
+    n = integer_in(n_plays, "n_plays", 2, 64)
+    if shape not in ("tanh", "identity"):
+        raise ValueError(f"shape: expected 'tanh' or 'identity', got {shape!r}")
+    mid, half = 0.5 * (v.max() + v.min()), 0.5 * np.ptp(v)
+    k0 = _scored(v)
+    ys = y[k0:]
+    yscale = max(float(np.ptp(ys)), 1e-300)
+    n_s = 2 if shape == "tanh" else 0
+
+    def parts(theta):
+        phi = _input_envelope(shape, theta[2:], mid, half)
+        s = phi.reference(v)
+        r = np.arange(n) / n * 0.5 * np.ptp(s)
+        asc, desc = (1.0, 0.0), (float(np.exp(theta[0])), float(theta[1]))
+        z0 = 0.5 * (s[0] + desc[0] * s[0] + desc[1])
+        cols = [AsymmetricPI(1.0, [1.0], [ri], ascending=asc, descending=desc, shape=phi,
+                             initial_state=z0).simulate(v) - s for ri in r]
+        A = np.column_stack([s] + cols + [np.ones(v.size), -np.ones(v.size)])[k0:]
+        x, _ = nnls(A, ys)
+        return phi, r, asc, desc, z0, A, x
+
+    def residual(theta):
+        A, x = parts(theta)[5:]
+        return (A @ x - ys) / yscale
+
+    theta0 = np.concatenate(([0.0, 0.0], [np.log(0.5), 0.0][:n_s]))
+    lo = np.concatenate(([np.log(0.2), -0.5], [np.log(1e-3), -3.0][:n_s]))
+    hi = np.concatenate(([np.log(5.0), 0.5], [np.log(20.0), 3.0][:n_s]))
+    res = least_squares(residual, theta0, bounds=(lo, hi), diff_step=1e-6,
+                        max_nfev=40 * (theta0.size + 1))
+    phi, r, asc, desc, z0, _, x = parts(res.x)
+    p0, p, offset = float(x[0]), x[1:n + 1], float(x[n + 1] - x[n + 2])
+    if p.sum() <= 0:
+        raise ValueError("fit_asymmetric: every play weight is zero; the record shows no "
+                         "hysteresis to fit")
+    delta = offset / p.sum()
+    keep = p > 1e-9 * p.sum()
+    model = AsymmetricPI(max(p0, 1e-9 * p.sum()), p[keep], r[keep],
+                         ascending=(asc[0], asc[1] + delta),
+                         descending=(desc[0], desc[1] + delta), shape=phi,
+                         initial_state=z0 + delta)
+    rms, mx, rng = _stats(model.simulate(v)[k0:], ys)
+    return OperatorFit(model, rms, mx, rng, {"n_plays": n, "shape": shape, "scored_from": k0,
+                                             "nfev": int(res.nfev)})
 
 
 # -- rate-dependent --------------------------------------------------------------------------
