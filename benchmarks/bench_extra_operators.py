@@ -16,6 +16,7 @@ import numpy as np
 from bench_operator import best_time  # the benchmarks folder is on sys.path when run
 
 from pimodel import PIOperator
+from pimodel.asymmetric import AsymmetricPI
 from pimodel.creep import CreepOperator
 from pimodel.envelopes import Envelope
 from pimodel.generalized import GeneralizedPI
@@ -32,7 +33,10 @@ def random_operators(rng, n: int = 8):
     rdpi = RateDependentPI(p, r, rate_gain=rng.uniform(0.1, 0.9) / probe.rate_sensitivity,
                            dt=1e-4)
     creep = CreepOperator(rng.uniform(0.005, 0.03, 4), 10.0 ** np.arange(-2, 2), dt=1e-4)
-    return gpi, rdpi, creep
+    asym = AsymmetricPI(rng.uniform(0.1, 1), p, r, ascending=(1.0, 0.0),
+                        descending=(rng.uniform(0.7, 1.5), rng.uniform(-0.3, 0.3)),
+                        shape=Envelope.tanh(rng.uniform(3, 6), rng.uniform(0.1, 0.3)))
+    return gpi, rdpi, creep, asym
 
 
 def main() -> None:
@@ -44,11 +48,12 @@ def main() -> None:
     N = args.samples
     tt = np.arange(N) * 1e-4
     v = 3 * np.sin(2 * np.pi * 5 * tt) * np.sin(2 * np.pi * 0.3 * tt) + rng.normal(0, 0.02, N)
-    gpi, rdpi, creep = random_operators(rng)
+    gpi, rdpi, creep, asym = random_operators(rng)
     pi = PIOperator(gpi.weights, gpi.radii)
     t_pi = best_time(lambda: pi.simulate(v), repeat=3)
     rows = [("PIOperator (baseline)", t_pi)]
-    for name, op in (("GeneralizedPI", gpi), ("RateDependentPI", rdpi), ("CreepOperator", creep)):
+    for name, op in (("GeneralizedPI", gpi), ("RateDependentPI", rdpi), ("CreepOperator", creep),
+                     ("AsymmetricPI", asym)):
         y = op.simulate(v)
         inv = op.inverse()
         rows.append((name, best_time(lambda op=op: op.simulate(v), repeat=3)))
@@ -59,7 +64,8 @@ def main() -> None:
         print(f"{name:<26}{t:>10.4f}{t / N * 1e9:>12.1f}{t / t_pi:>8.2f}")
     speed_ok = all(t / t_pi <= 5 for name, t in rows[1:] if not name.startswith("  "))
 
-    worst = {"GeneralizedPI": 0.0, "RateDependentPI": 0.0, "CreepOperator": 0.0}
+    worst = {"GeneralizedPI": 0.0, "RateDependentPI": 0.0, "CreepOperator": 0.0,
+             "AsymmetricPI": 0.0}
     for _ in range(args.cases):
         ops = random_operators(rng)
         w = np.cumsum(rng.normal(0, 0.05, 20_000))
