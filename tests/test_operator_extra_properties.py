@@ -85,8 +85,7 @@ def test_generalized_rate_independent(op, v, data):
                                atol=1e-12)
 
 
-@given(generalized(), st.floats(1, V_MAX), st.floats(0.05, 0.95))
-def test_generalized_wiping_out(op, amp, frac_down):
+def assert_wiping_out(op, amp, frac_down):
     """A minor loop that returns to its start point leaves no trace (return-point memory)."""
     low = amp - frac_down * 2 * amp
     ramp = np.linspace(-amp, amp, 150)
@@ -95,6 +94,11 @@ def test_generalized_wiping_out(op, amp, frac_down):
     y1 = op.simulate(np.concatenate((ramp, minor, after)))
     y2 = op.simulate(np.concatenate((ramp, after)))
     np.testing.assert_allclose(y1[-len(after):], y2[-len(after):], atol=1e-9)
+
+
+@given(generalized(), st.floats(1, V_MAX), st.floats(0.05, 0.95))
+def test_generalized_wiping_out(op, amp, frac_down):
+    assert_wiping_out(op, amp, frac_down)
 
 
 @given(generalized(), st.lists(st.tuples(finite, finite), min_size=1, max_size=100))
@@ -246,13 +250,7 @@ def test_asymmetric_monotone_and_rate_independent(op, v):
 
 @given(asymmetric(), st.floats(1, V_MAX), st.floats(0.05, 0.95))
 def test_asymmetric_wiping_out(op, amp, frac_down):
-    low = amp - frac_down * 2 * amp
-    ramp = np.linspace(-amp, amp, 150)
-    minor = np.concatenate((np.linspace(amp, low, 40)[1:], np.linspace(low, amp, 40)[1:]))
-    after = np.linspace(amp, -amp, 150)[1:]
-    y1 = op.simulate(np.concatenate((ramp, minor, after)))
-    y2 = op.simulate(np.concatenate((ramp, after)))
-    np.testing.assert_allclose(y1[-len(after):], y2[-len(after):], atol=1e-9)
+    assert_wiping_out(op, amp, frac_down)
 
 
 @given(pi_parts(linear_play=False), st.floats(0.05, 2), signals)

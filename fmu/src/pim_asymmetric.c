@@ -59,7 +59,7 @@ static double asym_slope(const pim_asym *a, size_t n, const double *p, const dou
 
 /* s with asym_sum(s) = y: f is continuous, strictly increasing, linear between the kinks;
  * the root is taken from the left kink with the segment's own slope (no long chords). */
-static double asym_solve(const pim_asym *a, size_t n, const double *p, const double *r,
+double pim_asym_solve(const pim_asym *a, size_t n, const double *p, const double *r,
                          const double *z, double y)
 {
     double b[3 * PIM_MAX_PLAYS] = {0.0};
@@ -99,7 +99,7 @@ size_t pim_asym_inverse_run(const pim_asym *a, size_t N, size_t n, const double 
 {
     if (n > PIM_MAX_PLAYS) return N + 1;
     for (size_t k = 0; k < N; ++k) {
-        const double s = asym_solve(a, n, p, r, z, yd[k]);
+        const double s = pim_asym_solve(a, n, p, r, z, yd[k]);
         v[k] = pim_envelope(a->kind_inv, a->c, s);
         if (isnan(v[k])) return k + 1;
         for (size_t i = 0; i < n; ++i) z[i] = asym_play(a, r[i], z[i], s);

@@ -34,6 +34,14 @@ typedef struct {
     int kind_inv;    /* phi^-1's kind */
 } pim_asym;
 
+/*
+ * The s that gives y at one step from play states z (z untouched): piecewise-linear solve
+ * between the sorted kinks, no iteration; n <= PIM_MAX_PLAYS.  Internal (also used by
+ * pim_play_solve), not exported from the library.
+ */
+double pim_asym_solve(const pim_asym *a, size_t n, const double *p, const double *r,
+                      const double *z, double y);
+
 /* Forward run; returns 0, or k + 1 when phi is undefined at v[k] (the run stops there). */
 PIM_API size_t pim_asym_run(const pim_asym *a, size_t N, size_t n, const double *p,
                             const double *r, double *z, const double *v, double *y);

@@ -1,56 +1,18 @@
 /* Rate-dependent PI operator and its exact inverse; semantics in pim_rate_dependent.h. */
 #include "pim_rate_dependent.h"
 
-#include <math.h>
+#include "pim_asymmetric.h"
+#include "pim_generalized.h"
 
-static double play_sum(size_t n, const double *p, const double *r, const double *z, double v)
-{
-    double y = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        double zi = z[i] < v + r[i] ? z[i] : v + r[i];
-        zi = zi > v - r[i] ? zi : v - r[i];
-        y += p[i] * zi;
-    }
-    return y;
-}
+#include <math.h>
 
 double pim_play_solve(size_t n, const double *p, const double *r, double *z, double y)
 {
-    double b[2 * PIM_MAX_PLAYS] = {0.0};
+    /* the asymmetric operator's solve with gamma_l = gamma_r = s and no direct term */
+    const pim_asym plain = {0.0, 1.0, 0.0, 1.0, 0.0, PIM_ENV_POLY2, {0.0, 1.0, 0.0, 0.0},
+                            PIM_ENV_POLY2_INV};
     if (n == 0 || n > PIM_MAX_PLAYS) return NAN;
-    size_t m = 0;
-    double P = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        b[m++] = z[i] - r[i];
-        b[m++] = z[i] + r[i];
-        P += p[i];
-    }
-    for (size_t i = 1; i < m; ++i) { /* insertion sort: m <= 128 */
-        const double x = b[i];
-        size_t j = i;
-        while (j > 0 && b[j - 1] > x) {
-            b[j] = b[j - 1];
-            --j;
-        }
-        b[j] = x;
-    }
-    double v;
-    double f_lo = play_sum(n, p, r, z, b[0]);
-    if (y <= f_lo) {
-        v = b[0] - (f_lo - y) / P; /* every play on its upper bound v + r_i: slope P */
-    } else {
-        v = NAN;
-        for (size_t j = 1; j < m; ++j) {
-            const double f_hi = play_sum(n, p, r, z, b[j]);
-            if (y <= f_hi) {
-                v = f_hi > f_lo ? b[j - 1] + (y - f_lo) * (b[j] - b[j - 1]) / (f_hi - f_lo)
-                                : b[j - 1];
-                break;
-            }
-            f_lo = f_hi;
-        }
-        if (isnan(v)) v = b[m - 1] + (y - f_lo) / P; /* every play on v - r_i */
-    }
+    const double v = pim_asym_solve(&plain, n, p, r, z, y);
     (void)pim_pi_step(n, p, r, z, v);
     return v;
 }
