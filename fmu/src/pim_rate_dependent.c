@@ -28,10 +28,9 @@ void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alpha, doub
                   double lam, double Ts, double *z, double *hist, const double *v, double *y)
 {
     for (size_t k = 0; k < N; ++k) {
-        const double scale = 1.0 + beta * hist[1];
         double acc = 0.0;
         for (size_t i = 0; i < n; ++i) {
-            const double ri = alpha[i] * scale;
+            const double ri = alpha[i] + alpha[i] * beta * hist[1]; /* alpha_1 = 0 stays 0 */
             double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
             z[i] = zi > v[k] - ri ? zi : v[k] - ri;
             acc += p[i] * z[i];
@@ -48,8 +47,7 @@ int pim_rdpi_inverse_run(size_t N, size_t n, const double *p, const double *alph
     double rl[PIM_MAX_PLAYS];
     if (n > PIM_MAX_PLAYS) return -1;
     for (size_t k = 0; k < N; ++k) {
-        const double scale = 1.0 + beta * hist[1];
-        for (size_t i = 0; i < n; ++i) rl[i] = alpha[i] * scale;
+        for (size_t i = 0; i < n; ++i) rl[i] = alpha[i] + alpha[i] * beta * hist[1];
         v[k] = pim_play_solve(n, p, rl, z, yd[k]);
         rate_update(hist, v[k], lam, Ts);
     }
