@@ -187,6 +187,13 @@ class AsymmetricPI:
         self._z = z
         return float(y[0])
 
+    def to_dict(self) -> dict:
+        """JSON-ready parameters."""
+        return {"type": "AsymmetricPI", "direct_weight": self.direct_weight,
+                "weights": self._p.tolist(), "radii": self._r.tolist(),
+                "ascending": list(self.ascending), "descending": list(self.descending),
+                "shape": self.shape.to_dict(), "initial_state": self._z0.tolist()}
+
     def inverse(self) -> AsymmetricPIInverse:
         """Exact causal inverse (module docstring).
 

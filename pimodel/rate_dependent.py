@@ -202,6 +202,14 @@ class RateDependentPI:
         """Advance one sample with ``v[k]`` and return ``y[k]``."""
         return float(self._run(as_signal(v, "v"), self._s)[0])
 
+    def to_dict(self) -> dict:
+        """JSON-ready parameters."""
+        return {"type": "RateDependentPI", "weights": self.weights.tolist(),
+                "base_radii": self.base_radii.tolist(), "rate_gain": self.rate_gain,
+                "dt": self.dt, "rate_time_constant": self.rate_time_constant,
+                "initial_state": self._pi.initial_state.tolist(),
+                "initial_input": self.initial_input}
+
     def inverse(self) -> RateDependentPIInverse:
         """Exact causal inverse (module docstring: when and why it is exact).
 
