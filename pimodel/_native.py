@@ -93,3 +93,95 @@ def pi_inverse(
     if lib.pim_pi_inverse(n, p, r, z, pinv, rinv, zinv) != 0:
         return None
     return pinv, rinv, zinv
+
+
+# -- generalized, rate-dependent and creep operators (fmu/src/pim_generalized.h,
+#    pim_rate_dependent.h, pim_creep.h) --------------------------------------------------------
+
+c_int = ctypes.c_int
+c_double = ctypes.c_double
+
+lib.pim_envelope.restype = c_double
+lib.pim_envelope.argtypes = [c_int, F64, c_double]
+lib.pim_envelope_check.restype = ctypes.c_char_p
+lib.pim_envelope_check.argtypes = [c_int, F64]
+lib.pim_gpi_run.restype = c_size
+lib.pim_gpi_run.argtypes = [c_size, c_size, F64, F64, F64, c_int, F64, c_int, F64, F64, F64]
+lib.pim_play_solve.restype = c_double
+lib.pim_play_solve.argtypes = [c_size, F64, F64, F64, c_double]
+lib.pim_rdpi_run.restype = None
+lib.pim_rdpi_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64, F64,
+                             F64, F64]
+lib.pim_rdpi_inverse_run.restype = c_int
+lib.pim_rdpi_inverse_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64,
+                                     F64, F64, F64]
+lib.pim_creep_run.restype = None
+lib.pim_creep_run.argtypes = [c_size, c_size, F64, F64, F64, F64, F64]
+lib.pim_creep_inverse_run.restype = None
+lib.pim_creep_inverse_run.argtypes = [c_size, c_size, F64, F64, F64, F64, F64]
+
+
+def envelope_check(kind: int, c: np.ndarray) -> str | None:
+    """Message naming the bad coefficient of an envelope, or None when it is valid."""
+    msg = lib.pim_envelope_check(kind, c)
+    return None if msg is None else msg.decode()
+
+
+def gpi_run(p: np.ndarray, r: np.ndarray, z: np.ndarray, kind_in: int, c_in: np.ndarray,
+            kind_out: int, c_out: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, int]:
+    """Generalized PI run; ``z`` updated in place. Returns ``(y, bad)``, ``bad`` = k + 1 of the
+    first sample where an envelope is undefined, else 0."""
+    y = np.empty(v.shape[0])
+    bad = lib.pim_gpi_run(v.shape[0], p.shape[0], p, r, z, kind_in, c_in, kind_out, c_out, v, y)
+    return y, int(bad)
+
+
+def rdpi_run(p: np.ndarray, alpha: np.ndarray, beta: float, lam: float, Ts: float,
+             z: np.ndarray, hist: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rate-dependent PI run; ``z`` (n) and ``hist`` (v[k-1], rate[k]) updated in place."""
+    y = np.empty(v.shape[0])
+    lib.pim_rdpi_run(v.shape[0], p.shape[0], p, alpha, beta, lam, Ts, z, hist, v, y)
+    return y
+
+
+def rdpi_inverse_run(p: np.ndarray, alpha: np.ndarray, beta: float, lam: float, Ts: float,
+                     z: np.ndarray, hist: np.ndarray, yd: np.ndarray) -> np.ndarray:
+    """Exact inverse of the rate-dependent PI; the forward state ``z``, ``hist`` advances."""
+    v = np.empty(yd.shape[0])
+    if lib.pim_rdpi_inverse_run(yd.shape[0], p.shape[0], p, alpha, beta, lam, Ts, z, hist, yd,
+                                v):
+        raise ValueError(f"rate-dependent inverse: at most 64 plays, got {p.shape[0]}")
+    return v
+
+
+def creep_run(a: np.ndarray, c: np.ndarray, x: np.ndarray, u: np.ndarray, *,
+              inverse: bool = False) -> np.ndarray:
+    """Creep operator (or, with ``inverse=True``, its inverse) over ``u``; ``x`` updated."""
+    out = np.empty(u.shape[0])
+    fn = lib.pim_creep_inverse_run if inverse else lib.pim_creep_run
+    fn(u.shape[0], a.shape[0], a, c, x, u, out)
+    return out
+
+
+class AsymParams(ctypes.Structure):
+    """``pim_asym`` (fmu/src/pim_asymmetric.h): direct weight, envelopes and shape function."""
+
+    _fields_ = [("p0", c_double), ("al", c_double), ("dl", c_double), ("ar", c_double),
+                ("dr", c_double), ("kind", c_int), ("c", c_double * 4), ("kind_inv", c_int)]
+
+
+lib.pim_asym_run.restype = c_size
+lib.pim_asym_run.argtypes = [ctypes.POINTER(AsymParams), c_size, c_size, F64, F64, F64, F64, F64]
+lib.pim_asym_inverse_run.restype = c_size
+lib.pim_asym_inverse_run.argtypes = [ctypes.POINTER(AsymParams), c_size, c_size, F64, F64, F64,
+                                     F64, F64]
+
+
+def asym_run(a: AsymParams, p: np.ndarray, r: np.ndarray, z: np.ndarray, x: np.ndarray, *,
+             inverse: bool = False) -> tuple[np.ndarray, int]:
+    """Asymmetric generalized PI (or its inverse) over ``x``; ``z`` updated in place.
+    Returns ``(out, bad)``, ``bad`` = k + 1 of the first failing sample, else 0."""
+    out = np.empty(x.shape[0])
+    fn = lib.pim_asym_inverse_run if inverse else lib.pim_asym_run
+    bad = fn(ctypes.byref(a), x.shape[0], p.shape[0], p, r, z, x, out)
+    return out, int(bad)

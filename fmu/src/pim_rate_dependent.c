@@ -1,0 +1,55 @@
+/* Rate-dependent PI operator and its exact inverse; semantics in pim_rate_dependent.h. */
+#include "pim_rate_dependent.h"
+
+#include "pim_asymmetric.h"
+#include "pim_generalized.h"
+
+#include <math.h>
+
+double pim_play_solve(size_t n, const double *p, const double *r, double *z, double y)
+{
+    /* the asymmetric operator's solve with gamma_l = gamma_r = s and no direct term */
+    const pim_asym plain = {0.0, 1.0, 0.0, 1.0, 0.0, PIM_ENV_POLY2, {0.0, 1.0, 0.0, 0.0},
+                            PIM_ENV_POLY2_INV};
+    if (n == 0 || n > PIM_MAX_PLAYS) return NAN;
+    const double v = pim_asym_solve(&plain, n, p, r, z, y);
+    (void)pim_pi_step(n, p, r, z, v);
+    return v;
+}
+
+/* hist = (v[k-1], rate[k]) -> (v[k], rate[k+1]) */
+static void rate_update(double *hist, double v, double lam, double Ts)
+{
+    hist[1] = lam * hist[1] + (1.0 - lam) * fabs(v - hist[0]) / Ts;
+    hist[0] = v;
+}
+
+void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
+                  double lam, double Ts, double *z, double *hist, const double *v, double *y)
+{
+    for (size_t k = 0; k < N; ++k) {
+        double acc = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            const double ri = alpha[i] + alpha[i] * beta * hist[1]; /* alpha_1 = 0 stays 0 */
+            double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
+            z[i] = zi > v[k] - ri ? zi : v[k] - ri;
+            acc += p[i] * z[i];
+        }
+        y[k] = acc;
+        rate_update(hist, v[k], lam, Ts);
+    }
+}
+
+int pim_rdpi_inverse_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
+                         double lam, double Ts, double *z, double *hist, const double *yd,
+                         double *v)
+{
+    double rl[PIM_MAX_PLAYS];
+    if (n > PIM_MAX_PLAYS) return -1;
+    for (size_t k = 0; k < N; ++k) {
+        for (size_t i = 0; i < n; ++i) rl[i] = alpha[i] + alpha[i] * beta * hist[1];
+        v[k] = pim_play_solve(n, p, rl, z, yd[k]);
+        rate_update(hist, v[k], lam, Ts);
+    }
+    return 0;
+}
