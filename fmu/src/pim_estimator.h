@@ -42,7 +42,10 @@
 extern "C" {
 #endif
 
-#define PIM_EST_WIN 64 /* ring buffer for the slope check (max window + 1) */
+#define PIM_EST_WIN 64    /* ring buffer for the slope check (max window + 1) */
+#define PIM_EST_BINS 256  /* bins of the branch slope profile (law PIM_LAW_DATA) */
+#define PIM_LAW_DATA 0    /* regime from the measured branch profile (default) */
+#define PIM_LAW_PAPER 1   /* regime from the estimate, as in the paper */
 
 typedef struct {
     /* parameters */
@@ -57,6 +60,7 @@ typedef struct {
     int known_linear;   /* rhat_1 fixed at 0 */
     int slope_window;   /* samples of the slope check window (0: no check) */
     double slope_tol;   /* tolerated slope mismatch, in units of the smallest weight */
+    int law;            /* PIM_LAW_DATA or PIM_LAW_PAPER */
     /* state (see pim_est_get_state for the flat layout) */
     double rhat[PIM_MAX_PLAYS];
     double zhat[PIM_MAX_PLAYS];
@@ -72,10 +76,21 @@ typedef struct {
     double nseg;     /* samples seen since the last reversal */
     double head;     /* ring buffer position */
     double vbuf[PIM_EST_WIN], ybuf[PIM_EST_WIN]; /* last inputs and outputs */
+    /* branch profile (law PIM_LAW_DATA) */
+    double t_prev;   /* input travel of the segment that ended at the last reversal */
+    double y_ext;    /* output at the running extreme v_ext */
+    double x_last;   /* travel of the last profiled point of the current branch */
+    double y_last;   /* output there */
+    double width;    /* bin width [input unit], 0 until the first reversal */
+    double top;      /* highest bin with data, -1 if none */
+    double fitted;   /* 1 once the regime table has been fitted */
+    double edge[PIM_MAX_PLAYS];  /* fitted breakpoints: travel where play j joins (inf: never) */
+    double S[PIM_EST_BINS];      /* sum of s * (output change) per travel bin */
+    double C[PIM_EST_BINS];      /* sum of travel per bin */
 } pim_estimator;
 
-/* Flat state length: 3n + 10 + 2 PIM_EST_WIN doubles. */
-#define PIM_EST_STATE_SIZE(n) (3 * (n) + 10 + 2 * PIM_EST_WIN)
+/* Flat state length: 4n + 17 + 2 PIM_EST_WIN + 2 PIM_EST_BINS doubles. */
+#define PIM_EST_STATE_SIZE(n) (4 * (n) + 17 + 2 * PIM_EST_WIN + 2 * PIM_EST_BINS)
 
 /*
  * Initialise: n plays with weights p (> 0), gains (>= 0), initial radii rhat0 (projected onto
@@ -106,6 +121,9 @@ PIM_API void pim_est_get_state(const pim_estimator *est, double *state);
 /* Slope check settings (see above); window 0 disables it, at most PIM_EST_WIN - 1.  Returns
  * NULL or a message.  pim_est_init sets window 8, tolerance 0.5. */
 PIM_API const char *pim_est_set_slope_check(pim_estimator *est, int window, double tol);
+
+/* Law: PIM_LAW_DATA (set by pim_est_init) or PIM_LAW_PAPER.  Returns NULL or a message. */
+PIM_API const char *pim_est_set_law(pim_estimator *est, int law);
 
 /* Returns NULL or a message if the state is not admissible (non-finite, unordered radii). */
 PIM_API const char *pim_est_set_state(pim_estimator *est, const double *state);

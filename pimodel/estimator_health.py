@@ -1,0 +1,117 @@
+"""Health report of a radius estimate: can it be trusted?
+
+Four checks on a finished run (the estimate history ``rhat[k]`` over the record):
+
+- excitation (Lemma 2, Prop. 2; :func:`pimodel.excitation.check_excitation`): reversals and an
+  input range above the loop width and above ``2 rhat_n``;
+- plays merged: adjacent estimates closer than ``1e-6 * max(rhat)`` (the ordering constraint
+  of the projection is active: the record did not separate them, or the law is stuck);
+- pinned at the projection bound: ``rhat_j = 0`` for a play not declared linear;
+- still moving: the mean of the last quarter of the record differs from the mean of the
+  quarter before it by more than 1 % of ``max(rhat)`` (the record is too short for the gains).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from .excitation import check_excitation
+
+
+@dataclass
+class EstimatorHealth:
+    """Result of :func:`estimator_health`; ``ok`` is False when any check failed.
+
+    Attributes
+    ----------
+    ok : bool
+        All checks passed.
+    excitation_ok : bool
+        The record excites all plays (Lemma 2, Prop. 2) for the estimated radii.
+    merged : list of tuple of int
+        1-based pairs ``(j, j + 1)`` of plays whose estimates coincide.
+    pinned : list of int
+        1-based plays whose estimate sits at the bound 0 (not declared linear).
+    still_moving : bool
+        The estimate drifted by more than 1 % of ``max(rhat)`` between the last two quarters.
+    drift : float
+        That drift, ``max_j |mean_Q4 - mean_Q3|`` [input unit].
+    messages : list of str
+        One sentence per failed check.
+    """
+
+    ok: bool
+    excitation_ok: bool
+    merged: list = field(default_factory=list)
+    pinned: list = field(default_factory=list)
+    still_moving: bool = False
+    drift: float = 0.0
+    messages: list = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        """Plain dict of the fields."""
+        return asdict(self)
+
+
+def estimator_health(v, weights, history, *, linear_play: bool = False,
+                     warn: bool = False) -> EstimatorHealth:
+    """Check a radius estimate (see the module docstring).
+
+    Parameters
+    ----------
+    v : array_like
+        The input record.
+    weights : array_like
+        Play weights p_j.
+    history : array_like, shape (N, n)
+        ``rhat[k]``, the estimate used at each sample.
+    linear_play : bool
+        ``rhat_1 = 0`` was held on purpose (not reported as pinned).
+    warn : bool
+        Issue a ``UserWarning`` with the messages when a check fails.
+
+    Returns
+    -------
+    EstimatorHealth
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = estimator_health(np.sin(np.arange(0, 60, 0.01)), [1.0, 1.0],
+    ...                      np.tile([0.2, 0.2], (6000, 1)))
+    >>> h.merged
+    [(1, 2)]
+    """
+    hist = np.asarray(history, float)
+    final = hist[-1]
+    scale = float(final.max()) if final.size else 0.0
+    msgs: list[str] = []
+    exc = check_excitation(v, weights, final, warn=False)
+    if not exc.ok:
+        msgs.extend(exc.messages)
+    tol = 1e-6 * max(scale, 1e-12)
+    merged = [(j + 1, j + 2) for j in range(final.size - 1) if final[j + 1] - final[j] <= tol]
+    if merged:
+        msgs.append("plays merged (equal estimates, the ordering constraint is active): "
+                    + ", ".join(f"r_hat[{a}] = r_hat[{b}]" for a, b in merged))
+    start = 1 if linear_play else 0
+    pinned = [j + 1 for j in range(start, final.size) if final[j] == 0.0]
+    if pinned:
+        msgs.append("radius pinned at the projection bound 0: "
+                    + ", ".join(f"r_hat[{j}]" for j in pinned))
+    q = hist.shape[0] // 4
+    drift = 0.0
+    if q >= 1:
+        drift = float(np.max(np.abs(hist[-q:].mean(axis=0) - hist[-2 * q:-q].mean(axis=0))))
+    moving = drift > 0.01 * scale
+    if moving:
+        msgs.append(f"estimate still moving at the end: drift {drift:.3g} between the last two "
+                    f"quarters of the record (> 1 % of max r_hat = {scale:.3g}); use a longer "
+                    "record or larger gains")
+    ok = exc.ok and not merged and not pinned and not moving
+    if warn and not ok:
+        warnings.warn("radius estimate health: " + "; ".join(msgs), UserWarning, stacklevel=2)
+    return EstimatorHealth(ok, exc.ok, merged, pinned, moving, drift, msgs)
