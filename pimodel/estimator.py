@@ -21,7 +21,7 @@ input ``v[k]`` (input unit, e.g. V) and measured output ``y[k]`` (output unit, e
    non-decreasing count ``i_b`` of plays on their envelope that best fits the pooled slopes
    (least squares against the levels ``P_i``, an exact dynamic programme over bins) gives the
    breakpoints ``edge_j``. Play j is on its envelope iff ``d >= edge_j``; within the band
-   ``g = max(guard, 1.5 bin widths)`` of ``edge_j`` the estimate decides (``d >= 2 rhat_j``)
+   ``g = max(guard, one bin width)`` of ``edge_j`` the estimate decides (``d >= 2 rhat_j``)
    if ``2 rhat_j`` lies in the band and ``d`` is at least ``guard`` from it, else the sample is
    skipped. An interior play must be surely saturated at the reversal
    (``edge_j + g <= t_prev``). The regime no longer depends on the estimate far from the

@@ -181,7 +181,7 @@ def _regime_data(prof: BranchProfile, rhat, d, guard, t_prev):
     """Plays on their envelope at travel d under the data law, or None (sample not used)."""
     if not prof.fitted:
         return None
-    g = max(guard, 1.5 * prof.width)
+    g = max(guard, prof.width)
     on = np.zeros(rhat.size, dtype=bool)
     for j, b in enumerate(prof.edge):
         if b < 0.0:

@@ -27,7 +27,7 @@ import numpy as np
 from .checks import as_signal, as_vector, positive_scalar
 
 G_CLEAN = 20.0  # normalised adaptation rate gain * |p|^2 on a clean record [1/s]
-G_NOISE = 2.0e-7  # gain * dt * sigma_y^2 / A^2 on a noisy record
+G_NOISE = 2.2e-6  # gain * dt * sigma_y^2 / A^2 on a noisy record
 STEP_BOUND = 0.5  # dt * gain * |p|^2 never above this (stability needs < 2)
 
 

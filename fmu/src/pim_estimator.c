@@ -56,10 +56,11 @@ const char *pim_est_set_law(pim_estimator *est, int law)
     return NULL;
 }
 
-/* Effective guard of the data law: at least 1.5 bins around each fitted breakpoint. */
+/* Band of the data law around a fitted breakpoint: at least one bin (the breakpoint lies
+ * in the bin on either side of the fitted edge). */
 static double est_data_guard(const pim_estimator *est)
 {
-    const double g = 1.5 * est->width;
+    const double g = est->width;
     return est->guard > g ? est->guard : g;
 }
 
