@@ -220,6 +220,26 @@ class RadiusEstimator:
         self._state_size = 4 * n + 17 + 2 * EST_WINDOW + 2 * EST_BINS
         self._initial = self.state
 
+    @classmethod
+    def for_record(cls, v, y, weights, *, dt: float, **options) -> RadiusEstimator:
+        """An estimator with the settings :func:`default_settings` picks from ``(v, y)``.
+
+        ``v``, ``y`` may be the first part of a longer record (e.g. the first chunk of a
+        stream); ``options`` (e.g. ``initial_radii``, ``law``) override or add keywords.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> v = 30 * np.sin(2 * np.pi * np.arange(0, 5, 1e-3))
+        >>> est = RadiusEstimator.for_record(v, 2 * v, [1.0, 1.0], dt=1e-3)
+        >>> float(est.gains[0])
+        10.0
+        """
+        auto = default_settings(v, y, weights, dt=dt)
+        kw = {k: auto[k] for k in ("gains", "guard", "threshold", "slope_window")}
+        kw.update(options)
+        return cls(weights, dt=dt, **kw)
+
     @property
     def radii(self) -> np.ndarray:
         """Current estimate rhat (after the last step)."""
@@ -336,7 +356,7 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
                           initial_state=initial_state, law=law, **settings)
     res = est.run(x, m)
     res.health = estimator_health(x, est.weights, res.history, linear_play=known_linear_play,
-                                  warn=warn)
+                                  y=m, error=res.error, warn=warn)
     res.settings = {**settings, "law": law}
     return res
 

@@ -1,6 +1,6 @@
 """Health report of a radius estimate: can it be trusted?
 
-Four checks on a finished run (the estimate history ``rhat[k]`` over the record):
+Five checks on a finished run (the estimate history ``rhat[k]`` over the record):
 
 - excitation (Lemma 2, Prop. 2; :func:`pimodel.excitation.check_excitation`): reversals and an
   input range above the loop width and above ``2 rhat_n``;
@@ -8,7 +8,11 @@ Four checks on a finished run (the estimate history ``rhat[k]`` over the record)
   of the projection is active: the record did not separate them, or the law is stuck);
 - pinned at the projection bound: ``rhat_j = 0`` for a play not declared linear;
 - still moving: the mean of the last quarter of the record differs from the mean of the
-  quarter before it by more than 1 % of ``max(rhat)`` (the record is too short for the gains).
+  quarter before it by more than 1 % of ``max(rhat)`` (the record is too short for the gains);
+- model fits the data: the RMS of ``e[k] = yhat[k] - y[k]`` over the last quarter is at most
+  ``1.1 sigma_y + 1e-4 range(y)`` (``sigma_y`` the noise level of y,
+  :func:`pimodel.estimator_settings.noise_level`). A law stuck at a wrong fixed point (the
+  paper's law from below) keeps the estimate still, so only this check sees it.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from .estimator_settings import noise_level
 from .excitation import check_excitation
 
 
@@ -39,6 +44,10 @@ class EstimatorHealth:
         The estimate drifted by more than 1 % of ``max(rhat)`` between the last two quarters.
     drift : float
         That drift, ``max_j |mean_Q4 - mean_Q3|`` [input unit].
+    fit_ok : bool
+        The model output fits y within the noise (True when not checked).
+    fit_rms : float or None
+        RMS of ``e`` over the last quarter [output unit] (None when not checked).
     messages : list of str
         One sentence per failed check.
     """
@@ -49,6 +58,8 @@ class EstimatorHealth:
     pinned: list = field(default_factory=list)
     still_moving: bool = False
     drift: float = 0.0
+    fit_ok: bool = True
+    fit_rms: float | None = None
     messages: list = field(default_factory=list)
 
     def to_json(self) -> dict:
@@ -56,7 +67,7 @@ class EstimatorHealth:
         return asdict(self)
 
 
-def estimator_health(v, weights, history, *, linear_play: bool = False,
+def estimator_health(v, weights, history, *, linear_play: bool = False, y=None, error=None,
                      warn: bool = False) -> EstimatorHealth:
     """Check a radius estimate (see the module docstring).
 
@@ -70,6 +81,8 @@ def estimator_health(v, weights, history, *, linear_play: bool = False,
         ``rhat[k]``, the estimate used at each sample.
     linear_play : bool
         ``rhat_1 = 0`` was held on purpose (not reported as pinned).
+    y, error : array_like, optional
+        Measured output and model error ``e[k]``; with both, the fit is checked.
     warn : bool
         Issue a ``UserWarning`` with the messages when a check fails.
 
@@ -111,7 +124,17 @@ def estimator_health(v, weights, history, *, linear_play: bool = False,
         msgs.append(f"estimate still moving at the end: drift {drift:.3g} between the last two "
                     f"quarters of the record (> 1 % of max r_hat = {scale:.3g}); use a longer "
                     "record or larger gains")
-    ok = exc.ok and not merged and not pinned and not moving
+    fit_ok, fit_rms = True, None
+    if y is not None and error is not None and q >= 1:
+        m = np.asarray(y, float)
+        fit_rms = float(np.sqrt(np.mean(np.asarray(error, float)[-q:] ** 2)))
+        bound = 1.1 * noise_level(m) + 1e-4 * float(np.ptp(m))
+        fit_ok = fit_rms <= bound
+        if not fit_ok:
+            msgs.append(f"the model does not fit the data: RMS error {fit_rms:.3g} over the "
+                        f"last quarter exceeds the noise bound {bound:.3g} (a wrong fixed "
+                        "point, or weights that do not match the data)")
+    ok = exc.ok and not merged and not pinned and not moving and fit_ok
     if warn and not ok:
         warnings.warn("radius estimate health: " + "; ".join(msgs), UserWarning, stacklevel=2)
-    return EstimatorHealth(ok, exc.ok, merged, pinned, moving, drift, msgs)
+    return EstimatorHealth(ok, exc.ok, merged, pinned, moving, drift, fit_ok, fit_rms, msgs)

@@ -73,7 +73,7 @@ def stability_bound(weights, dt: float) -> float:
     Examples
     --------
     >>> round(stability_bound([0.3, 0.5, 0.8, 0.3, 0.2], 1e-3), 1)
-    1526.7
+    1801.8
     """
     p = as_vector(weights, "weights")
     return 2.0 / (positive_scalar(dt, "dt") * float(p @ p))
@@ -117,7 +117,7 @@ def default_settings(v, y, weights, *, dt: float) -> dict:
     >>> y = PIOperator(p, [0.4, 1, 1.5, 2, 3.6]).simulate(v)
     >>> s = default_settings(v, y, p, dt=1e-3)
     >>> round(s["gains"], 2), s["guard"]
-    (9.92, 0.0)
+    (18.02, 0.0)
     """
     x = as_signal(v, "v", min_length=3)
     m = as_signal(y, "y", min_length=3)
