@@ -20,12 +20,14 @@ input ``v[k]`` (input unit, e.g. V) and measured output ``y[k]`` (output unit, e
    set from the first segment and doubled as the travel grows), and at every reversal the
    non-decreasing count ``i_b`` of plays on their envelope that best fits the pooled slopes
    (least squares against the levels ``P_i``, an exact dynamic programme over bins) gives the
-   breakpoints ``edge_j``. Play j is on its envelope iff ``d >= edge_j``; within the band
-   ``g = max(guard, one bin width)`` of ``edge_j`` the estimate decides (``d >= 2 rhat_j``)
-   if ``2 rhat_j`` lies in the band and ``d`` is at least ``guard`` from it, else the sample is
-   skipped. An interior play must be surely saturated at the reversal
-   (``edge_j + g <= t_prev``). The regime no longer depends on the estimate far from the
-   truth, so the law has one fixed point, the truth, from any start.
+   breakpoints ``edge_j`` (refitted also whenever the profile reaches a new bin). Play j is
+   on its envelope iff ``d >= edge_j``; within the band ``g = max(guard, one bin width)`` of
+   ``edge_j`` the estimate decides (``d >= 2 rhat_j``) if ``2 rhat_j`` lies in the band and
+   ``d`` is at least ``guard`` from it, else the sample is skipped. An interior play must be
+   surely saturated at the reversal (``edge_j + g <= t_prev``). While the profile does not yet
+   cover ``t_prev`` (the first branches), a play whose breakpoint has not been profiled follows
+   the paper's rule. Far from the truth the regime no longer depends on the estimate, so the
+   law has one fixed point, the truth, from any start.
 
    ``law="paper"``: the paper's rule, from the estimate: on iff ``d >= 2 rhat_j[k]``, a play
    saturated at the reversal iff ``t_prev >= 2 rhat_j + guard``, samples within ``guard`` of a

@@ -150,9 +150,12 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
             if law == "data":
                 if d > x_last:
                     if d <= t_prev:
+                        top = prof.top
                         prof.add(x_last, d, s * (yk - y_last))
+                        if prof.top > top:  # the profile grew
+                            prof.fit()
                     x_last, y_last = d, yk
-                on = _regime_data(prof, rhat, d, guard, t_prev)
+                on = _regime_data(prof, rhat, sat, d, guard, t_prev)
             else:
                 on = _regime_paper(rhat, sat, d, guard) if _slope_ok(
                     p, rhat, past_v, past_y, nseg, slope_window, slope_tol, v_rev,
@@ -177,13 +180,21 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
     return hist, yhat, e, ed, used.astype(bool), rhat
 
 
-def _regime_data(prof: BranchProfile, rhat, d, guard, t_prev):
+def _regime_data(prof: BranchProfile, rhat, sat, d, guard, t_prev):
     """Plays on their envelope at travel d under the data law, or None (sample not used)."""
     if not prof.fitted:
         return None
     g = max(guard, prof.width)
+    partial = (prof.top + 1.0) * prof.width < t_prev
     on = np.zeros(rhat.size, dtype=bool)
     for j, b in enumerate(prof.edge):
+        if b < 0.0 and partial:  # breakpoint not profiled yet: the paper's rule
+            if abs(d - 2.0 * rhat[j]) < guard:
+                return None
+            on[j] = d >= 2.0 * rhat[j]
+            if not on[j] and sat[j] == 0.0:
+                return None
+            continue
         if b < 0.0:
             on[j] = False
         elif abs(d - b) >= g:

@@ -175,7 +175,7 @@ def test_c_core_equals_numpy_reference(seed, law):
 def test_streaming_equals_batch_and_state_round_trip():
     t, v = sinusoid(30, 1, fs=500, duration=3)
     y = PIOperator(P, R).simulate(v) + np.random.default_rng(5).normal(0, 0.5, v.size)
-    batch = estimate_radii(v, y, P, dt=2e-3, gains=10, initial_radii=WRONG)
+    batch = RadiusEstimator(P, dt=2e-3, gains=10, initial_radii=WRONG).run(v, y)
     est = RadiusEstimator(P, dt=2e-3, gains=10, initial_radii=WRONG)
     rows = [est.step(a, b) for a, b in zip(v, y, strict=True)]
     np.testing.assert_allclose([r[1] for r in rows], batch.model_output, atol=1e-12)

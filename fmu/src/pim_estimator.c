@@ -132,16 +132,26 @@ static void est_fit_regimes(pim_estimator *est)
  * the sample is not to be used.  Away from a fitted breakpoint edge_j (by the guard band g) the
  * table decides; within the band the estimate decides (d >= 2 rhat_j, the paper's rule, finer
  * than a bin) if 2 rhat_j itself lies in the band and d is at least `guard` from it, else the
- * sample is skipped.  Skipped too: no table yet, a travel beyond the profiled one with plays
+ * sample is skipped.  While the profile does not yet cover the travel t_prev (the first
+ * branches), a play whose breakpoint has not been profiled follows the paper's rule.
+ * Skipped too: no table yet, a travel beyond the profiled one with plays
  * not yet on, an interior play whose fitted breakpoint (plus g) exceeds the travel t_prev of
  * the segment before the reversal (not surely saturated there). */
 static int est_regime_data(const pim_estimator *est, double d, int *on)
 {
     if (est->fitted == 0.0) return 0;
     const double g = est_data_guard(est);
+    const int partial = (est->top + 1.0) * est->width < est->t_prev;
     int all_on = 1;
     for (size_t j = 0; j < est->n; ++j) {
         const double b = est->edge[j];
+        if (b < 0.0 && partial) { /* breakpoint not profiled yet: the paper's rule */
+            if (fabs(d - 2.0 * est->rhat[j]) < est->guard) return 0;
+            on[j] = d >= 2.0 * est->rhat[j];
+            if (!on[j] && est->sat[j] == 0.0) return 0;
+            if (!on[j]) all_on = 0;
+            continue;
+        }
         if (b < 0.0) {
             on[j] = 0;
         } else if (fabs(d - b) >= g) {
@@ -306,8 +316,11 @@ int pim_est_step(pim_estimator *est, double v, double y, double *rhat_used, doub
         int on[PIM_MAX_PLAYS], ok;
         if (est->law == PIM_LAW_DATA) {
             if (d > est->x_last) { /* the branch profile: F(x) holds for x <= t_prev */
-                if (d <= est->t_prev)
+                if (d <= est->t_prev) {
+                    const double top = est->top;
                     est_profile_add(est, est->x_last, d, s * (y - est->y_last));
+                    if (est->top > top) est_fit_regimes(est); /* the profile grew */
+                }
                 est->x_last = d;
                 est->y_last = y;
             }
