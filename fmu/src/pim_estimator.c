@@ -38,6 +38,15 @@ static void est_weights(const pim_estimator *est, double *w)
     for (size_t j = 0; j < est->n; ++j) w[j] = 1.0 / (est->gain[j] > 1e-300 ? est->gain[j] : 1e-300);
 }
 
+/* 1 if rhat already satisfies 0 <= rhat_1 <= ... <= rhat_n (and rhat_1 == 0 if known_linear). */
+static int est_feasible(const pim_estimator *est)
+{
+    if (est->known_linear ? est->rhat[0] != 0.0 : est->rhat[0] < 0.0) return 0;
+    for (size_t j = 1; j < est->n; ++j)
+        if (est->rhat[j] < est->rhat[j - 1]) return 0;
+    return 1;
+}
+
 size_t pim_est_sizeof(void) { return sizeof(pim_estimator); }
 
 const char *pim_est_set_slope_check(pim_estimator *est, int window, double tol)
@@ -351,8 +360,10 @@ int pim_est_step(pim_estimator *est, double v, double y, double *rhat_used, doub
                 }
                 est->rhat[j] += step;
             }
-            est_weights(est, w);
-            pim_project_ordered(n, est->rhat, w, est->known_linear);
+            if (!est_feasible(est)) { /* the projection is the identity on feasible points */
+                est_weights(est, w);
+                pim_project_ordered(n, est->rhat, w, est->known_linear);
+            }
             *e_delta = ed;
             used = 1;
         }
