@@ -257,14 +257,15 @@ def test_defaults_follow_the_noise_level():
     assert noisy["guard"] > 0 and noisy["slope_window"] == 0
 
 
-def test_health_flags_a_short_record_and_small_input():
-    """Input range below 2 r_n (Prop. 2) and a record too short to settle: both reported."""
+def test_health_flags_a_small_input():
+    """An input range of 4 against 2 r_n = 7.2 (Lemma 2, Prop. 2): the health report says the
+    record cannot excite all plays."""
     t, v = sinusoid(2, 1, fs=1000, duration=5)
     y = PIOperator(P, R).simulate(v)
     res = estimate_radii(v, y, P, dt=1e-3, initial_radii=WRONG)
     assert not res.health.ok
     assert not res.health.excitation_ok
-    assert any("2 r_n" in m for m in res.health.messages)
+    assert any("input range" in m for m in res.health.messages)
 
 
 def test_step_rejects_nan():
