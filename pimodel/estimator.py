@@ -345,8 +345,8 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
     m = as_signal(y, "y", min_length=2)
     if x.size != m.size:
         raise ValueError(f"v and y: expected equal lengths, got {x.size} and {m.size}")
-    auto = (default_settings(x, m, weights, dt=dt) if x.size >= 3 and None in
-            (gains, threshold, guard, slope_window) else
+    auto = (default_settings(x, m, weights, dt=dt) if x.size >= 3 and any(
+            a is None for a in (gains, threshold, guard, slope_window)) else
             {"gains": 10.0, "guard": 0.0, "threshold": 0.0, "slope_window": 8})
     settings = {"gains": auto["gains"] if gains is None else gains,
                 "threshold": auto["threshold"] if threshold is None else threshold,
