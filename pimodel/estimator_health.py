@@ -133,7 +133,8 @@ def estimator_health(v, weights, history, *, linear_play: bool = False, y=None, 
         if not fit_ok:
             msgs.append(f"the model does not fit the data: RMS error {fit_rms:.3g} over the "
                         f"last quarter exceeds the noise bound {bound:.3g} (a wrong fixed "
-                        "point, or weights that do not match the data)")
+                        "point, weights that do not match the data, or dynamics the PI model "
+                        "lacks, e.g. creep on a real record)")
     ok = exc.ok and not merged and not pinned and not moving and fit_ok
     if warn and not ok:
         warnings.warn("radius estimate health: " + "; ".join(msgs), UserWarning, stacklevel=2)
