@@ -31,7 +31,7 @@ from .operator import PIOperator
 from .slopes import SlopeIdentification, identify_slopes
 
 METHODS = ("adaptive", "conventional", "joint")
-HISTORY_LIMIT = 5_000_000  # samples (record x passes) up to which the estimate history is kept
+HISTORY_LIMIT = 2_000_000  # samples (record x passes) up to which the estimate history is kept
 
 
 @dataclass
