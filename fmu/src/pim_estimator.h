@@ -12,14 +12,28 @@
  *      declared once v has moved back from the running extreme by more than the threshold h;
  *      samples within h of the extreme are not used.  Holds (v[k] == v[k-1]) keep s and are
  *      used.
- *   3. principal case from the input travel d = |v[k] - v_rev|: play j on its envelope iff
+ *   3. principal case at the input travel d = |v[k] - v_rev|: which plays are on their envelope.
+ *      law PIM_LAW_DATA (default): from the measured branches.  For d <= t_prev (travel of
+ *      the segment before the reversal) the branch increment is s (y - y_rev) =
+ *      sum_j p_j max(0, d - 2 r_j) for any history (Madelung), slopes P_i = p_1 + .. + p_i.
+ *      The increments s (y[k] - y[k-1]) are pooled in PIM_EST_BINS travel bins (width set at
+ *      the first reversal to 2.2 t_prev / PIM_EST_BINS, doubled by merging pairs as the travel
+ *      grows); at each reversal, and whenever the profile reaches a new bin, the
+ *      non-decreasing count of saturated plays per bin minimising sum_b C_b (S_b/C_b - P_i)^2
+ *      is fitted (dynamic programme) and gives breakpoints edge_j.  Play j is on iff
+ *      d >= edge_j; within g = max(guard, bin width) of edge_j the estimate decides
+ *      (d >= 2 rhat_j) if |2 rhat_j - edge_j| < g and |d - 2 rhat_j| >= guard, else the sample
+ *      is skipped; an interior play needs edge_j + g <= t_prev (saturated at the reversal);
+ *      beyond the profiled travel only the all-on case is used; while the profile does not
+ *      cover t_prev, a play not yet profiled follows the paper's rule below.
+ *      law PIM_LAW_PAPER: from the estimate, play j on its envelope iff
  *      d >= 2 rhat_j[k] (no noisy slope is differenced).  The sample is used only when every
  *      interior play was saturated at the reversal (else its state is unknown: minor loops),
  *      and only when d is at least `guard` away from every breakpoint 2 rhat_j (a sample near a
  *      breakpoint may be misclassified, which biases the estimate under noise).
- *      Slope check (slope_window m > 0): the measured output change over the m samples before
- *      k (within the segment; y[k] itself is not used, so the choice does not correlate with
- *      the current noise) must match the case model's change within slope_tol * min p_j per
+ *      Slope check (slope_window m > 0, paper law only): the measured output change over the
+ *      m samples before k (within the segment; y[k] itself is not used, so the choice does not
+ *      correlate with the current noise) must match the case model's change within slope_tol * min p_j per
  *      unit of travel; otherwise the regime read from rhat is wrong (an overestimated radius
  *      whose true play is already on its envelope) and the sample is skipped.  Without this
  *      check a radius overestimate can run away.
