@@ -91,6 +91,12 @@ static void est_profile_add(pim_estimator *est, double x0, double x1, double dy)
     int b0 = (int)(x0 / w), b1 = (int)(x1 / w);
     if (b1 > PIM_EST_BINS - 1) b1 = PIM_EST_BINS - 1;
     if (b0 > b1) b0 = b1;
+    if (b0 == b1) { /* the usual case: one bin (dy * (span / span) == dy exactly) */
+        est->S[b1] += dy;
+        est->C[b1] += span;
+        if ((double)b1 > est->top) est->top = (double)b1;
+        return;
+    }
     for (int b = b0; b <= b1; ++b) {
         double lo = b * w > x0 ? b * w : x0, hi = (b + 1) * w < x1 ? (b + 1) * w : x1;
         double part = b0 == b1 ? span : (hi > lo ? hi - lo : 0.0);
