@@ -8,20 +8,35 @@ input ``v[k]`` (input unit, e.g. V) and measured output ``y[k]`` (output unit, e
    ``yhat[k] = sum_j p_j zhat_j[k]``, ``e[k] = yhat[k] - y[k]`` (paper eqs. 7-8);
 2. monotone segments of v: direction ``s``, last reversal ``v_rev`` (declared once v has moved
    back from the running extreme by more than ``threshold``; samples within the threshold are
-   not used), and whether each play was surely saturated at that reversal (the segment that
-   ended there travelled ``>= 2 rhat_j + guard``; no measured output enters this test, so the
-   choice of samples does not correlate with the noise). Holds keep ``s`` and are used (the
-   play states do not move during a hold);
-3. principal case from the input travel ``d = |v[k] - v_rev|``: play j on its envelope iff
-   ``d >= 2 rhat_j[k]`` (no noisy output slope is differenced). Samples where an interior play
-   was not saturated at the reversal (minor loops, the first segment) are not used, nor samples
-   with ``d`` closer than ``guard`` to a breakpoint ``2 rhat_j`` (misclassification there biases
-   the estimate under noise). Slope check: the measured output change over the
-   ``slope_window`` samples before k (y[k] not used) must agree with the case model's change
-   within ``slope_tol * min p`` per unit of travel, else the regime read from rhat is wrong
-   (an overestimated radius whose play is already on its envelope) and the sample is skipped;
-   without it an overestimate can run away.
-   ``e_delta[k] = ybar - y[k] = s phi^T (r - rhat)`` with
+   not used), the travel ``t_prev`` of the segment that ended there, and whether each play was
+   surely saturated at that reversal. Holds keep ``s``;
+3. principal case at the input travel ``d = |v[k] - v_rev|``: which plays are on their
+   envelope. Two laws decide it:
+
+   ``law="data"`` (default): from the measured branches. Along a branch, for ``d <= t_prev``,
+   the output change is ``s (y - y_rev) = F(d) = sum_j p_j max(0, d - 2 r_j)`` whatever the
+   earlier history (Madelung's rule), with slopes ``P_i = p_1 + ... + p_i``. The increments
+   ``s (y[k] - y[k-1])`` are pooled over all branches in 256 bins of travel (the bin width is
+   set from the first segment and doubled as the travel grows), and at every reversal the
+   non-decreasing count ``i_b`` of plays on their envelope that best fits the pooled slopes
+   (least squares against the levels ``P_i``, an exact dynamic programme over bins) gives the
+   breakpoints ``edge_j`` (refitted also whenever the profile reaches a new bin). Play j is
+   on its envelope iff ``d >= edge_j``; within the band ``g = max(guard, one bin width)`` of
+   ``edge_j`` the estimate decides (``d >= 2 rhat_j``) if ``2 rhat_j`` lies in the band and
+   ``d`` is at least ``guard`` from it, else the sample is skipped. An interior play must be
+   surely saturated at the reversal (``edge_j + g <= t_prev``). While the profile does not yet
+   cover ``t_prev`` (the first branches), a play whose breakpoint has not been profiled follows
+   the paper's rule. Far from the truth the regime no longer depends on the estimate, so the
+   law has one fixed point, the truth, from any start.
+
+   ``law="paper"``: the paper's rule, from the estimate: on iff ``d >= 2 rhat_j[k]``, a play
+   saturated at the reversal iff ``t_prev >= 2 rhat_j + guard``, samples within ``guard`` of a
+   breakpoint ``2 rhat_j`` skipped, and the slope check (the measured output change over the
+   ``slope_window`` samples before k must agree with the case model's within
+   ``slope_tol * min p`` per unit of travel). It converges from starts above the truth but
+   can lock onto wrong fixed points from below, equal or mixed starts (plays merge).
+
+   Then ``e_delta[k] = ybar - y[k] = s phi^T (r - rhat)`` with
    ``ybar = sum_on p_j (v - s rhat_j) + sum_interior p_j (v_rev + s rhat_j)`` and
    ``phi_j = +p_j`` (on envelope) or ``-p_j`` (interior), i.e. ``sgn(i - j) p_j`` (eq. 19);
 4. ``rhat[k+1] = Proj(rhat[k] + dt * gain_j(t) * e_delta[k] * s * phi_j)`` with
@@ -30,9 +45,11 @@ input ``v[k]`` (input unit, e.g. V) and measured output ``y[k]`` (output unit, e
    ``1/gains``) onto ``0 <= rhat_1 <= ... <= rhat_n``, with ``rhat_1 = 0`` held when
    ``known_linear_play``.
 
-The discrete law is stable when ``dt * gains_j * |phi|^2 < 2`` (e.g. the piezo stage with
-``|p|^2 = 43.5`` and gains 20 needs ``dt < 2.3 ms``); :func:`pimodel.identify` scales its
-default gains by ``1 / sum p^2``.
+The discrete law is stable when ``dt * gains_j * |p|^2 < 2``
+(:func:`pimodel.estimator_settings.stability_bound`; a larger gain gives a warning).
+:func:`estimate_radii` picks gains, guard, threshold and slope check from the record when they
+are left at None (:func:`pimodel.estimator_settings.default_settings`) and reports the health
+of the result (:mod:`pimodel.estimator_health`).
 """
 
 from __future__ import annotations
@@ -45,6 +62,8 @@ import numpy as np
 
 from . import _native
 from .checks import as_signal, as_vector, integer_in, positive_scalar
+from .estimator_health import EstimatorHealth, estimator_health
+from .estimator_settings import check_gains, default_settings
 
 _lib = _native.lib
 _F64 = _native.F64
@@ -68,6 +87,10 @@ _lib.pim_est_set_state.argtypes = [ctypes.c_void_p, _F64]
 _lib.pim_est_set_slope_check.restype = ctypes.c_char_p
 _lib.pim_est_set_slope_check.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_double]
 EST_WINDOW = 64  # PIM_EST_WIN in pim_estimator.h
+EST_BINS = 256  # PIM_EST_BINS
+_lib.pim_est_set_law.restype = ctypes.c_char_p
+_lib.pim_est_set_law.argtypes = [ctypes.c_void_p, ctypes.c_int]
+LAWS = {"data": 0, "paper": 1}  # PIM_LAW_DATA, PIM_LAW_PAPER in pim_estimator.h
 _lib.pim_project_ordered.restype = None
 _lib.pim_project_ordered.argtypes = [ctypes.c_size_t, _F64, _F64, ctypes.c_int]
 
@@ -84,12 +107,16 @@ def project_ordered(x, weights=None, *, fix_first: bool = False) -> np.ndarray:
 
 @dataclass
 class RadiusEstimate:
-    """Result of :func:`estimate_radii`.
+    """Result of :func:`estimate_radii` and :meth:`RadiusEstimator.run`.
 
     ``history[k]`` is the estimate used at step k (before that step's update), so
     ``history[0]`` is the (projected) initial guess and ``radii`` the estimate after the last
     sample. ``error[k] = yhat[k] - y[k]``, ``modified_error[k]`` is ``e_delta[k]`` (0 where
     the sample was not used), ``used[k]`` whether sample k adapted the radii.
+    ``radii_mean`` is the mean of ``history`` over the last half of the record (None below
+    ``MIN_MEAN_SAMPLES`` samples): under output noise the constant-gain iterate keeps
+    fluctuating and the mean is the estimate to use. ``health`` (from :func:`estimate_radii`)
+    says whether the estimate can be trusted, see :mod:`pimodel.estimator_health`.
     """
 
     radii: np.ndarray
@@ -99,6 +126,9 @@ class RadiusEstimate:
     model_output: np.ndarray
     used: np.ndarray
     dt: float
+    radii_mean: np.ndarray | None = None
+    health: EstimatorHealth | None = None
+    settings: dict | None = None
 
     def mean_radii(self, last_seconds: float) -> np.ndarray:
         """Average of the estimate over the last ``last_seconds`` of the record."""
@@ -106,24 +136,40 @@ class RadiusEstimate:
         return self.history[-k:].mean(axis=0)
 
 
+MIN_MEAN_SAMPLES = 1000  # radii_mean needs a record at least this long
+
+
 class RadiusEstimator:
     """Streaming radius estimator: :meth:`step` takes one sample ``(v[k], y[k])``.
 
     Parameters: ``weights`` p_j > 0 (known, e.g. from the loop slopes), ``dt`` sample time [s],
-    ``gains`` (scalar or per play, >= 0; the paper's Lambda diagonal), ``initial_radii``
+    ``gains`` (scalar or per play, >= 0; the paper's Lambda diagonal; above the stability
+    bound ``2 / (dt |p|^2)`` a ``UserWarning`` is issued), ``law`` (``"data"``: regime from the
+    measured branches, the default; ``"paper"``: regime from the estimate), ``initial_radii``
     (projected onto the ordered set), ``known_linear_play`` (hold rhat_1 = 0), ``threshold``
     (reversal threshold, input unit), ``max_step`` (per-sample clip of the update, input unit),
     ``guard`` (breakpoint guard band, input unit), ``slope_window`` and ``slope_tol`` (the slope
     check: samples, 0 to disable; tolerance in units of the smallest weight),
     ``anneal_time`` (gain annealing time constant [s]), ``initial_state`` (model play state).
-    See the module docstring for the exact discrete-time law.
+    The slope check applies to ``law="paper"`` only. See the module docstring for the exact
+    discrete-time law.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pimodel import PIOperator
+    >>> p, r = [0.3, 0.5, 0.8, 0.3, 0.2], [0.4, 1, 1.5, 2, 3.6]
+    >>> v = 30 * np.sin(2 * np.pi * np.arange(0, 150, 1e-3))
+    >>> est = RadiusEstimator(p, dt=1e-3, gains=10, initial_radii=[0] * 5)
+    >>> np.round(est.run(v, PIOperator(p, r).simulate(v)).radii, 2)
+    array([0.4, 1. , 1.5, 2. , 3.6])
     """
 
     def __init__(self, weights, *, dt: float, gains=10.0, initial_radii=None,
                  known_linear_play: bool = False, threshold: float = 0.0,
                  max_step: float | None = None, anneal_time: float | None = None,
                  guard: float = 0.0, slope_window: int = 8, slope_tol: float = 0.5,
-                 initial_state: float = 0.0):
+                 initial_state: float = 0.0, law: str = "data"):
         p = as_vector(weights, "weights")
         n = p.size
         if n > MAX_PLAYS:
@@ -136,6 +182,8 @@ class RadiusEstimator:
             raise ValueError(f"gains: expected a scalar or {n} values, got {g.size}")
         if np.any(g < 0):
             raise ValueError("gains: every gain must be >= 0")
+        if law not in LAWS:
+            raise ValueError(f"law: expected one of {sorted(LAWS)}, got {law!r}")
         if initial_radii is None:
             r0 = np.zeros(n)
         else:
@@ -153,7 +201,9 @@ class RadiusEstimator:
         at = 0.0 if anneal_time is None else positive_scalar(anneal_time, "anneal_time")
         if not np.isfinite(guard) or guard < 0:
             raise ValueError(f"guard: expected a finite number >= 0, got {guard!r}")
+        check_gains(g, p, self.dt)
         self.n = n
+        self.law = law
         self.weights = p
         self.gains = np.ascontiguousarray(g, dtype=float)
         self.known_linear_play = bool(known_linear_play)
@@ -168,8 +218,29 @@ class RadiusEstimator:
         msg = _lib.pim_est_set_slope_check(self._buf, int(slope_window), float(slope_tol))
         if msg:
             raise ValueError(msg.decode())
-        self._state_size = 3 * n + 10 + 2 * EST_WINDOW
+        _lib.pim_est_set_law(self._buf, LAWS[law])
+        self._state_size = 4 * n + 17 + 2 * EST_WINDOW + 2 * EST_BINS
         self._initial = self.state
+
+    @classmethod
+    def for_record(cls, v, y, weights, *, dt: float, **options) -> RadiusEstimator:
+        """An estimator with the settings :func:`default_settings` picks from ``(v, y)``.
+
+        ``v``, ``y`` may be the first part of a longer record (e.g. the first chunk of a
+        stream); ``options`` (e.g. ``initial_radii``, ``law``) override or add keywords.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> v = 30 * np.sin(2 * np.pi * np.arange(0, 5, 1e-3))
+        >>> est = RadiusEstimator.for_record(v, 2 * v, [1.0, 1.0], dt=1e-3)
+        >>> float(est.gains[0])
+        10.0
+        """
+        auto = default_settings(v, y, weights, dt=dt)
+        kw = {k: auto[k] for k in ("gains", "guard", "threshold", "slope_window")}
+        kw.update(options)
+        return cls(weights, dt=dt, **kw)
 
     @property
     def radii(self) -> np.ndarray:
@@ -215,25 +286,81 @@ class RadiusEstimator:
         bad = _lib.pim_est_run(self._buf, N, x, m, R, yhat, e, ed, used)
         if bad >= 0:  # unreachable after validation; kept as a guard
             raise ValueError(f"v, y: sample {bad} is not finite")
-        return RadiusEstimate(self.radii, R, e, ed, yhat, used.astype(bool), self.dt)
+        mean = R[N // 2:].mean(axis=0) if N >= MIN_MEAN_SAMPLES else None
+        return RadiusEstimate(self.radii, R, e, ed, yhat, used.astype(bool), self.dt, mean)
 
 
-def estimate_radii(v, y, weights, *, dt: float, gains=10.0, initial_radii=None,
-                   known_linear_play: bool = False, threshold: float = 0.0,
+def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
+                   known_linear_play: bool = False, threshold: float | None = None,
                    max_step: float | None = None, anneal_time: float | None = None,
-                   guard: float = 0.0, slope_window: int = 8, slope_tol: float = 0.5,
-                   initial_state: float = 0.0) -> RadiusEstimate:
+                   guard: float | None = None, slope_window: int | None = None,
+                   slope_tol: float = 0.5, initial_state: float = 0.0, law: str = "data",
+                   warn: bool = False) -> RadiusEstimate:
     """Estimate the play radii from a record ``(v[k], y[k])``, k = 0..N-1, sampled every ``dt``.
 
     Runs :class:`RadiusEstimator` over the arrays (the C batch loop); see the module docstring
-    for the law and its options. Returns a :class:`RadiusEstimate`.
+    for the law.
+
+    Parameters
+    ----------
+    v, y : array_like
+        Input [input unit] and measured output [output unit], equal lengths >= 2.
+    weights : array_like
+        Known play weights p_j > 0.
+    dt : float
+        Sample time [s].
+    gains, threshold, guard, slope_window : optional
+        None (default): chosen from the record by
+        :func:`pimodel.estimator_settings.default_settings` (noise level, input range, dt).
+    initial_radii : array_like, optional
+        Start (default all 0); any start converges under ``law="data"``.
+    known_linear_play, max_step, anneal_time, slope_tol, initial_state, law
+        As for :class:`RadiusEstimator`.
+    warn : bool
+        Issue a ``UserWarning`` when the health report fails.
+
+    Returns
+    -------
+    RadiusEstimate
+        With ``radii`` (final), ``radii_mean`` (mean over the last half), ``health`` and the
+        ``settings`` used.
+
+    Raises
+    ------
+    ValueError
+        Bad arrays or parameters (the message names the argument).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pimodel import PIOperator
+    >>> p, r = [0.3, 0.5, 0.8, 0.3, 0.2], [0.4, 1, 1.5, 2, 3.6]
+    >>> v = 30 * np.sin(2 * np.pi * np.arange(0, 150, 1e-3))
+    >>> res = estimate_radii(v, PIOperator(p, r).simulate(v), p, dt=1e-3,
+    ...                      initial_radii=[2] * 5)
+    >>> np.round(res.radii, 2), res.health.ok
+    (array([0.4, 1. , 1.5, 2. , 3.6]), True)
     """
-    est = RadiusEstimator(weights, dt=dt, gains=gains, initial_radii=initial_radii,
-                          known_linear_play=known_linear_play, threshold=threshold,
-                          max_step=max_step, anneal_time=anneal_time, guard=guard,
-                          slope_window=slope_window, slope_tol=slope_tol,
-                          initial_state=initial_state)
-    return est.run(v, y)
+    x = as_signal(v, "v", min_length=2)
+    m = as_signal(y, "y", min_length=2)
+    if x.size != m.size:
+        raise ValueError(f"v and y: expected equal lengths, got {x.size} and {m.size}")
+    auto = (default_settings(x, m, weights, dt=dt) if x.size >= 3 and any(
+            a is None for a in (gains, threshold, guard, slope_window)) else
+            {"gains": 10.0, "guard": 0.0, "threshold": 0.0, "slope_window": 8})
+    settings = {"gains": auto["gains"] if gains is None else gains,
+                "threshold": auto["threshold"] if threshold is None else threshold,
+                "guard": auto["guard"] if guard is None else guard,
+                "slope_window": auto["slope_window"] if slope_window is None else slope_window}
+    est = RadiusEstimator(weights, dt=dt, initial_radii=initial_radii,
+                          known_linear_play=known_linear_play, max_step=max_step,
+                          anneal_time=anneal_time, slope_tol=slope_tol,
+                          initial_state=initial_state, law=law, **settings)
+    res = est.run(x, m)
+    res.health = estimator_health(x, est.weights, res.history, linear_play=known_linear_play,
+                                  y=m, error=res.error, warn=warn)
+    res.settings = {**settings, "law": law}
+    return res
 
 
 def stream_tail_average(estimator: RadiusEstimator, chunks: Iterable[tuple], *, total: int,

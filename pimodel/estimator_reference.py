@@ -1,12 +1,15 @@
 """Plain NumPy specification of the radius estimator (one Python step per sample).
 
-Implements exactly the law of :mod:`pimodel.estimator` / ``fmu/src/pim_estimator.c``; a test
-holds the two equal to 1e-12. Slow on purpose: it is the readable version.
+Implements exactly the laws of :mod:`pimodel.estimator` / ``fmu/src/pim_estimator.c``
+(``law="data"`` and ``law="paper"``); a test holds the two equal to 1e-12. Slow on purpose: it
+is the readable version.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+BINS = 256  # PIM_EST_BINS
 
 
 def project_ordered_reference(x: np.ndarray, w: np.ndarray, fix_first: bool) -> np.ndarray:
@@ -27,9 +30,70 @@ def project_ordered_reference(x: np.ndarray, w: np.ndarray, fix_first: bool) -> 
     return x
 
 
+class BranchProfile:
+    """Pooled branch slopes over travel bins and the regime table fitted to them (data law)."""
+
+    def __init__(self, p: np.ndarray, linear_play: bool):
+        self.levels = np.concatenate([[0.0], np.cumsum(p)])  # P_0 = 0, P_i = p_1 + ... + p_i
+        self.imin = 1 if linear_play else 0
+        self.S = np.zeros(BINS)  # sum of s * output change per bin
+        self.C = np.zeros(BINS)  # sum of travel per bin
+        self.width = 0.0
+        self.top = -1
+        self.edge = np.full(p.size, -1.0)
+        self.fitted = False
+
+    def add(self, x0: float, x1: float, dy: float) -> None:
+        """Spread the branch piece [x0, x1] with output change dy over the bins it covers."""
+        while x1 >= BINS * self.width:  # merge bins in pairs
+            self.S[: BINS // 2] = self.S[0::2] + self.S[1::2]
+            self.C[: BINS // 2] = self.C[0::2] + self.C[1::2]
+            self.S[BINS // 2:] = 0.0
+            self.C[BINS // 2:] = 0.0
+            self.width *= 2.0
+            self.top = self.top // 2 if self.top >= 0 else -1
+        w, span = self.width, x1 - x0
+        b1 = min(int(x1 / w), BINS - 1)
+        b0 = min(int(x0 / w), b1)
+        for b in range(b0, b1 + 1):
+            lo, hi = max(b * w, x0), min((b + 1) * w, x1)
+            part = span if b0 == b1 else (hi - lo if hi > lo else 0.0)
+            self.S[b] += dy * (part / span)
+            self.C[b] += part
+        self.top = max(self.top, b1)
+
+    def fit(self) -> None:
+        """Non-decreasing count per bin minimising sum C_b (S_b/C_b - P_i)^2; edges from it."""
+        if self.top < 0:
+            return
+        P, n1 = self.levels, self.levels.size
+        big = 1e300
+        f = [big if i < self.imin else self.C[0] * P[i] * P[i] - 2.0 * self.S[0] * P[i]
+             for i in range(n1)]
+        back = np.zeros((self.top + 1, n1), dtype=int)
+        for b in range(1, self.top + 1):
+            best, arg = big, 0
+            for i in range(n1):
+                if f[i] < best:
+                    best, arg = f[i], i
+                back[b, i] = arg
+                f[i] = big if i < self.imin else (best + self.C[b] * P[i] * P[i]
+                                                  - 2.0 * self.S[b] * P[i])
+        i = self.imin
+        for k in range(self.imin, n1):
+            if f[k] < f[i]:
+                i = k
+        self.edge[:] = -1.0
+        for b in range(self.top, -1, -1):
+            self.edge[:i] = b * self.width
+            if b > 0:
+                i = back[b, i]
+        self.fitted = True
+
+
 def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_linear_play=False,
                              threshold=0.0, max_step=None, anneal_time=None, guard=0.0,
-                             slope_window=8, slope_tol=0.5, initial_state=0.0):
+                             slope_window=8, slope_tol=0.5, initial_state=0.0, law="data"):
     """Returns ``(history, yhat, e, e_delta, used, final radii)`` as in the C batch loop."""
     p = np.asarray(weights, float)
     n = p.size
@@ -38,10 +102,12 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
     rhat = project_ordered_reference(np.asarray(initial_radii, float), w, known_linear_play)
     zhat = np.full(n, float(initial_state))
     sat = np.zeros(n)
+    prof = BranchProfile(p, known_linear_play)
     started = False
     direction = 0.0
     have_rev = False
-    v_first = v_start = v_ext = v_rev = 0.0
+    v_first = v_start = v_ext = v_rev = y_ext = 0.0
+    t_prev = x_last = y_last = 0.0
     time = 0.0
     nseg = 0
     past_v: list[float] = []  # inputs and outputs before sample k
@@ -56,53 +122,49 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
         e[k] = yhat[k] - yk
         usable = False
         if not started:
-            started, v_first, v_start, v_ext = True, vk, vk, vk
+            started, v_first, v_start, v_ext, y_ext = True, vk, vk, vk, yk
         elif direction == 0.0:
             if abs(vk - v_first) > threshold:
                 direction = 1.0 if vk > v_first else -1.0
-                v_ext = vk
+                v_ext, y_ext = vk, yk
         elif direction * (vk - v_ext) >= 0.0:
             if direction * (vk - v_ext) > 0.0:
-                v_ext = vk
+                v_ext, y_ext = vk, yk
             usable = have_rev
         elif abs(vk - v_ext) > threshold:
-            travel = abs(v_ext - v_start)
-            sat = (travel >= 2.0 * rhat + guard).astype(float)
+            t_prev = abs(v_ext - v_start)
+            sat = (t_prev >= 2.0 * rhat + guard).astype(float)
             v_rev = v_start = v_ext
             have_rev = True
             direction = -direction
-            v_ext = vk
+            x_last, y_last = 0.0, y_ext
+            v_ext, y_ext = vk, yk
             nseg = 0
             usable = True
-        if usable and slope_window > 0:
-            m = slope_window
-            if nseg < m + 1:
-                usable = False
-            else:
-                da, db = abs(past_v[-1 - m] - v_rev), abs(past_v[-1] - v_rev)
-                if db - da > 0:
-                    model = sum(p[j] * max(0.0, db - max(da, 2.0 * rhat[j])) for j in range(n))
-                    meas = direction * (past_y[-1] - past_y[-1 - m])
-                    usable = abs(meas - model) <= slope_tol * p.min() * (db - da)
+            if law == "data":
+                if prof.width == 0.0:
+                    prof.width = 2.2 * t_prev / BINS
+                prof.fit()
         if usable:
             s, d = direction, abs(vk - v_rev)
-            phi = np.empty(n)
-            ybar = 0.0
-            valid = True
-            for j in range(n):
-                if abs(d - 2.0 * rhat[j]) < guard:
-                    valid = False
-                    break
-                if d >= 2.0 * rhat[j]:
-                    phi[j] = p[j]
-                    ybar += p[j] * (vk - s * rhat[j])
-                else:
-                    if sat[j] == 0.0:
-                        valid = False
-                        break
-                    phi[j] = -p[j]
-                    ybar += p[j] * (v_rev + s * rhat[j])
-            if valid:
+            if law == "data":
+                if d > x_last:
+                    if d <= t_prev:
+                        top = prof.top
+                        prof.add(x_last, d, s * (yk - y_last))
+                        if prof.top > top:  # the profile grew
+                            prof.fit()
+                    x_last, y_last = d, yk
+                on = _regime_data(prof, rhat, sat, d, guard, t_prev)
+            else:
+                on = _regime_paper(rhat, sat, d, guard) if _slope_ok(
+                    p, rhat, past_v, past_y, nseg, slope_window, slope_tol, v_rev,
+                    direction) else None
+            if on is not None:
+                phi = np.where(on, p, -p)
+                ybar = 0.0
+                for j in range(n):  # sequential sum, as in C
+                    ybar += p[j] * (vk - s * rhat[j]) if on[j] else p[j] * (v_rev + s * rhat[j])
                 err = ybar - yk
                 scale = 1.0 / (1.0 + time / anneal_time) if anneal_time else 1.0
                 step = dt * g * scale * err * s * phi
@@ -116,3 +178,58 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
         past_v.append(vk)
         past_y.append(yk)
     return hist, yhat, e, ed, used.astype(bool), rhat
+
+
+def _regime_data(prof: BranchProfile, rhat, sat, d, guard, t_prev):
+    """Plays on their envelope at travel d under the data law, or None (sample not used)."""
+    if not prof.fitted:
+        return None
+    g = max(guard, prof.width)
+    partial = (prof.top + 1.0) * prof.width < t_prev
+    on = np.zeros(rhat.size, dtype=bool)
+    for j, b in enumerate(prof.edge):
+        if b < 0.0 and partial:  # breakpoint not profiled yet: the paper's rule
+            if abs(d - 2.0 * rhat[j]) < guard:
+                return None
+            on[j] = d >= 2.0 * rhat[j]
+            if not on[j] and sat[j] == 0.0:
+                return None
+            continue
+        if b < 0.0:
+            on[j] = False
+        elif abs(d - b) >= g:
+            on[j] = d >= b
+        else:
+            b2 = 2.0 * rhat[j]
+            if abs(b2 - b) >= g or abs(d - b2) < guard:
+                return None
+            on[j] = d >= b2
+        if not on[j] and (b < 0.0 or b + g > t_prev):
+            return None
+    if not on.all() and d >= (prof.top + 1.0) * prof.width:
+        return None
+    return on
+
+
+def _regime_paper(rhat, sat, d, guard):
+    """Plays on their envelope at travel d under the paper's law, or None."""
+    if np.any(np.abs(d - 2.0 * rhat) < guard):
+        return None
+    on = d >= 2.0 * rhat
+    if np.any(~on & (sat == 0.0)):
+        return None
+    return on
+
+
+def _slope_ok(p, rhat, past_v, past_y, nseg, m, tol, v_rev, direction) -> bool:
+    """The paper law's slope check over the m samples before k."""
+    if m == 0:
+        return True
+    if nseg < m + 1:
+        return False
+    da, db = abs(past_v[-1 - m] - v_rev), abs(past_v[-1] - v_rev)
+    if db - da <= 0:
+        return True
+    model = sum(p[j] * max(0.0, db - max(da, 2.0 * rhat[j])) for j in range(p.size))
+    meas = direction * (past_y[-1] - past_y[-1 - m])
+    return abs(meas - model) <= tol * p.min() * (db - da)

@@ -24,12 +24,14 @@ from .branches import find_reversals
 from .checks import as_signal, positive_scalar
 from .conventional import fit_conventional
 from .estimator import RadiusEstimator, run_tail_average
+from .estimator_health import EstimatorHealth, estimator_health
 from .excitation import ExcitationReport, check_excitation
 from .joint import JointEstimator
 from .operator import PIOperator
 from .slopes import SlopeIdentification, identify_slopes
 
 METHODS = ("adaptive", "conventional", "joint")
+HISTORY_LIMIT = 2_000_000  # samples (record x passes) up to which the estimate history is kept
 
 
 @dataclass
@@ -45,6 +47,7 @@ class Identification:
     excitation: ExcitationReport
     slopes: SlopeIdentification | None = None
     settings: dict = field(default_factory=dict)
+    health: EstimatorHealth | None = None  # adaptive method: the radius estimate's health
 
     @property
     def weights(self) -> np.ndarray:
@@ -75,6 +78,7 @@ class Identification:
             "excitation": self.excitation.to_json(),
             "slopes": self.slopes.to_json() if self.slopes else None,
             "settings": self.settings,
+            "health": self.health.to_json() if self.health else None,
         }
 
     def save_json(self, path) -> Path:
@@ -101,7 +105,8 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     conventional: default 10). ``gains``: estimator gains (default ``20 / sum p_i^2``, a
     convergence rate of about 20/s whatever the units). ``passes``: repetitions of the record
     (default: enough for 200 s of adaptation, at least 3). ``guard``: estimator breakpoint
-    guard (default 0.2 % of the input range).
+    guard (default 0.2 % of the input range). The adaptive method reports the health of its
+    radius estimate (``health``, :mod:`pimodel.estimator_health`) and warns when it fails.
     """
     v = as_signal(v, "v", min_length=10)
     y = as_signal(y, "y", min_length=10)
@@ -140,12 +145,23 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard
     est = RadiusEstimator(p, dt=dt, gains=g, initial_radii=slopes.radii_guess,
                           known_linear_play=slopes.linear_play, guard=guard_)
-    _, radii = run_tail_average(est, vv, yy, tail=0.5)
+    if vv.size <= HISTORY_LIMIT:  # keep the history for the health report
+        run = est.run(vv, yy)
+        radii = run.history[vv.size // 2:].mean(axis=0)
+        health = estimator_health(vv, p, run.history, linear_play=slopes.linear_play, y=yy,
+                                  error=run.error)
+    else:  # long record: bounded memory, health from the final mean only
+        _, radii = run_tail_average(est, vv, yy, tail=0.5)
+        health = estimator_health(v, p, radii[None, :], linear_play=slopes.linear_play)
+    if not health.ok:
+        warnings.warn("identify: radius estimate health: " + "; ".join(health.messages),
+                      UserWarning, stacklevel=2)
     op = PIOperator(p, radii)
     offset, rms, mx = _errors(op, v, y)
     settings = {"gains": np.broadcast_to(g, p.shape).tolist(), "passes": passes,
                 "guard": guard_, "radii_from": "average of the estimate over the last half"}
-    return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings)
+    return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings,
+                          health)
 
 
 def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification) -> Identification:

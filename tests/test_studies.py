@@ -14,7 +14,8 @@ from pimodel.study_runner import available_studies, run_study
 
 def test_all_studies_are_listed():
     assert set(available_studies()) >= {"paper_simulation", "paper_experiment", "compensation",
-                                        "cosimulation", "sim_to_real", "real_data", "limit_cycle"}
+                                        "cosimulation", "sim_to_real", "real_data", "limit_cycle",
+                                        "convergence_map"}
 
 
 def _run(name, tmp_path):
@@ -121,3 +122,12 @@ def test_limit_cycle(tmp_path):
     assert "stable" in kinds  # a limit cycle actually exists in one case
     assert n["no compensation, moderate"]["circle_criterion"]["holds"]
     assert n["inverse (radii 20 % low), moderate"]["circle_criterion"]["holds"]
+
+
+def test_convergence_map(tmp_path):
+    """Quick grid (1 kHz, 60 s): every clean cell, from every start (up to 6x the truth, all
+    zero, all equal) and on every input, is within 10 % after 60 s (the full size, 150 s,
+    reaches 0.06 %)."""
+    res = _run("convergence_map", tmp_path)
+    assert res.numbers["cases"] == 7 * 4 * 4
+    assert res.numbers["clean_worst"] < 0.10

@@ -12,14 +12,28 @@
  *      declared once v has moved back from the running extreme by more than the threshold h;
  *      samples within h of the extreme are not used.  Holds (v[k] == v[k-1]) keep s and are
  *      used.
- *   3. principal case from the input travel d = |v[k] - v_rev|: play j on its envelope iff
+ *   3. principal case at the input travel d = |v[k] - v_rev|: which plays are on their envelope.
+ *      law PIM_LAW_DATA (default): from the measured branches.  For d <= t_prev (travel of
+ *      the segment before the reversal) the branch increment is s (y - y_rev) =
+ *      sum_j p_j max(0, d - 2 r_j) for any history (Madelung), slopes P_i = p_1 + .. + p_i.
+ *      The increments s (y[k] - y[k-1]) are pooled in PIM_EST_BINS travel bins (width set at
+ *      the first reversal to 2.2 t_prev / PIM_EST_BINS, doubled by merging pairs as the travel
+ *      grows); at each reversal, and whenever the profile reaches a new bin, the
+ *      non-decreasing count of saturated plays per bin minimising sum_b C_b (S_b/C_b - P_i)^2
+ *      is fitted (dynamic programme) and gives breakpoints edge_j.  Play j is on iff
+ *      d >= edge_j; within g = max(guard, bin width) of edge_j the estimate decides
+ *      (d >= 2 rhat_j) if |2 rhat_j - edge_j| < g and |d - 2 rhat_j| >= guard, else the sample
+ *      is skipped; an interior play needs edge_j + g <= t_prev (saturated at the reversal);
+ *      beyond the profiled travel only the all-on case is used; while the profile does not
+ *      cover t_prev, a play not yet profiled follows the paper's rule below.
+ *      law PIM_LAW_PAPER: from the estimate, play j on its envelope iff
  *      d >= 2 rhat_j[k] (no noisy slope is differenced).  The sample is used only when every
  *      interior play was saturated at the reversal (else its state is unknown: minor loops),
  *      and only when d is at least `guard` away from every breakpoint 2 rhat_j (a sample near a
  *      breakpoint may be misclassified, which biases the estimate under noise).
- *      Slope check (slope_window m > 0): the measured output change over the m samples before
- *      k (within the segment; y[k] itself is not used, so the choice does not correlate with
- *      the current noise) must match the case model's change within slope_tol * min p_j per
+ *      Slope check (slope_window m > 0, paper law only): the measured output change over the
+ *      m samples before k (within the segment; y[k] itself is not used, so the choice does not
+ *      correlate with the current noise) must match the case model's change within slope_tol * min p_j per
  *      unit of travel; otherwise the regime read from rhat is wrong (an overestimated radius
  *      whose true play is already on its envelope) and the sample is skipped.  Without this
  *      check a radius overestimate can run away.
@@ -42,7 +56,10 @@
 extern "C" {
 #endif
 
-#define PIM_EST_WIN 64 /* ring buffer for the slope check (max window + 1) */
+#define PIM_EST_WIN 64    /* ring buffer for the slope check (max window + 1) */
+#define PIM_EST_BINS 256  /* bins of the branch slope profile (law PIM_LAW_DATA) */
+#define PIM_LAW_DATA 0    /* regime from the measured branch profile (default) */
+#define PIM_LAW_PAPER 1   /* regime from the estimate, as in the paper */
 
 typedef struct {
     /* parameters */
@@ -57,6 +74,7 @@ typedef struct {
     int known_linear;   /* rhat_1 fixed at 0 */
     int slope_window;   /* samples of the slope check window (0: no check) */
     double slope_tol;   /* tolerated slope mismatch, in units of the smallest weight */
+    int law;            /* PIM_LAW_DATA or PIM_LAW_PAPER */
     /* state (see pim_est_get_state for the flat layout) */
     double rhat[PIM_MAX_PLAYS];
     double zhat[PIM_MAX_PLAYS];
@@ -72,10 +90,21 @@ typedef struct {
     double nseg;     /* samples seen since the last reversal */
     double head;     /* ring buffer position */
     double vbuf[PIM_EST_WIN], ybuf[PIM_EST_WIN]; /* last inputs and outputs */
+    /* branch profile (law PIM_LAW_DATA) */
+    double t_prev;   /* input travel of the segment that ended at the last reversal */
+    double y_ext;    /* output at the running extreme v_ext */
+    double x_last;   /* travel of the last profiled point of the current branch */
+    double y_last;   /* output there */
+    double width;    /* bin width [input unit], 0 until the first reversal */
+    double top;      /* highest bin with data, -1 if none */
+    double fitted;   /* 1 once the regime table has been fitted */
+    double edge[PIM_MAX_PLAYS];  /* fitted breakpoints: travel where play j joins (inf: never) */
+    double S[PIM_EST_BINS];      /* sum of s * (output change) per travel bin */
+    double C[PIM_EST_BINS];      /* sum of travel per bin */
 } pim_estimator;
 
-/* Flat state length: 3n + 10 + 2 PIM_EST_WIN doubles. */
-#define PIM_EST_STATE_SIZE(n) (3 * (n) + 10 + 2 * PIM_EST_WIN)
+/* Flat state length: 4n + 17 + 2 PIM_EST_WIN + 2 PIM_EST_BINS doubles. */
+#define PIM_EST_STATE_SIZE(n) (4 * (n) + 17 + 2 * PIM_EST_WIN + 2 * PIM_EST_BINS)
 
 /*
  * Initialise: n plays with weights p (> 0), gains (>= 0), initial radii rhat0 (projected onto
@@ -106,6 +135,9 @@ PIM_API void pim_est_get_state(const pim_estimator *est, double *state);
 /* Slope check settings (see above); window 0 disables it, at most PIM_EST_WIN - 1.  Returns
  * NULL or a message.  pim_est_init sets window 8, tolerance 0.5. */
 PIM_API const char *pim_est_set_slope_check(pim_estimator *est, int window, double tol);
+
+/* Law: PIM_LAW_DATA (set by pim_est_init) or PIM_LAW_PAPER.  Returns NULL or a message. */
+PIM_API const char *pim_est_set_law(pim_estimator *est, int law);
 
 /* Returns NULL or a message if the state is not admissible (non-finite, unordered radii). */
 PIM_API const char *pim_est_set_state(pim_estimator *est, const double *state);

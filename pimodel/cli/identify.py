@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 from ..data import load_record
 from .common import add_columns_option, float_list
@@ -48,5 +49,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"figure: {path}")
     print(json.dumps({k: idn.to_json()[k] for k in ("method", "weights", "radii", "fit")},
                      indent=1))
+    if idn.health is not None and not idn.health.ok:
+        for msg in idn.health.messages:
+            print(f"warning: radius estimate: {msg}", file=sys.stderr)
     print(f"wrote {args.json}")
     return 0
