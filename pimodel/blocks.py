@@ -458,16 +458,8 @@ def _estimator_signature() -> dict[str, object]:
     sig = inspect.signature(RadiusEstimator.__init__).parameters
     out = {k: p.default for k, p in sig.items()
            if p.kind is inspect.Parameter.KEYWORD_ONLY and k != "dt"}
-    if "linear_play" in out:
-        out.pop("known_linear_play", None)
-    elif "known_linear_play" in out:
-        out["linear_play"] = out.pop("known_linear_play")
+    out.pop("known_linear_play", None)  # deprecated alias of linear_play
     return out
-
-
-def _linear_play_keyword() -> str:
-    sig = inspect.signature(RadiusEstimator.__init__).parameters
-    return "linear_play" if "linear_play" in sig else "known_linear_play"
 
 
 def radius_estimator(weights, *, dt: float, **settings) -> RadiusEstimator:
@@ -493,9 +485,6 @@ def radius_estimator(weights, *, dt: float, **settings) -> RadiusEstimator:
     >>> radius_estimator([1.0, 0.5], dt=1e-3, initial_radii=[0.1, 0.3], linear_play=True).radii
     array([0. , 0.3])
     """
-    settings = dict(settings)
-    if "linear_play" in settings:
-        settings[_linear_play_keyword()] = settings.pop("linear_play")
     return RadiusEstimator(weights, dt=dt, **settings)
 
 

@@ -43,7 +43,7 @@ input ``v[k]`` (input unit, e.g. V) and measured output ``y[k]`` (output unit, e
    ``gain_j(t) = gains_j / (1 + t / anneal_time)`` (constant when ``anneal_time`` is None),
    optionally clipped to ``max_step`` per sample; ``Proj`` is the projection (weighted by
    ``1/gains``) onto ``0 <= rhat_1 <= ... <= rhat_n``, with ``rhat_1 = 0`` held when
-   ``known_linear_play``.
+   ``linear_play``.
 
 The discrete law is stable when ``dt * gains_j * |p|^2 < 2``
 (:func:`pimodel.estimator_settings.stability_bound`; a larger gain gives a warning).
@@ -55,6 +55,7 @@ of the result (:mod:`pimodel.estimator_health`).
 from __future__ import annotations
 
 import ctypes
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 
@@ -139,6 +140,15 @@ class RadiusEstimate:
 MIN_MEAN_SAMPLES = 1000  # radii_mean needs a record at least this long
 
 
+def _renamed_linear_play(linear_play: bool, known_linear_play: bool | None, where: str) -> bool:
+    """``linear_play``, or the deprecated ``known_linear_play`` when that was given."""
+    if known_linear_play is None:
+        return linear_play
+    warnings.warn(f"{where}: known_linear_play is deprecated; use linear_play",
+                  DeprecationWarning, stacklevel=3)
+    return bool(known_linear_play)
+
+
 class RadiusEstimator:
     """Streaming radius estimator: :meth:`step` takes one sample ``(v[k], y[k])``.
 
@@ -146,7 +156,8 @@ class RadiusEstimator:
     ``gains`` (scalar or per play, >= 0; the paper's Lambda diagonal; above the stability
     bound ``2 / (dt |p|^2)`` a ``UserWarning`` is issued), ``law`` (``"data"``: regime from the
     measured branches, the default; ``"paper"``: regime from the estimate), ``initial_radii``
-    (projected onto the ordered set), ``known_linear_play`` (hold rhat_1 = 0), ``threshold``
+    (projected onto the ordered set), ``linear_play`` (hold rhat_1 = 0; the old name
+    ``known_linear_play`` is deprecated), ``threshold``
     (reversal threshold, input unit), ``max_step`` (per-sample clip of the update, input unit),
     ``guard`` (breakpoint guard band, input unit), ``slope_window`` and ``slope_tol`` (the slope
     check: samples, 0 to disable; tolerance in units of the smallest weight),
@@ -166,10 +177,12 @@ class RadiusEstimator:
     """
 
     def __init__(self, weights, *, dt: float, gains=10.0, initial_radii=None,
-                 known_linear_play: bool = False, threshold: float = 0.0,
+                 linear_play: bool = False, threshold: float = 0.0,
                  max_step: float | None = None, anneal_time: float | None = None,
                  guard: float = 0.0, slope_window: int = 8, slope_tol: float = 0.5,
-                 initial_state: float = 0.0, law: str = "data"):
+                 initial_state: float = 0.0, law: str = "data",
+                 known_linear_play: bool | None = None):
+        linear_play = _renamed_linear_play(linear_play, known_linear_play, "RadiusEstimator")
         p = as_vector(weights, "weights")
         n = p.size
         if n > MAX_PLAYS:
@@ -206,11 +219,11 @@ class RadiusEstimator:
         self.law = law
         self.weights = p
         self.gains = np.ascontiguousarray(g, dtype=float)
-        self.known_linear_play = bool(known_linear_play)
+        self.linear_play = bool(linear_play)
         self._buf = ctypes.create_string_buffer(_lib.pim_est_sizeof())
         msg = _lib.pim_est_init(self._buf, n, p, self.gains, np.ascontiguousarray(r0), self.dt,
                                 float(initial_state), float(threshold), ms, at, float(guard),
-                                int(self.known_linear_play))
+                                int(self.linear_play))
         if msg:
             raise ValueError(msg.decode())
         if int(slope_window) != slope_window:
@@ -291,11 +304,11 @@ class RadiusEstimator:
 
 
 def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
-                   known_linear_play: bool = False, threshold: float | None = None,
+                   linear_play: bool = False, threshold: float | None = None,
                    max_step: float | None = None, anneal_time: float | None = None,
                    guard: float | None = None, slope_window: int | None = None,
                    slope_tol: float = 0.5, initial_state: float = 0.0, law: str = "data",
-                   warn: bool = False) -> RadiusEstimate:
+                   warn: bool = False, known_linear_play: bool | None = None) -> RadiusEstimate:
     """Estimate the play radii from a record ``(v[k], y[k])``, k = 0..N-1, sampled every ``dt``.
 
     Runs :class:`RadiusEstimator` over the arrays (the C batch loop); see the module docstring
@@ -314,10 +327,12 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
         :func:`pimodel.estimator_settings.default_settings` (noise level, input range, dt).
     initial_radii : array_like, optional
         Start (default all 0); any start converges under ``law="data"``.
-    known_linear_play, max_step, anneal_time, slope_tol, initial_state, law
+    linear_play, max_step, anneal_time, slope_tol, initial_state, law
         As for :class:`RadiusEstimator`.
     warn : bool
         Issue a ``UserWarning`` when the health report fails.
+    known_linear_play : bool, optional
+        Deprecated name of ``linear_play``.
 
     Returns
     -------
@@ -341,6 +356,7 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
     >>> np.round(res.radii, 2), res.health.ok
     (array([0.4, 1. , 1.5, 2. , 3.6]), True)
     """
+    linear_play = _renamed_linear_play(linear_play, known_linear_play, "estimate_radii")
     x = as_signal(v, "v", min_length=2)
     m = as_signal(y, "y", min_length=2)
     if x.size != m.size:
@@ -353,11 +369,11 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
                 "guard": auto["guard"] if guard is None else guard,
                 "slope_window": auto["slope_window"] if slope_window is None else slope_window}
     est = RadiusEstimator(weights, dt=dt, initial_radii=initial_radii,
-                          known_linear_play=known_linear_play, max_step=max_step,
+                          linear_play=linear_play, max_step=max_step,
                           anneal_time=anneal_time, slope_tol=slope_tol,
                           initial_state=initial_state, law=law, **settings)
     res = est.run(x, m)
-    res.health = estimator_health(x, est.weights, res.history, linear_play=known_linear_play,
+    res.health = estimator_health(x, est.weights, res.history, linear_play=linear_play,
                                   y=m, error=res.error, warn=warn)
     res.settings = {**settings, "law": law}
     return res

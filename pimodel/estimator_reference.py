@@ -91,7 +91,7 @@ class BranchProfile:
         self.fitted = True
 
 
-def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_linear_play=False,
+def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, linear_play=False,
                              threshold=0.0, max_step=None, anneal_time=None, guard=0.0,
                              slope_window=8, slope_tol=0.5, initial_state=0.0, law="data"):
     """Returns ``(history, yhat, e, e_delta, used, final radii)`` as in the C batch loop."""
@@ -99,10 +99,10 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
     n = p.size
     g = np.broadcast_to(np.asarray(gains, float), (n,)).copy()
     w = 1.0 / np.maximum(g, 1e-300)
-    rhat = project_ordered_reference(np.asarray(initial_radii, float), w, known_linear_play)
+    rhat = project_ordered_reference(np.asarray(initial_radii, float), w, linear_play)
     zhat = np.full(n, float(initial_state))
     sat = np.zeros(n)
-    prof = BranchProfile(p, known_linear_play)
+    prof = BranchProfile(p, linear_play)
     started = False
     direction = 0.0
     have_rev = False
@@ -170,7 +170,7 @@ def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, known_l
                 step = dt * g * scale * err * s * phi
                 if max_step:
                     step = np.clip(step, -max_step, max_step)
-                rhat = project_ordered_reference(rhat + step, w, known_linear_play)
+                rhat = project_ordered_reference(rhat + step, w, linear_play)
                 ed[k] = err
                 used[k] = 1.0
         time += dt

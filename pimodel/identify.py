@@ -144,7 +144,7 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     yy = np.concatenate([y] + [y[first:]] * (passes - 1)) - offset
     guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard
     est = RadiusEstimator(p, dt=dt, gains=g, initial_radii=slopes.radii_guess,
-                          known_linear_play=slopes.linear_play, guard=guard_)
+                          linear_play=slopes.linear_play, guard=guard_)
     if vv.size <= HISTORY_LIMIT:  # keep the history for the health report
         run = est.run(vv, yy)
         radii = run.history[vv.size // 2:].mean(axis=0)

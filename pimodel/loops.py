@@ -156,8 +156,7 @@ def run_loop(ref, plant: PIOperator, dt: float, *, dynamics=None, feedforward="n
     elif feedforward == "adaptive":
         if not isinstance(estimator, RadiusEstimator):
             raise ValueError("estimator: feedforward='adaptive' needs a RadiusEstimator")
-        holds_r1 = getattr(estimator, "linear_play", None)  # the name before: known_linear_play
-        if not (estimator.known_linear_play if holds_r1 is None else holds_r1):
+        if not estimator.linear_play:
             raise ValueError("estimator: the adaptive inverse needs linear_play=True")
         nm = estimator.n
         L.ff_mode, L.nm = 2, nm

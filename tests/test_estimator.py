@@ -131,7 +131,7 @@ def test_paper_law_overestimated_radii_do_not_run_away():
     without it the estimate runs away above the input travel and freezes there."""
     t, v = triangle(1, 1, fs=1000, duration=60)
     y = PIOperator(STAGE_P, STAGE_R).simulate(v)
-    kw = dict(dt=1e-3, gains=20, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True,
+    kw = dict(dt=1e-3, gains=20, initial_radii=[0, 0.3, 0.4, 0.8], linear_play=True,
               law="paper")
     res = estimate_radii(v, y, STAGE_P, **kw)
     assert max_rel_error(res.radii, STAGE_R) < 0.01
@@ -139,12 +139,12 @@ def test_paper_law_overestimated_radii_do_not_run_away():
     assert max_rel_error(bad.radii, STAGE_R) > 0.5
 
 
-def test_piezo_stage_triangle_with_known_linear_play():
+def test_piezo_stage_triangle_with_linear_play():
     """The paper's stage, 1 Hz triangle of 2 V, gains 20, r_1 = 0 known: final estimate."""
     t, v = triangle(2, 1, fs=1000, duration=60)
     y = PIOperator(STAGE_P, STAGE_R).simulate(v)
     res = estimate_radii(v, y, STAGE_P, dt=1e-3, gains=20, initial_radii=[0, 0.5, 0.6, 0.9],
-                         known_linear_play=True)
+                         linear_play=True)
     assert res.radii[0] == 0.0
     assert max_rel_error(res.radii, STAGE_R) < 0.01
     assert np.all(res.history[:, 0] == 0.0)
@@ -274,3 +274,15 @@ def test_step_rejects_nan():
         est.step(np.nan, 0.0)
     with pytest.raises(ValueError, match="state: expected 677 values"):
         est.state = np.zeros(3)
+
+
+def test_known_linear_play_is_a_deprecated_name_of_linear_play():
+    with pytest.warns(DeprecationWarning, match="known_linear_play is deprecated"):
+        est = RadiusEstimator([1.0, 0.5], dt=1e-3, initial_radii=[0.2, 0.3],
+                              known_linear_play=True)
+    assert est.linear_play and est.radii[0] == 0.0
+    v = np.sin(np.linspace(0, 20, 2000))
+    y = PIOperator([1.0, 0.5], [0.0, 0.3]).simulate(v)
+    with pytest.warns(DeprecationWarning, match="known_linear_play is deprecated"):
+        res = estimate_radii(v, y, [1.0, 0.5], dt=1e-3, known_linear_play=True)
+    assert res.radii[0] == 0.0

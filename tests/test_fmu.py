@@ -92,7 +92,7 @@ def test_substepping_matches_operator(fmus, m):
 def test_estimator_fmu_matches_python(fmus):
     t, v = triangle(2, 1, fs=1 / TS, duration=4)
     y = STAGE.simulate(v)
-    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
+    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], linear_play=True)
     ref = estimate_radii(v, y, STAGE.weights, dt=TS, **kw)
     unit = FMUUnit(fmus / "RadiusEstimator.fmu", {
         "Ts": TS, "n": 4, "gain": 20.0, "linear_play": True, **arr("p", STAGE.weights),
@@ -230,7 +230,7 @@ def test_cosimulation_equals_native_interconnection(fmus):
     dt = 1e-4
     t, yd = sinusoid(8, 20, fs=1 / dt, duration=0.05)
     G = stage_dynamics(dt, fn_hz=1000, damping=0.05)
-    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
+    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], linear_play=True)
     co = cosimulate_adaptive_loop(fmus, yd, dt, STAGE, weights=STAGE.weights, gain=20.0,
                                   initial_radii=kw["initial_radii"], dynamics=G)
     est = RadiusEstimator(STAGE.weights, dt=dt, **kw)

@@ -93,7 +93,7 @@ def test_substepping_equals_fmi2(fmus):
 def test_estimator_and_inverse_match_python(fmus):
     t, v = triangle(2, 1, fs=1 / TS, duration=4)
     y = STAGE.simulate(v)
-    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], known_linear_play=True)
+    kw = dict(gains=20.0, initial_radii=[0, 0.3, 0.4, 0.8], linear_play=True)
     ref = estimate_radii(v, y, STAGE.weights, dt=TS, **kw)
     est = FMUUnit(path(fmus, "RadiusEstimator"), {
         "Ts": TS, "n": 4, "gain": 20.0, "linear_play": True, "p": STAGE.weights,
@@ -193,7 +193,7 @@ def test_fmu_block_and_cosimulation(fmus):
     co = cosimulate_adaptive_loop(fmus, yd, dt, STAGE, weights=STAGE.weights, gain=20.0,
                                   initial_radii=r0, dynamics=G, fmi_version="3.0")
     est = RadiusEstimator(STAGE.weights, dt=dt, gains=20.0, initial_radii=r0,
-                          known_linear_play=True)
+                          linear_play=True)
     native = run_loop(yd, STAGE, dt, dynamics=G, feedforward="adaptive", estimator=est)
     np.testing.assert_allclose(co.y, native.y, rtol=0, atol=1e-12)
     plant = fmu_block(path(fmus, "PIHysteresis"), TS, name="plant3",

@@ -99,7 +99,7 @@ def test_radius_estimator_equals_reference(seed, law):
     v = 0.25 * np.round(40 * np.sin(2 * np.pi * k / 900) * (1 + 0.3 * np.sin(k / 170)))
     y = PIOperator(p, r).simulate(v) + rng.normal(0, 0.05, v.size)
     kw = dict(dt=1e-3, gains=rng.uniform(1, 20, n), initial_radii=rng.uniform(0, 4, n),
-              known_linear_play=linear, guard=float(rng.uniform(0, 0.2)), law=law)
+              linear_play=linear, guard=float(rng.uniform(0, 0.2)), law=law)
     a = estimate_radii(v, y, p, threshold=0.0, slope_window=4, **kw)
     hist, yhat, e, ed, used, final = estimate_radii_reference(v, y, p, threshold=0.0,
                                                               slope_window=4, **kw)
