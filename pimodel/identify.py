@@ -27,6 +27,7 @@ from .estimator import RadiusEstimator, run_tail_average
 from .excitation import ExcitationReport, check_excitation
 from .joint import JointEstimator
 from .operator import PIOperator
+from .play_reduction import reduce_plays
 from .slopes import SlopeIdentification, identify_slopes
 
 METHODS = ("adaptive", "conventional", "joint")
@@ -124,7 +125,7 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     slopes = identify_slopes(v, y, n_plays=n_plays, linear_play=linear_play,
                              max_segments=max_segments)
     if method == "joint":
-        return _identify_jointly(v, y, slopes)
+        return _identify_jointly(v, y, slopes, n_plays)
     p = slopes.weights
     exc = check_excitation(v, p, slopes.radii_guess)
     guess = PIOperator(p, slopes.radii_guess)
@@ -148,7 +149,8 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings)
 
 
-def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification) -> Identification:
+def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification,
+                      n_plays: int | None) -> Identification:
     threshold = 0.01 * float(np.ptp(v))
     est = JointEstimator(slopes.weights.size, linear_play=slopes.linear_play,
                          initial_weights=np.maximum(slopes.weights, 0.0),
@@ -156,12 +158,16 @@ def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification)
                          refit_every=1_000_000)  # offline: the first update and the final one
     est.run(v, y)
     res = est.finish()
-    keep = res.weights > 0
-    if not np.all(keep):
-        warnings.warn(f"joint estimation: {int((~keep).sum())} play(s) got weight 0 (no slope "
-                      f"change at their radius) and were dropped; the model has "
-                      f"{int(keep.sum())} plays", RuntimeWarning, stacklevel=3)
-    op = PIOperator(res.weights[keep], res.radii[keep])
+    red = reduce_plays(*est.binned(), res.weights, res.radii, linear_play=slopes.linear_play) \
+        if est.result().update_index.size else None
+    if red is not None and red.changed:
+        asked = f"n_plays={n_plays}" if n_plays is not None else "the slopes' choice"
+        warnings.warn(f"joint estimation: fitted {res.weights.size} plays ({asked}), the data "
+                      f"resolve {red.weights.size}: {red.describe()}; the model has "
+                      f"{red.weights.size} plays", RuntimeWarning, stacklevel=3)
+        op = PIOperator(red.weights, red.radii)
+    else:
+        op = PIOperator(res.weights, res.radii)
     exc = check_excitation(v, op.weights, op.radii)
     offset, rms, mx = _errors(op, v, y)
     settings = {"threshold": threshold, "updates": int(res.update_index.size),
