@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .branches import find_reversals
-from .checks import as_signal, positive_scalar
+from .checks import as_signal, integer_in, positive_scalar
 from .conventional import fit_conventional
 from .estimator import RadiusEstimator, run_tail_average
 from .excitation import ExcitationReport, check_excitation
@@ -31,6 +31,24 @@ from .play_reduction import reduce_plays
 from .slopes import SlopeIdentification, identify_slopes
 
 METHODS = ("adaptive", "conventional", "joint")
+MAX_PLAYS = 64                  # the FMUs' limit too
+MAX_REPEATED_SAMPLES = 20_000_000  # passes * record length: bounds the repeated record's memory
+MIN_LOOP_R2 = 0.5               # below: "no hysteresis loop found" warning
+
+
+def max_passes(n_samples: int) -> int:
+    """Largest ``passes`` for a record of ``n_samples``: ``MAX_REPEATED_SAMPLES // n_samples``
+    (the repeated record is held in memory, 16 bytes per sample)."""
+    return MAX_REPEATED_SAMPLES // max(int(n_samples), 1)
+
+
+def _warn_if_no_loop(slopes: SlopeIdentification) -> None:
+    if slopes.r2 < MIN_LOOP_R2:
+        warnings.warn(
+            f"y: no hysteresis loop found: the loop-branch fit explains {100 * slopes.r2:.2g} % "
+            f"of the output variance along the branches (R^2 = {slopes.r2:.3g}, expected > "
+            f"{MIN_LOOP_R2}; branch fit RMS {slopes.rms:.3g}); is y noise, or unrelated to v? "
+            "The model returned describes noise", RuntimeWarning, stacklevel=3)
 
 
 @dataclass
@@ -98,11 +116,16 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
              max_segments: int = 8) -> Identification:
     """Identify a PI model from a record ``(v[k], y[k])`` sampled every ``dt`` seconds.
 
-    ``n_plays``: fixed number of plays (adaptive: else chosen by BIC on the slopes;
-    conventional: default 10). ``gains``: estimator gains (default ``20 / sum p_i^2``, a
-    convergence rate of about 20/s whatever the units). ``passes``: repetitions of the record
-    (default: enough for 200 s of adaptation, at least 3). ``guard``: estimator breakpoint
-    guard (default 0.2 % of the input range).
+    ``n_plays``: fixed number of plays, an integer from 1 to 64 (adaptive: else chosen by BIC
+    on the slopes; conventional: default 10). ``gains``: estimator gains (default
+    ``20 / sum p_i^2``, a convergence rate of about 20/s whatever the units). ``passes``:
+    repetitions of the record, an integer from 1 to ``max_passes(len(v))`` (2e7 samples in all;
+    default: enough for 200 s of adaptation, at least 3, within that bound). ``guard``:
+    estimator breakpoint guard (default 0.2 % of the input range).
+
+    Warns (RuntimeWarning) when the record shows no hysteresis loop (slope-fit R^2 < 0.5) and
+    when the joint fit has more plays than the data resolve (they are merged or dropped).
+    Raises ValueError naming the argument on bad input.
     """
     v = as_signal(v, "v", min_length=10)
     y = as_signal(y, "y", min_length=10)
@@ -113,6 +136,11 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
         raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
     if np.ptp(v) == 0:
         raise ValueError("v: the input is constant; identification needs a varying input")
+    if n_plays is not None:
+        n_plays = integer_in(n_plays, "n_plays", 1, MAX_PLAYS)
+    if passes is not None:
+        passes = integer_in(passes, "passes", 1, max_passes(v.size))
+    max_segments = integer_in(max_segments, "max_segments", 1, MAX_PLAYS + 1)
 
     if method == "conventional":
         n = 10 if n_plays is None else n_plays
@@ -124,6 +152,7 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
 
     slopes = identify_slopes(v, y, n_plays=n_plays, linear_play=linear_play,
                              max_segments=max_segments)
+    _warn_if_no_loop(slopes)
     if method == "joint":
         return _identify_jointly(v, y, slopes, n_plays)
     p = slopes.weights
@@ -135,7 +164,8 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     rev = find_reversals(v, 0.01 * float(np.ptp(v)))
     first = rev[0] if rev else 0
     if passes is None:
-        passes = max(3, int(np.ceil(200.0 / (dt * (v.size - first)))))
+        passes = min(max(3, int(np.ceil(200.0 / (dt * (v.size - first))))),
+                     max(1, max_passes(v.size)))
     vv = np.concatenate([v] + [v[first:]] * (passes - 1))
     yy = np.concatenate([y] + [y[first:]] * (passes - 1)) - offset
     guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard

@@ -103,7 +103,7 @@ class JointEstimator:
         if not (isinstance(forgetting, (int, float, np.number)) and np.isfinite(forgetting)
                 and 0 < forgetting <= 1):
             raise ValueError(f"forgetting: expected a number in (0, 1], got {forgetting!r}")
-        self.bins = integer_in(bins, "bins", 4 * (self.n + 1))
+        self.bins = integer_in(bins, "bins", 4 * (self.n + 1), 10_000_000)
         self.refit_every = integer_in(refit_every, "refit_every", 1)
         self.forgetting = float(forgetting)
         self.travel_range = None if travel_range is None else positive_scalar(
