@@ -135,6 +135,9 @@ def _parse_csv(path: Path, reader, sep: str) -> tuple[list[str], np.ndarray]:
         header = [h.strip() for h in next(reader)]
     except StopIteration:
         raise DataError(f"{path}: empty file, expected a header line") from None
+    if not any(header):
+        raise DataError(f"{path}: the first line is empty; expected a header line of column "
+                        "names, e.g. t,v,y")
     rows = []
     for lineno, row in enumerate(reader, start=1):
         if not row or all(not c.strip() for c in row):
