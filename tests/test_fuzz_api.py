@@ -164,6 +164,7 @@ def plausible_record(draw):
     return v, y
 
 
+@pytest.mark.slow
 @fuzz(60)
 @given(rec=plausible_record(), dt=st.sampled_from([1e-3, 1.0, 1e-9]),
        n_plays=st.one_of(st.none(), st.integers(1, 5)),
