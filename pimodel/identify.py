@@ -27,7 +27,7 @@ from .estimator import RadiusEstimator, run_tail_average
 from .excitation import ExcitationReport, check_excitation
 from .joint import JointEstimator
 from .operator import PIOperator
-from .play_reduction import reduce_plays
+from .play_reduction import PlayReduction, reduce_plays
 from .slopes import SlopeIdentification, identify_slopes
 
 METHODS = ("adaptive", "conventional", "joint")
@@ -188,16 +188,21 @@ def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification,
                          refit_every=1_000_000)  # offline: the first update and the final one
     est.run(v, y)
     res = est.finish()
-    red = reduce_plays(*est.binned(), res.weights, res.radii, linear_play=slopes.linear_play) \
-        if est.result().update_index.size else None
-    if red is not None and red.changed:
+    if n_plays is not None and res.update_index.size:
+        # more plays asked than the data may show: merge or drop the unresolved ones
+        red = reduce_plays(*est.binned(), res.weights, res.radii,
+                           linear_play=slopes.linear_play)
+    else:  # the slopes chose the number: only a zero weight is dropped
+        keep = res.weights > 0
+        red = PlayReduction(res.weights[keep], res.radii[keep], dropped=[
+            (float(r), float(w)) for r, w in zip(res.radii[~keep], res.weights[~keep],
+                                                 strict=True)])
+    if red.changed:
         asked = f"n_plays={n_plays}" if n_plays is not None else "the slopes' choice"
         warnings.warn(f"joint estimation: fitted {res.weights.size} plays ({asked}), the data "
                       f"resolve {red.weights.size}: {red.describe()}; the model has "
                       f"{red.weights.size} plays", RuntimeWarning, stacklevel=3)
-        op = PIOperator(red.weights, red.radii)
-    else:
-        op = PIOperator(res.weights, res.radii)
+    op = PIOperator(red.weights, red.radii)
     exc = check_excitation(v, op.weights, op.radii)
     offset, rms, mx = _errors(op, v, y)
     settings = {"threshold": threshold, "updates": int(res.update_index.size),
