@@ -48,12 +48,24 @@ def positive_scalar(value, name: str) -> float:
 
 
 def integer_in(value, name: str, lo: int, hi: int | None = None) -> int:
-    """``value`` as an int in ``[lo, hi]``, else a ValueError naming ``name``."""
+    """``value`` as an int in ``[lo, hi]``, else a ValueError naming ``name``.
+
+    Accepts Python and NumPy integers; rejects floats (also integral ones such as ``4.0``),
+    booleans and anything else with a message saying what was given.
+
+    Examples
+    --------
+    >>> integer_in(4, "n_plays", 1, 64)
+    4
+    """
     rng = f"from {lo} to {hi}" if hi is not None else f">= {lo}"
-    try:
-        ok = isinstance(value, (int, np.integer, float, np.floating)) and int(value) == value
-    except (OverflowError, ValueError):
-        ok = False
-    if not ok or value < lo or (hi is not None and value > hi):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        kind = type(value).__name__
+        hint = ""
+        if isinstance(value, (float, np.floating)) and np.isfinite(value) and \
+                float(value).is_integer():
+            hint = f"; write {int(value)}"
+        raise ValueError(f"{name}: expected an integer {rng}, got {value!r} (a {kind}{hint})")
+    if value < lo or (hi is not None and value > hi):
         raise ValueError(f"{name}: expected an integer {rng}, got {value!r}")
     return int(value)

@@ -2,19 +2,23 @@
 
 A record holds time ``t`` [s], actuator input ``v`` (e.g. V) and measured output ``y``
 (e.g. um), sampled at the same instants; extra columns are kept in ``Record.extra``.
-Validation: at least two samples, equal lengths, finite numbers, strictly increasing time.
+Validation: at least two samples, equal lengths, finite numbers, strictly increasing time,
+uniform sampling (every interval within 1 % of the median).
 Errors name the file, the row (1-based data row, header excluded) and the column.
 """
 
 from __future__ import annotations
 
 import csv
+import warnings
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 DEFAULT_COLUMNS = ("t", "v", "y")
+SAMPLING_TOLERANCE = 0.01  # largest relative deviation of a sample interval from the median
 
 
 class DataError(ValueError):
@@ -30,6 +34,7 @@ class Record:
     y: np.ndarray
     extra: dict[str, np.ndarray] = field(default_factory=dict)
     source: str = "<array>"
+    has_output: bool = True  # False: the file had no output column and ``y`` is zeros
 
     def __post_init__(self):
         cols = {"t": self.t, "v": self.v, "y": self.y, **self.extra}
@@ -85,58 +90,153 @@ def _validate_columns(cols: dict[str, np.ndarray], source: str) -> dict[str, np.
             f"{source}: row {k + 1}, column 't': time {float(out['t'][k])!r} does not increase "
             f"strictly (previous {float(out['t'][k - 1])!r})"
         )
+    med = float(np.median(dt))
+    off = np.flatnonzero(np.abs(dt - med) > SAMPLING_TOLERANCE * med)
+    if off.size:
+        change = np.flatnonzero(np.abs(dt - dt[0]) > SAMPLING_TOLERANCE * med)
+        k = int(change[0]) if change.size else int(off[0])
+        raise DataError(
+            f"{source}: row {k + 2}, column 't': the sample interval changes there from "
+            f"{float(dt[max(k - 1, 0)]):.6g} s to {float(dt[k]):.6g} s (median {med:.6g} s; "
+            f"{off.size} interval(s) more than {100 * SAMPLING_TOLERANCE:g} % off the median); "
+            "the methods need uniform sampling: resample the record or split it where the "
+            "rate changes"
+        )
     return out
 
 
+def _delimiter(path: Path, header_line: str) -> str:
+    """``,`` unless the header has no comma but semicolons or tabs (then that, with a
+    warning saying so)."""
+    if "," in header_line:
+        return ","
+    for sep, name in ((";", "semicolon"), ("\t", "tab")):
+        if sep in header_line:
+            warnings.warn(f"{path}: the header has no comma but {name}s; read as "
+                          f"{name}-separated", UserWarning, stacklevel=4)
+            return sep
+    return ","
+
+
 def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
-    with path.open(newline="") as fh:
-        reader = csv.reader(fh)
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as fh:  # a UTF-8 BOM is accepted
+            first = fh.readline()
+            fh.seek(0)
+            sep = _delimiter(path, first)
+            return _parse_csv(path, csv.reader(fh, delimiter=sep), sep)
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path}: not a UTF-8 text file (byte {exc.start}); expected a CSV "
+                        "with a header line, or an .npz") from None
+
+
+def _parse_csv(path: Path, reader, sep: str) -> tuple[list[str], np.ndarray]:
+    try:
+        header = [h.strip() for h in next(reader)]
+    except StopIteration:
+        raise DataError(f"{path}: empty file, expected a header line") from None
+    if not any(header):
+        raise DataError(f"{path}: the first line is empty; expected a header line of column "
+                        "names, e.g. t,v,y")
+    rows = []
+    for lineno, row in enumerate(reader, start=1):
+        if not row or all(not c.strip() for c in row):
+            continue
+        if len(row) != len(header):
+            hint = ""
+            if len(header) == 1 and any(c in header[0] for c in ";\t"):
+                hint = " (is the file separated by something other than commas?)"
+            raise DataError(
+                f"{path}: row {lineno} has {len(row)} fields, expected {len(header)} "
+                f"(header: {','.join(header)}){hint}"
+            )
         try:
-            header = [h.strip() for h in next(reader)]
-        except StopIteration:
-            raise DataError(f"{path}: empty file, expected a header line") from None
-        rows = []
-        for lineno, row in enumerate(reader, start=1):
-            if not row or all(not c.strip() for c in row):
-                continue
-            if len(row) != len(header):
-                raise DataError(
-                    f"{path}: row {lineno} has {len(row)} fields, expected {len(header)} "
-                    f"(header: {','.join(header)})"
-                )
-            try:
-                rows.append([float(c) for c in row])
-            except ValueError:
-                for c, name in zip(row, header, strict=True):
-                    try:
-                        float(c)
-                    except ValueError:
-                        raise DataError(
-                            f"{path}: row {lineno}, column '{name}': {c!r} is not a number"
-                        ) from None
+            rows.append([float(c) for c in row])
+        except ValueError:
+            for c, name in zip(row, header, strict=True):
+                try:
+                    float(c)
+                except ValueError:
+                    hint = " (a decimal comma? write decimal points)" if \
+                        sep != "," and "," in c else ""
+                    raise DataError(
+                        f"{path}: row {lineno}, column '{name}': {c!r} is not a number{hint}"
+                    ) from None
     return header, np.array(rows, dtype=float).reshape(-1, len(header))
 
 
-def load_record(path, columns: tuple[str, str, str] = DEFAULT_COLUMNS) -> Record:
+def _read_npz(path: Path) -> dict[str, np.ndarray]:
+    with path.open("rb") as fh:
+        magic = fh.read(4)
+    if magic[:2] != b"PK":
+        kind = "looks like a text (CSV?) file; rename it to .csv" if \
+            magic and all(32 <= b < 127 or b in (9, 10, 13) for b in magic) else \
+            "is not a zip archive"
+        raise DataError(f"{path}: not a valid .npz file: it {kind}")
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            data = {k: npz[k] for k in npz.files}
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
+        raise DataError(f"{path}: corrupt .npz file ({type(exc).__name__}: {exc})") from None
+    for k, a in data.items():
+        if a.dtype.kind not in "biuf":
+            raise DataError(f"{path}: array '{k}' has dtype {a.dtype}; expected numbers")
+    return data
+
+
+def load_record(path, columns: tuple[str, str, str] = DEFAULT_COLUMNS, *,
+                output_required: bool = True) -> Record:
     """Load a record from CSV (header line) or NPZ; ``columns`` names time, input, output.
 
-    Columns other than the three named are kept in ``Record.extra``. Raises
-    :class:`DataError` naming the file, row and column on any violation.
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A CSV file with a header line (comma-separated; a header without commas but with
+        semicolons or tabs is read with that separator, with a warning; a UTF-8 BOM is
+        accepted) or an ``.npz`` of 1-D arrays.
+    columns : tuple of str
+        Names of the time [s], input and output columns.
+    output_required : bool
+        When False, a file without the output column loads with ``y`` zeros and
+        ``has_output=False`` (e.g. an input to simulate).
+
+    Returns
+    -------
+    Record
+        Columns other than the three named are kept in ``Record.extra``.
+
+    Raises
+    ------
+    DataError
+        Naming the file, row and column on any violation (also: a corrupt ``.npz``, a text
+        file named ``.npz``, a sampling interval that changes mid-record).
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "r.csv"
+    >>> _ = f.write_text("t,v\\n0,0\\n0.1,1\\n0.2,0\\n")
+    >>> load_record(f, output_required=False).has_output
+    False
     """
     path = Path(path)
     if len(columns) != 3:
         raise DataError(f"columns: expected three names (time, input, output), got {columns!r}")
     if not path.exists():
         raise DataError(f"{path}: no such file")
+    if not path.is_file():
+        raise DataError(f"{path}: not a file")
     if path.suffix.lower() == ".npz":
-        with np.load(path, allow_pickle=False) as npz:
-            data = {k: npz[k] for k in npz.files}
+        data = _read_npz(path)
         header = list(data)
     else:
         header, table = _read_csv(path)
         if len(set(header)) != len(header):
             raise DataError(f"{path}: duplicate column names in header {header}")
         data = {name: table[:, i] for i, name in enumerate(header)}
+    has_output = columns[2] in data
+    if not has_output and not output_required and columns[0] in data and columns[1] in data:
+        data = {**data, columns[2]: np.zeros(np.shape(data[columns[1]]))}
     missing = [c for c in columns if c not in data]
     if missing:
         raise DataError(
@@ -154,7 +254,7 @@ def load_record(path, columns: tuple[str, str, str] = DEFAULT_COLUMNS) -> Record
             msg = msg.replace(f"column '{internal}'", f"column '{user}'")
         raise DataError(msg) from None
     return Record(checked["t"], checked["v"], checked["y"],
-                  {k: checked[k] for k in extra}, source=str(path))
+                  {k: checked[k] for k in extra}, source=str(path), has_output=has_output)
 
 
 def save_record(record: Record, path, columns: tuple[str, str, str] = DEFAULT_COLUMNS) -> Path:

@@ -21,17 +21,36 @@ from pathlib import Path
 import numpy as np
 
 from .branches import find_reversals
-from .checks import as_signal, positive_scalar
+from .checks import as_signal, integer_in, positive_scalar
 from .conventional import fit_conventional
 from .estimator import RadiusEstimator, run_tail_average
 from .estimator_health import EstimatorHealth, estimator_health
 from .excitation import ExcitationReport, check_excitation
 from .joint import JointEstimator
 from .operator import PIOperator
+from .play_reduction import PlayReduction, reduce_plays
 from .slopes import SlopeIdentification, identify_slopes
 
 METHODS = ("adaptive", "conventional", "joint")
 HISTORY_LIMIT = 2_000_000  # samples (record x passes) up to which the estimate history is kept
+MAX_PLAYS = 64                  # the FMUs' limit too
+MAX_REPEATED_SAMPLES = 20_000_000  # passes * record length: bounds the repeated record's memory
+MIN_LOOP_R2 = 0.5               # below: "no hysteresis loop found" warning
+
+
+def max_passes(n_samples: int) -> int:
+    """Largest ``passes`` for a record of ``n_samples``: ``MAX_REPEATED_SAMPLES // n_samples``
+    (the repeated record is held in memory, 16 bytes per sample)."""
+    return MAX_REPEATED_SAMPLES // max(int(n_samples), 1)
+
+
+def _warn_if_no_loop(slopes: SlopeIdentification) -> None:
+    if slopes.r2 < MIN_LOOP_R2:
+        warnings.warn(
+            f"y: no hysteresis loop found: the loop-branch fit explains {100 * slopes.r2:.2g} % "
+            f"of the output variance along the branches (R^2 = {slopes.r2:.3g}, expected > "
+            f"{MIN_LOOP_R2}; branch fit RMS {slopes.rms:.3g}); is y noise, or unrelated to v? "
+            "The model returned describes noise", RuntimeWarning, stacklevel=3)
 
 
 @dataclass
@@ -101,12 +120,18 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
              max_segments: int = 8) -> Identification:
     """Identify a PI model from a record ``(v[k], y[k])`` sampled every ``dt`` seconds.
 
-    ``n_plays``: fixed number of plays (adaptive: else chosen by BIC on the slopes;
-    conventional: default 10). ``gains``: estimator gains (default ``20 / sum p_i^2``, a
-    convergence rate of about 20/s whatever the units). ``passes``: repetitions of the record
-    (default: enough for 200 s of adaptation, at least 3). ``guard``: estimator breakpoint
-    guard (default 0.2 % of the input range). The adaptive method reports the health of its
-    radius estimate (``health``, :mod:`pimodel.estimator_health`) and warns when it fails.
+    ``n_plays``: fixed number of plays, an integer from 1 to 64 (adaptive: else chosen by BIC
+    on the slopes; conventional: default 10). ``gains``: estimator gains (default
+    ``20 / sum p_i^2``, a convergence rate of about 20/s whatever the units). ``passes``:
+    repetitions of the record, an integer from 1 to ``max_passes(len(v))`` (2e7 samples in all;
+    default: enough for 200 s of adaptation, at least 3, within that bound). ``guard``:
+    estimator breakpoint guard (default 0.2 % of the input range). The adaptive method reports
+    the health of its radius estimate (``health``, :mod:`pimodel.estimator_health`) and warns
+    when it fails.
+
+    Warns (RuntimeWarning) when the record shows no hysteresis loop (slope-fit R^2 < 0.5) and
+    when the joint fit has more plays than the data resolve (they are merged or dropped).
+    Raises ValueError naming the argument on bad input.
     """
     v = as_signal(v, "v", min_length=10)
     y = as_signal(y, "y", min_length=10)
@@ -117,6 +142,11 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
         raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
     if np.ptp(v) == 0:
         raise ValueError("v: the input is constant; identification needs a varying input")
+    if n_plays is not None:
+        n_plays = integer_in(n_plays, "n_plays", 1, MAX_PLAYS)
+    if passes is not None:
+        passes = integer_in(passes, "passes", 1, max_passes(v.size))
+    max_segments = integer_in(max_segments, "max_segments", 1, MAX_PLAYS + 1)
 
     if method == "conventional":
         n = 10 if n_plays is None else n_plays
@@ -128,8 +158,9 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
 
     slopes = identify_slopes(v, y, n_plays=n_plays, linear_play=linear_play,
                              max_segments=max_segments)
+    _warn_if_no_loop(slopes)
     if method == "joint":
-        return _identify_jointly(v, y, slopes)
+        return _identify_jointly(v, y, slopes, n_plays)
     p = slopes.weights
     exc = check_excitation(v, p, slopes.radii_guess)
     guess = PIOperator(p, slopes.radii_guess)
@@ -139,7 +170,8 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     rev = find_reversals(v, 0.01 * float(np.ptp(v)))
     first = rev[0] if rev else 0
     if passes is None:
-        passes = max(3, int(np.ceil(200.0 / (dt * (v.size - first)))))
+        passes = min(max(3, int(np.ceil(200.0 / (dt * (v.size - first))))),
+                     max(1, max_passes(v.size)))
     vv = np.concatenate([v] + [v[first:]] * (passes - 1))
     yy = np.concatenate([y] + [y[first:]] * (passes - 1)) - offset
     guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard
@@ -164,7 +196,8 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
                           health)
 
 
-def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification) -> Identification:
+def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification,
+                      n_plays: int | None) -> Identification:
     threshold = 0.01 * float(np.ptp(v))
     est = JointEstimator(slopes.weights.size, linear_play=slopes.linear_play,
                          initial_weights=np.maximum(slopes.weights, 0.0),
@@ -172,12 +205,21 @@ def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification)
                          refit_every=1_000_000)  # offline: the first update and the final one
     est.run(v, y)
     res = est.finish()
-    keep = res.weights > 0
-    if not np.all(keep):
-        warnings.warn(f"joint estimation: {int((~keep).sum())} play(s) got weight 0 (no slope "
-                      f"change at their radius) and were dropped; the model has "
-                      f"{int(keep.sum())} plays", RuntimeWarning, stacklevel=3)
-    op = PIOperator(res.weights[keep], res.radii[keep])
+    if n_plays is not None and res.update_index.size:
+        # more plays asked than the data may show: merge or drop the unresolved ones
+        red = reduce_plays(*est.binned(), res.weights, res.radii,
+                           linear_play=slopes.linear_play)
+    else:  # the slopes chose the number: only a zero weight is dropped
+        keep = res.weights > 0
+        red = PlayReduction(res.weights[keep], res.radii[keep], dropped=[
+            (float(r), float(w)) for r, w in zip(res.radii[~keep], res.weights[~keep],
+                                                 strict=True)])
+    if red.changed:
+        asked = f"n_plays={n_plays}" if n_plays is not None else "the slopes' choice"
+        warnings.warn(f"joint estimation: fitted {res.weights.size} plays ({asked}), the data "
+                      f"resolve {red.weights.size}: {red.describe()}; the model has "
+                      f"{red.weights.size} plays", RuntimeWarning, stacklevel=3)
+    op = PIOperator(red.weights, red.radii)
     exc = check_excitation(v, op.weights, op.radii)
     offset, rms, mx = _errors(op, v, y)
     settings = {"threshold": threshold, "updates": int(res.update_index.size),

@@ -103,7 +103,7 @@ class JointEstimator:
         if not (isinstance(forgetting, (int, float, np.number)) and np.isfinite(forgetting)
                 and 0 < forgetting <= 1):
             raise ValueError(f"forgetting: expected a number in (0, 1], got {forgetting!r}")
-        self.bins = integer_in(bins, "bins", 4 * (self.n + 1))
+        self.bins = integer_in(bins, "bins", 4 * (self.n + 1), 10_000_000)
         self.refit_every = integer_in(refit_every, "refit_every", 1)
         self.forgetting = float(forgetting)
         self.travel_range = None if travel_range is None else positive_scalar(
@@ -243,9 +243,7 @@ class JointEstimator:
         self._since_update += 1
 
     def _fit_bins(self) -> None:
-        cnt, sx, sy = self._stats
-        ok = cnt > 0
-        xb, yb, wb = sx[ok] / cnt[ok], sy[ok] / cnt[ok], cnt[ok]
+        xb, yb, wb = self.binned()
         hinges = self.n - 1 if self.linear_play else self.n
         if xb.size < 2 * self.n + 2:
             return  # too few distinct travels to place the hinges yet
@@ -253,6 +251,13 @@ class JointEstimator:
         b, a, c, _ = fit_hinges(xb, yb, wb, hinges, linear_term=self.linear_play, start=start)
         self.weights = a.copy()
         self.radii = np.concatenate(([0.0], b / 2)) if self.linear_play else b / 2
+
+    def binned(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The fit's data: mean travel ``x`` (input unit), mean centred signed output ``Y``
+        (output unit) and sample count of each occupied bin."""
+        cnt, sx, sy = self._stats
+        ok = cnt > 0
+        return sx[ok] / cnt[ok], sy[ok] / cnt[ok], cnt[ok]
 
     def result(self) -> JointEstimate:
         """Everything so far as a :class:`JointEstimate`."""

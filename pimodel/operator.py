@@ -13,6 +13,7 @@ no role, only the sequence of input values. Units: ``v`` and the radii share the
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -23,6 +24,19 @@ from .checks import as_signal, as_vector
 
 if TYPE_CHECKING:
     from .describing import PIDescribingFunction
+
+INVERSE_CONDITION_WARN = 1e6    # max/min branch slope above which inverse() warns
+INVERSE_CONDITION_ERROR = 1e12  # ... and above which it raises (rounding dominates)
+
+
+def _check_output(y: np.ndarray, v: np.ndarray) -> None:
+    """ValueError when a finite input gave a non-finite output (float64 overflow)."""
+    if not np.all(np.isfinite(y)):
+        k = int(np.flatnonzero(~np.isfinite(y))[0])
+        raise ValueError(
+            f"v: sample {k} ({float(v[k]):.6g}) makes the output overflow to {float(y[k])!r}; "
+            f"expected |v| * sum |p_i| below {np.finfo(float).max:.3g}: scale the input"
+        )
 
 
 def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -130,6 +144,7 @@ class PIOperator:
         x = as_signal(v, "v")
         z = self._z0.copy() if state is None else _initial_state(state, self.n)
         y, _ = _native.pi_run(self._p, self._r, z, x)
+        _check_output(y, x)
         return (y, z) if return_state else y
 
     def play_outputs(self, v, *, state=None) -> np.ndarray:
@@ -158,7 +173,9 @@ class PIOperator:
         vk = float(v)
         if not np.isfinite(vk):
             raise ValueError(f"v: input sample is {v!r}; expected a finite number")
-        return _native.pi_step(self._p, self._r, self._z, vk)
+        y = _native.pi_step(self._p, self._r, self._z, vk)
+        _check_output(np.array([y]), np.array([vk]))
+        return y
 
     def output(self, state=None) -> float:
         """Output ``sum_i p_i z_i`` for a state (default: the current streaming state)."""
@@ -204,6 +221,21 @@ class PIOperator:
             raise ValueError(
                 "PIOperator.inverse: not invertible, a partial sum of weights is not positive"
             )
+        P = np.cumsum(self._p)
+        cond = float(P.max() / P.min())
+        if cond > INVERSE_CONDITION_ERROR:
+            raise ValueError(
+                f"PIOperator.inverse: ill-conditioned, weights: the branch slopes range over "
+                f"max P_i / min P_i = {cond:.3g} (P_i = p_1 + ... + p_i; p_1 = "
+                f"{float(self._p[0]):.3g}); above {INVERSE_CONDITION_ERROR:.0e} rounding alone "
+                "spoils the inverse. Expected p_1 no smaller than 1e-12 of the total weight"
+            )
+        if cond > INVERSE_CONDITION_WARN:
+            warnings.warn(
+                f"PIOperator.inverse: ill-conditioned, max P_i / min P_i = {cond:.3g} (p_1 = "
+                f"{float(self._p[0]):.3g}): the inverse amplifies output errors up to "
+                f"{cond:.3g} times (well-conditioned below {INVERSE_CONDITION_WARN:.0e})",
+                RuntimeWarning, stacklevel=2)
         pinv, rinv, zinv = res
         return PIOperator(pinv, rinv, initial_state=zinv, signed_weights=True)
 

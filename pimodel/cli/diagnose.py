@@ -6,7 +6,7 @@ import argparse
 import json
 
 from ..data import load_record
-from .common import add_columns_option
+from .common import add_columns_option, refuse_overwrite
 
 
 def register(sub) -> None:
@@ -31,6 +31,8 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..diagnosis import diagnose
 
+    refuse_overwrite({"--train": args.train, "--validate": args.validate},
+                     {"--json": args.json}, {"--plots": args.plots})
     train = [load_record(f, columns=args.columns) for f in args.train]
     validate = [load_record(f, columns=args.columns) for f in args.validate]
     rep = diagnose(train, validate)

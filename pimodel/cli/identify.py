@@ -7,7 +7,7 @@ import json
 import sys
 
 from ..data import load_record
-from .common import add_columns_option, float_list
+from .common import add_columns_option, float_list, refuse_overwrite
 
 
 def register(sub) -> None:
@@ -35,6 +35,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..identify import identify
 
+    refuse_overwrite({"DATA": [args.data]}, {"--json": args.json}, {"--plots": args.plots})
     rec = load_record(args.data, columns=args.columns)
     gains = None
     if args.gains is not None:

@@ -6,7 +6,7 @@ import argparse
 
 from ..data import Record, load_record, save_record
 from ..operator import PIOperator
-from .common import add_columns_option, float_list
+from .common import add_columns_option, float_list, refuse_overwrite, unique_name
 
 
 def register(sub) -> None:
@@ -14,7 +14,9 @@ def register(sub) -> None:
         "simulate",
         help="run a PI operator on a record's input",
         description="Run y = PI[v] on the input column of DATA (CSV or NPZ) and write a record "
-        "t,v,y (y = model output; the measured output, if any, is kept as 'y_measured').",
+        "t,v,y (y = model output; the measured output, if any, is kept as 'y_measured'; a "
+        "new column whose name the input already uses gets a suffix _1, _2, ... with a "
+        "warning). The output file must not be the input file.",
     )
     p.add_argument("data", help="input record (CSV with header, or NPZ)")
     p.add_argument("--weights", type=float_list, required=True, help="weights p_i, e.g. 1,0.5")
@@ -29,12 +31,18 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    rec = load_record(args.data, columns=args.columns)
+    refuse_overwrite({"DATA": [args.data]}, {"--out": args.out})
+    rec = load_record(args.data, columns=args.columns, output_required=False)
     op = PIOperator(args.weights, args.radii, initial_state=args.initial_state)
     if args.inverse:
         op = op.inverse()
     y = op.simulate(rec.v)
-    out = Record(rec.t, rec.v, y, {"y_measured": rec.y, **rec.extra}, source=args.out)
-    save_record(out, args.out)
+    taken = list(rec.extra)
+    names = [unique_name(n, taken) for n in ("t", "v", "y")]
+    extra = dict(rec.extra)
+    if rec.has_output:
+        extra = {unique_name("y_measured", taken + names): rec.y, **extra}
+    out = Record(rec.t, rec.v, y, extra, source=args.out)
+    save_record(out, args.out, columns=tuple(names))
     print(f"wrote {len(out)} samples to {args.out}")
     return 0

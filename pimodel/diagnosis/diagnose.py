@@ -15,6 +15,7 @@ validate RMS by at least 10 %, and the current RMS is above 1.5 times the noise 
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -104,7 +105,16 @@ def _check(records: list[Record], role: str) -> None:
 
 def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 3
              ) -> DiagnosisReport:
-    """Diagnose the gap between a PI model fitted on ``train`` and the ``validate`` records."""
+    """Diagnose the gap between a PI model fitted on ``train`` and the ``validate`` records.
+
+    Warns (UserWarning) when a validate record is also a train record: nothing is held out.
+    """
+    shared = [r.source for r in validate if any(
+        r.t.size == t.t.size and np.array_equal(r.v, t.v) and np.array_equal(r.y, t.y)
+        for t in train)]
+    if shared:
+        warnings.warn(f"validate: {shared} also in train; nothing is held out, so the validate "
+                      "gap is a training fit, not a test", UserWarning, stacklevel=2)
     with threadpool_limits(1, user_api="blas"):
         return _diagnose(train, validate, max_effects)
 
