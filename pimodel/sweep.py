@@ -39,6 +39,13 @@ import numpy as np
 # 80 % and restarts it at 95 %; a case that keeps exceeding it fails with KilledWorker.
 DEFAULT_MEMORY_LIMIT = "2GiB"
 
+# Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which also switches off glibc's
+# dynamic mmap threshold: every array above 128 KiB is then mmap'd and unmapped afresh, and a
+# case of the diagnosis or identification spends ~50 % more CPU (measured on the identify
+# sweep). Larger thresholds keep the case's working arrays (up to 16 MiB) on the heap; memory
+# still returns to the system above 64 MiB of free heap top.
+WORKER_ENV = {"MALLOC_MMAP_THRESHOLD_": str(16 * 2**20), "MALLOC_TRIM_THRESHOLD_": str(64 * 2**20)}
+
 __all__ = ["CaseFailed", "DEFAULT_MEMORY_LIMIT", "available_cores", "case_key", "grid", "plain",
            "random_cases", "run_cases", "tidy_rows", "write_table"]
 
@@ -317,7 +324,7 @@ def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory
         # processes, one thread each: the Python glue of a case holds the GIL
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                memory_limit=memory_limit, dashboard_address=None,
-                               silence_logs=logging.ERROR)
+                               silence_logs=logging.ERROR, env=WORKER_ENV)
     client = Client(cluster if cluster is not None else scheduler)
     try:
         run = partial(_call_case, func)
@@ -415,11 +422,16 @@ def _flatten(prefix: str, x, row: dict) -> None:
     if isinstance(x, Mapping):
         for k, v in x.items():
             _flatten(f"{prefix}.{k}" if prefix else str(k), v, row)
-    elif isinstance(x, list) and all(not isinstance(v, list | Mapping) for v in x) and x:
+    elif isinstance(x, list) and x and all(isinstance(v, int | float) for v in x):
         for j, v in enumerate(x, start=1):  # 1-based like r_hat[1]..r_hat[n]
             row[f"{prefix}[{j}]"] = v
     else:
         row[prefix] = x
+
+
+def _cell_text(x) -> str:
+    """``x`` as text for a table cell: strings as they are, other values as JSON."""
+    return x if isinstance(x, str) else json.dumps(x)
 
 
 def tidy_rows(cases: Sequence[dict], results: Sequence) -> list[dict]:
@@ -436,7 +448,7 @@ def tidy_rows(cases: Sequence[dict], results: Sequence) -> list[dict]:
     -------
     list of dict
         Flat rows; lists of numbers become columns ``name[1]``, ``name[2]``, ... and other
-        lists a ``+``-joined text.
+        lists (text, empty) a ``+``-joined text in column ``name``.
 
     Examples
     --------
@@ -448,7 +460,7 @@ def tidy_rows(cases: Sequence[dict], results: Sequence) -> list[dict]:
         row: dict = {}
         _flatten("", plain(p), row)
         _flatten("" if isinstance(r, Mapping) else "result", plain(r), row)
-        rows.append({k: "+".join(map(str, v)) if isinstance(v, list) else v
+        rows.append({k: "+".join(map(_cell_text, v)) if isinstance(v, list) else v
                      for k, v in row.items()})
     return rows
 

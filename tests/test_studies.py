@@ -18,7 +18,7 @@ def test_all_studies_are_listed():
 
 
 def _run(name, tmp_path):
-    res = run_study(name, tmp_path / name, quick=True)
+    res = run_study(name, tmp_path / name, quick=True, workers=0)
     out = tmp_path / name
     assert (out / "results.md").exists() and (out / "results.json").exists()
     for fig in res.figures:
@@ -65,6 +65,31 @@ def test_sim_to_real(tmp_path):
         assert d["hits"] == d["n"], case
         if case != "none (clean PI)":
             assert d["min_shrink"] >= 0.5, case
+
+
+@pytest.mark.slow
+def test_sim_to_real_on_two_workers_equals_serial(tmp_path):
+    """``pimodel study sim_to_real --quick --workers 2`` (a 2-process LocalCluster) writes the
+    same results.json as ``--workers 0`` (in-process): each case seeds its own generators."""
+    serial, cluster = tmp_path / "serial", tmp_path / "cluster"
+    assert main(["study", "sim_to_real", "--quick", "--workers", "0", "--out", str(serial)]) == 0
+    assert main(["study", "sim_to_real", "--quick", "--workers", "2", "--out", str(cluster)]) == 0
+    a = json.loads((serial / "results.json").read_text())
+    b = json.loads((cluster / "results.json").read_text())
+    assert a["numbers"] and a == b
+    assert len(list((cluster / "cases").glob("*.json"))) == 6  # 5 effects + clean PI, seed 0
+
+
+def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
+    """A rerun of a sweep study loads its finished cases instead of computing them."""
+    from pimodel.study_runner import load_study
+
+    first = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    module = load_study("paper_simulation")
+    monkeypatch.setattr("pimodel.study_runner.load_study", lambda name: module)
+    monkeypatch.setattr(module, "run_case", lambda params: pytest.fail(f"recomputed {params}"))
+    again = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    assert again.to_json() == first.to_json()
 
 
 def test_cli_study_list_and_unknown(tmp_path, capsys):
