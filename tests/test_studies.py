@@ -57,27 +57,23 @@ def test_real_data(tmp_path):
     assert n["adaptive (BIC)"]["held_out_rms"] < n["conventional n=10"]["held_out_rms"]
 
 
+@pytest.mark.slow
 def test_sim_to_real(tmp_path):
+    """The quick confusion table is right, and ``pimodel study sim_to_real --quick --workers 2``
+    (a 2-process LocalCluster) writes the same results.json as the serial run (each case seeds
+    its own generators)."""
     n = _run("sim_to_real", tmp_path).numbers
+    cluster = tmp_path / "cluster"
+    assert main(["study", "sim_to_real", "--quick", "--workers", "2", "--out", str(cluster)]) == 0
+    serial = json.loads((tmp_path / "sim_to_real" / "results.json").read_text())
+    assert serial["numbers"] and json.loads((cluster / "results.json").read_text()) == serial
+    assert len(list((cluster / "cases").glob("*.json"))) == 6  # 5 effects + clean PI, seed 0
     for case, d in n.items():
         if case == "real":
             continue
         assert d["hits"] == d["n"], case
         if case != "none (clean PI)":
             assert d["min_shrink"] >= 0.5, case
-
-
-@pytest.mark.slow
-def test_sim_to_real_on_two_workers_equals_serial(tmp_path):
-    """``pimodel study sim_to_real --quick --workers 2`` (a 2-process LocalCluster) writes the
-    same results.json as ``--workers 0`` (in-process): each case seeds its own generators."""
-    serial, cluster = tmp_path / "serial", tmp_path / "cluster"
-    assert main(["study", "sim_to_real", "--quick", "--workers", "0", "--out", str(serial)]) == 0
-    assert main(["study", "sim_to_real", "--quick", "--workers", "2", "--out", str(cluster)]) == 0
-    a = json.loads((serial / "results.json").read_text())
-    b = json.loads((cluster / "results.json").read_text())
-    assert a["numbers"] and a == b
-    assert len(list((cluster / "cases").glob("*.json"))) == 6  # 5 effects + clean PI, seed 0
 
 
 def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
