@@ -46,8 +46,8 @@ DEFAULT_MEMORY_LIMIT = "2GiB"
 # still returns to the system above 64 MiB of free heap top.
 WORKER_ENV = {"MALLOC_MMAP_THRESHOLD_": str(16 * 2**20), "MALLOC_TRIM_THRESHOLD_": str(64 * 2**20)}
 
-__all__ = ["CaseFailed", "DEFAULT_MEMORY_LIMIT", "available_cores", "case_key", "grid", "plain",
-           "random_cases", "run_cases", "tidy_rows", "write_table"]
+__all__ = ["CaseFailed", "DEFAULT_MEMORY_LIMIT", "WORKER_ENV", "available_cores", "case_key",
+           "grid", "plain", "random_cases", "run_cases", "tidy_rows", "write_table"]
 
 
 class CaseFailed(RuntimeError):
