@@ -44,7 +44,49 @@ def _output_error(weights: np.ndarray, radii: np.ndarray) -> float:
     return float(100 * np.max(np.abs(d - d.mean())) / np.ptp(y))
 
 
-def run(out: Path, quick: bool = False) -> StudyResult:
+def cases(quick: bool) -> list[dict]:
+    """One case per noisy record and seed (the noise-free run is in :func:`aggregate`)."""
+    if quick:
+        spec = [("sinusoid, SNR 20 dB", "sinusoid", 10_000.0, 300.0, 20, 100, [0])]
+    else:
+        spec = [("sinusoid, SNR 20 dB", "sinusoid", 10_000.0, 6000.0, 20, 2000, [0, 1, 2]),
+                ("sinusoid, SNR 10 dB", "sinusoid", 10_000.0, 20_000.0, 10, 2000, [0, 1, 2]),
+                ("stair-step, SNR 20 dB", "stair-step", 1000.0, 40_000.0, 20, 10_000,
+                 [0, 1, 2]),
+                ("sinusoid, SNR 20 dB, long", "sinusoid", 10_000.0, 30_000.0, 20, 10_000,
+                 [0, 1, 2]),
+                ("sinusoid, SNR 10 dB, long", "sinusoid", 10_000.0, 100_000.0, 10, 20_000,
+                 [0, 1, 2])]
+    return [{"name": name, "input": kind, "fs": fs, "duration": dur, "snr": snr,
+             "refit_every": refit, "seed": seed}
+            for name, kind, fs, dur, snr, refit, seeds in spec for seed in seeds]
+
+
+def _plotted(params: dict) -> bool:
+    return params["seed"] == 0 and params["input"] == "sinusoid" and "long" not in params["name"]
+
+
+def run_case(params: dict) -> dict:
+    """Joint estimate on one chunked noisy record; histories for the plotted cases."""
+    fs = params["fs"]
+    sine = lambda t: 30 * np.sin(2 * np.pi * t)  # noqa: E731
+    input_at = sine if params["input"] == "sinusoid" else _staircase_at(fs)
+    est = JointEstimator(5, initial_weights=P0, initial_radii=R0,
+                         refit_every=params["refit_every"])
+    chunks = noisy_output_chunks(PIOperator(P, R), input_at, fs=fs,
+                                 duration=params["duration"], snr_db=params["snr"],
+                                 rng=np.random.default_rng(params["seed"]))
+    r = stream_jointly(est, chunks)
+    out = {"weights": r.weights, "radii": r.radii,
+           "output_error": _output_error(r.weights, r.radii)}
+    if _plotted(params):
+        out.update(update_index=r.update_index, radius_history=r.radius_history,
+                   weight_history=r.weight_history)
+    return out
+
+
+def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) -> StudyResult:
+    """The noise-free run, then the noisy cases' rows, worst errors and figure."""
     res = StudyResult("joint_estimation")
     op = PIOperator(P, R)
     rows, numbers = [], {}
@@ -57,42 +99,28 @@ def run(out: Path, quick: bool = False) -> StudyResult:
                  _output_error(clean.weights, clean.radii)])
     numbers["noise_free"] = {"weights": float(ew), "radii": float(er)}
 
-    sine = lambda t: 30 * np.sin(2 * np.pi * t)  # noqa: E731
-    if quick:
-        cases = [("sinusoid, SNR 20 dB", sine, 10_000.0, 300.0, 20, 100, [0])]
-    else:
-        cases = [("sinusoid, SNR 20 dB", sine, 10_000.0, 6000.0, 20, 2000, [0, 1, 2]),
-                 ("sinusoid, SNR 10 dB", sine, 10_000.0, 20_000.0, 10, 2000, [0, 1, 2]),
-                 ("stair-step, SNR 20 dB", _staircase_at(1000.0), 1000.0, 40_000.0, 20, 10_000,
-                  [0, 1, 2]),
-                 ("sinusoid, SNR 20 dB, long", sine, 10_000.0, 30_000.0, 20, 10_000, [0, 1, 2]),
-                 ("sinusoid, SNR 10 dB, long", sine, 10_000.0, 100_000.0, 10, 20_000,
-                  [0, 1, 2])]
     fig, ax = new_figure(2, 1)
-    for name, input_at, fs, dur, snr, refit, seeds in cases:
-        worst = {"weights": 0.0, "radii": 0.0}
-        for seed in seeds:
-            est = JointEstimator(5, initial_weights=P0, initial_radii=R0, refit_every=refit)
-            chunks = noisy_output_chunks(op, input_at, fs=fs, duration=dur, snr_db=snr,
-                                         rng=np.random.default_rng(seed))
-            r = stream_jointly(est, chunks)
-            ew, er = np.abs(r.weights / P - 1).max(), np.abs(r.radii / R - 1).max()
-            worst = {"weights": max(worst["weights"], float(ew)),
-                     "radii": max(worst["radii"], float(er))}
-            rows.append([name, f"{fs / 1e3:g} kHz, {dur:g} s, final", seed, 100 * ew, 100 * er,
-                         _output_error(r.weights, r.radii)])
-            if seed == 0 and name.startswith("sinusoid") and "long" not in name:
-                n = r.update_index + 1
-                ax[0, 0].loglog(n, np.abs(r.radius_history / R - 1).max(axis=1) * 100, "o-",
-                                label=f"{name}, radii")
-                ax[0, 0].loglog(n, np.abs(r.weight_history / P - 1).max(axis=1) * 100, "s--",
-                                label=f"{name}, weights")
-                if snr == 10 or quick:
-                    for i in range(5):
-                        ax[0, 1].semilogx(n, r.radius_history[:, i], label=f"rhat_{i + 1}")
-                        ax[0, 1].axhline(R[i], color="0.6", lw=0.6, ls="--")
-                    ax[0, 1].set(title=f"Radius estimates, {name}, seed 0")
-        numbers[name] = worst
+    for c, r in zip(cases, results, strict=True):
+        name, fs, dur, snr, seed = c["name"], c["fs"], c["duration"], c["snr"], c["seed"]
+        worst = numbers.setdefault(name, {"weights": 0.0, "radii": 0.0})
+        weights, radii = np.array(r["weights"]), np.array(r["radii"])
+        ew, er = np.abs(weights / P - 1).max(), np.abs(radii / R - 1).max()
+        worst.update(weights=max(worst["weights"], float(ew)),
+                     radii=max(worst["radii"], float(er)))
+        rows.append([name, f"{fs / 1e3:g} kHz, {dur:g} s, final", seed, 100 * ew, 100 * er,
+                     r["output_error"]])
+        if _plotted(c):
+            n = np.array(r["update_index"]) + 1
+            radius_history = np.array(r["radius_history"])
+            ax[0, 0].loglog(n, np.abs(radius_history / R - 1).max(axis=1) * 100, "o-",
+                            label=f"{name}, radii")
+            ax[0, 0].loglog(n, np.abs(np.array(r["weight_history"]) / P - 1).max(axis=1) * 100,
+                            "s--", label=f"{name}, weights")
+            if snr == 10 or quick:
+                for i in range(5):
+                    ax[0, 1].semilogx(n, radius_history[:, i], label=f"rhat_{i + 1}")
+                    ax[0, 1].axhline(R[i], color="0.6", lw=0.6, ls="--")
+                ax[0, 1].set(title=f"Radius estimates, {name}, seed 0")
     ax[0, 0].set(xlabel="samples so far", ylabel="max relative error [%]",
                  title="Joint estimate against the record length (seed 0)")
     ax[0, 0].legend(fontsize=7)

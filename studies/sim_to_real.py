@@ -30,7 +30,16 @@ def withheld_cases(quick: bool):
     return cases
 
 
-def run_case(effects, seed):
+def cases(quick: bool) -> list[dict]:
+    """One case per withheld effect set and seed (the sweep's plain parameter dicts)."""
+    seeds = range(1 if quick else 10)
+    return [{"effects": list(effects), "seed": s} for effects in withheld_cases(quick)
+            for s in seeds]
+
+
+def run_case(params: dict) -> dict:
+    """The diagnosis' verdict on train/validate records of a random truth (seeded)."""
+    effects, seed = params["effects"], params["seed"]
     tt, vt = excitation("train", seed=2 * seed + 1)
     tv, vv = excitation("validate", seed=2 * seed + 2)
     truth = random_truth(list(effects), seed)
@@ -52,15 +61,14 @@ def real_record(out: Path):
     return rep, figs
 
 
-def run(out: Path, quick: bool = False) -> StudyResult:
-    from tqdm import tqdm
-
-    seeds = range(1 if quick else 10)
+def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) -> StudyResult:
+    """Confusion table over the cases (grouped by withheld effects) and the real record."""
     res = StudyResult("sim_to_real")
     rows, numbers = [], {}
-    cases = withheld_cases(quick)
-    for effects in tqdm(cases, desc="withheld-effect cases", disable=None):
-        verdicts = [run_case(effects, s) for s in seeds]
+    groups: dict[tuple, list[dict]] = {}
+    for params, verdict in zip(cases, results, strict=True):
+        groups.setdefault(tuple(params["effects"]), []).append(verdict)
+    for effects, verdicts in groups.items():
         expected = sorted(effects) or ["none"]
         hits = sum(sorted(v["effects"]) == expected for v in verdicts)
         shrinks = [v["shrink"] for v in verdicts]

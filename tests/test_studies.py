@@ -19,7 +19,7 @@ def test_all_studies_are_listed():
 
 
 def _run(name, tmp_path):
-    res = run_study(name, tmp_path / name, quick=True)
+    res = run_study(name, tmp_path / name, quick=True, workers=0)
     out = tmp_path / name
     assert (out / "results.md").exists() and (out / "results.json").exists()
     for fig in res.figures:
@@ -58,14 +58,35 @@ def test_real_data(tmp_path):
     assert n["adaptive (BIC)"]["held_out_rms"] < n["conventional n=10"]["held_out_rms"]
 
 
+@pytest.mark.slow
 def test_sim_to_real(tmp_path):
+    """The quick confusion table is right, and ``pimodel study sim_to_real --quick --workers 2``
+    (a 2-process LocalCluster) writes the same results.json as the serial run (each case seeds
+    its own generators)."""
     n = _run("sim_to_real", tmp_path).numbers
+    cluster = tmp_path / "cluster"
+    assert main(["study", "sim_to_real", "--quick", "--workers", "2", "--out", str(cluster)]) == 0
+    serial = json.loads((tmp_path / "sim_to_real" / "results.json").read_text())
+    assert serial["numbers"] and json.loads((cluster / "results.json").read_text()) == serial
+    assert len(list((cluster / "cases").glob("*.json"))) == 6  # 5 effects + clean PI, seed 0
     for case, d in n.items():
         if case == "real":
             continue
         assert d["hits"] == d["n"], case
         if case != "none (clean PI)":
             assert d["min_shrink"] >= 0.5, case
+
+
+def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
+    """A rerun of a sweep study loads its finished cases instead of computing them."""
+    from pimodel.study_runner import load_study
+
+    first = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    module = load_study("paper_simulation")
+    monkeypatch.setattr("pimodel.study_runner.load_study", lambda name: module)
+    monkeypatch.setattr(module, "run_case", lambda params: pytest.fail(f"recomputed {params}"))
+    again = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    assert again.to_json() == first.to_json()
 
 
 def test_cli_study_list_and_unknown(tmp_path, capsys):

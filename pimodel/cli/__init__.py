@@ -7,7 +7,7 @@ import argparse
 import importlib
 import sys
 
-COMMANDS = ["simulate", "identify", "fmu", "diagnose", "demo", "study"]
+COMMANDS = ["simulate", "identify", "fmu", "diagnose", "demo", "study", "sweep"]
 
 
 def build_parser() -> argparse.ArgumentParser:

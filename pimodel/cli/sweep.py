@@ -1,0 +1,119 @@
+"""``pimodel sweep TARGET``: a grid or random sweep over the truth simulator's parameters and the
+diagnosis' or identification's settings, on Dask, into a tidy table (one row per case)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+
+def _value(text: str):
+    """A command-line value: JSON (numbers, true/false/null, lists) or else the text itself."""
+    try:
+        return json.loads(text)
+    except ValueError:
+        return text
+
+
+def _assignment(text: str) -> tuple[str, str]:
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip() or not value.strip():
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    return name.strip(), value.strip()
+
+
+def _grid_axis(text: str) -> tuple[str, list]:
+    name, values = _assignment(text)
+    return name, [_value(v.strip()) for v in values.split(",")]
+
+
+def _range(text: str) -> tuple[str, tuple[float, float]]:
+    name, value = _assignment(text)
+    lo, sep, hi = value.partition(":")
+    try:
+        if not sep:
+            raise ValueError
+        return name, (float(lo), float(hi))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected NAME=LOW:HIGH, got {text!r}") from None
+
+
+def register(sub) -> None:
+    from ..study_runner import add_run_options
+    from ..truth_sweep import DIAGNOSE_SETTINGS, IDENTIFY_SETTINGS, TRUTH_PARAMS
+
+    p = sub.add_parser(
+        "sweep",
+        help="sweep the truth simulator and diagnosis/identification settings (tidy table)",
+        description="Run the diagnosis or the identification on records of the truth simulator "
+        "over a grid (--grid) or a random sample (--random) of parameters, on a local Dask "
+        "cluster or a given scheduler, and write OUT/table.csv (one row per case; "
+        ".parquet with pyarrow). Finished cases are kept in OUT/cases, so a rerun computes "
+        f"only the missing ones. Truth parameters: {', '.join(TRUTH_PARAMS)}, fs. "
+        f"Diagnose settings: {', '.join(DIAGNOSE_SETTINGS)}. Identify settings: "
+        f"{', '.join(IDENTIFY_SETTINGS)}.",
+    )
+    p.add_argument("target", choices=["diagnose", "identify"], help="what each case runs")
+    p.add_argument("--grid", type=_grid_axis, action="append", default=[], metavar="NAME=V1,V2",
+                   help="a grid axis (repeatable; the grid is every combination)")
+    p.add_argument("--random", type=_range, action="append", default=[],
+                   metavar="NAME=LOW:HIGH", help="a uniformly sampled parameter (repeatable)")
+    p.add_argument("--samples", type=int, default=None, metavar="N",
+                   help="number of random cases (with --random)")
+    p.add_argument("--set", type=_assignment, action="append", default=[], metavar="NAME=VALUE",
+                   help="a fixed parameter or setting for every case (repeatable)")
+    p.add_argument("--seeds", type=int, default=1, metavar="N",
+                   help="seeds 0..N-1 for every grid point (default 1); random cases get "
+                        "seeds --seed, --seed+1, ...")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random sample (default 0)")
+    p.add_argument("--out", default=None, help="output folder (default out/sweeps/TARGET)")
+    p.add_argument("--table", default="table.csv",
+                   help="table file name in OUT: .csv (default) or .parquet (needs pyarrow)")
+    add_run_options(p)
+    p.set_defaults(func=run)
+
+
+def build_cases(args: argparse.Namespace) -> list[dict]:
+    """The cases the options describe (grid x seeds, or a random sample), with --set values."""
+    from ..sweep import grid, random_cases
+
+    fixed = {name: _value(v) for name, v in args.set}
+    if args.random:
+        if args.grid:
+            raise ValueError("--grid and --random: give one of them")
+        if args.samples is None or args.samples < 1:
+            raise ValueError(f"--samples: expected an integer >= 1 with --random, got "
+                             f"{args.samples}")
+        cases = random_cases(args.samples, seed=args.seed, **dict(args.random))
+    else:
+        if args.samples is not None:
+            raise ValueError("--samples needs --random")
+        if args.seeds < 1:
+            raise ValueError(f"--seeds: expected an integer >= 1, got {args.seeds}")
+        cases = grid(**dict(args.grid), seed=list(range(args.seeds)))
+    clash = sorted(set(fixed) & set(cases[0]))
+    if clash:
+        raise ValueError(f"--set {', '.join(clash)}: already swept")
+    return [{**c, **fixed} for c in cases]
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..sweep import DEFAULT_MEMORY_LIMIT, CaseFailed
+    from ..truth_sweep import truth_sweep
+
+    cases = build_cases(args)
+    out = Path(args.out or Path("out") / "sweeps" / args.target)
+    t0 = time.perf_counter()
+    try:
+        rows = truth_sweep(cases, target=args.target, out=out, table=args.table,
+                           workers=args.workers, scheduler=args.scheduler, fresh=args.fresh,
+                           memory_limit=args.memory_limit or DEFAULT_MEMORY_LIMIT)
+    except CaseFailed as exc:
+        print(f"pimodel sweep: error: {exc}", file=sys.stderr)
+        return 1
+    print(f"sweep {args.target}: {len(rows)} cases in {time.perf_counter() - t0:.1f} s; "
+          f"table {(out / args.table).resolve()}")
+    return 0
