@@ -110,9 +110,9 @@ def _label(snr) -> str:
     return "clean" if snr is None else f"{snr:g} dB"
 
 
-def run(out: Path, quick: bool = False) -> StudyResult:
+def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) -> StudyResult:
+    """The map (table and figure) from the finished cells."""
     res = StudyResult("convergence_map")
-    results = [run_case(c) for c in cases(quick)]
     grid = {(r["input"], r["snr_db"], r["start"]): r for r in results}
     rows = [[inp, start, *[100 * grid[inp, snr, start]["error"] for snr in NOISE]]
             for inp in INPUTS for start in STARTS]
