@@ -62,12 +62,14 @@ def _arrays(prefix: str, base: int, causality: str, start: str, what: str) -> li
             for i in range(NMAX)]
 
 
-def _common() -> list[Var]:
+def _common(*, elements: str = "plays", z0: str = "initial play state (input unit)",
+            weights: tuple[str, str, str] = ("p", "1", "weight p (> 0), play")) -> list[Var]:
+    """Ts, n, z0 and the weight array (name, start, description) of a unit."""
     return [
         Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (>= 1e-12)"),
-        Var("n", 1, "Integer", "parameter", "1", f"number of plays, 1 <= n <= {NMAX}"),
-        Var("z0", 2, "Real", "parameter", "0", "initial play state (input unit)"),
-        *_arrays("p", 100, "parameter", "1", "weight p (> 0), play"),
+        Var("n", 1, "Integer", "parameter", "1", f"number of {elements}, 1 <= n <= {NMAX}"),
+        Var("z0", 2, "Real", "parameter", "0", z0),
+        *_arrays(weights[0], 100, "parameter", weights[1], weights[2]),
     ]
 
 
@@ -140,10 +142,8 @@ MODELS: dict[str, dict] = {
         "id": 5,
         "description": "Asymmetric generalized PI (ascending/descending envelopes a phi + d) or "
                        "its exact inverse (pimodel.asymmetric.AsymmetricPI)",
-        "vars": [Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (>= 1e-12)"),
-                 Var("n", 1, "Integer", "parameter", "1", f"number of plays, 1 <= n <= {NMAX}"),
-                 Var("z0", 2, "Real", "parameter", "0", "initial play state (unit of phi)"),
-                 *_arrays("p", 100, "parameter", "1", "weight p (>= 0), play"),
+        "vars": [*_common(z0="initial play state (unit of phi)",
+                          weights=("p", "1", "weight p (>= 0), play")),
                  *_arrays("r", 200, "parameter", "0", "radius r (>= 0, sorted), play"),
                  _inverse_flag("v, y = y", "y_d, y = v"),
                  Var("p0", 30, "Real", "parameter", "1", "direct weight of phi(v) (> 0)"),
@@ -172,10 +172,8 @@ MODELS: dict[str, dict] = {
         "id": 7,
         "description": "Creep: sum of ZOH first-order lags with feedthrough 1, or its exact "
                        "inverse (pimodel.creep.CreepOperator, dt = Ts)",
-        "vars": [Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (>= 1e-12)"),
-                 Var("n", 1, "Integer", "parameter", "1", f"number of lags, 1 <= n <= {NMAX}"),
-                 Var("z0", 2, "Real", "parameter", "0", "initial lag state x_i[0]"),
-                 *_arrays("c", 100, "parameter", "0.05", "gain c (> 0), lag"),
+        "vars": [*_common(elements="lags", z0="initial lag state x_i[0]",
+                          weights=("c", "0.05", "gain c (> 0), lag")),
                  *_arrays("tau", 200, "parameter", "1", "time constant tau [s] (> 0), lag"),
                  _inverse_flag("u, y = G[u]", "y, y = G^-1[y]"),
                  *_io("input (u, or y when inverse)", "output (G[u], or u when inverse)")],
