@@ -111,6 +111,7 @@ def test_unit_equals_python_operator_with_substepping(fmus, name, inverse, fmi):
     assert np.ptp(want) > 0.5  # the output moved
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 def test_exported_model_equals_python_in_simulate_fmu(tmp_path, fmi):
     """fmpy.simulate_fmu with output_interval = Ts on the exported FMUs (the operators'
@@ -308,6 +309,7 @@ def test_bad_model_json_names_the_place(tmp_path):
                                  CreepOperator([0.1], [1.0], dt=2e-3)), tmp_path)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 def test_cli_exports_a_cascade_that_validates_and_runs_in_the_master(tmp_path, fmi):
     """pimodel fmu build --model: one FMU per stage; each passes fmpy validate and fmutool
