@@ -345,3 +345,20 @@ def test_cli_exports_a_cascade_that_validates_and_runs_in_the_master(tmp_path, f
     np.testing.assert_allclose(cosimulate_chain(inv_paths, y, TS), v, rtol=0, atol=1e-9)
     if exe is None:
         pytest.skip("fmutool (fmu-manipulation-toolbox) is not installed; fmpy checks passed")
+
+
+def test_pi_operator_stage_exports_as_pihysteresis(tmp_path):
+    """A PIOperator stage becomes a PIHysteresis FMU (input v) with the model's start values;
+    the chain equals the Python cascade in the master; a signed-weight PI is refused."""
+    from pimodel import PIOperator
+
+    model = Cascade(PIOperator([1.0, 0.5, 0.2], [0.0, 0.3, 0.6], initial_state=0.1),
+                    operator("CreepOperator"))
+    paths = build_model_fmus(model_from_dict(model_to_dict(model)), tmp_path)
+    assert [p.name for p in paths] == ["model_1_PIHysteresis.fmu", "model_2_CreepOperator.fmu"]
+    assert all(validate_fmu(str(p)) == [] for p in paths)
+    v = signal(400)
+    np.testing.assert_allclose(cosimulate_chain(paths, v, TS), model.simulate(v), rtol=0,
+                               atol=1e-12)
+    with pytest.raises(ValueError, match="model stage 1: op: a PIOperator with signed weights"):
+        build_model_fmus(PIOperator([1.0, 0.5], [0.0, 0.3]).inverse(), tmp_path)

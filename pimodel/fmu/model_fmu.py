@@ -2,8 +2,9 @@
 operator, each a unit of ``pimodel.fmu.build.MODELS`` whose parameters' start values are the
 operator's (in the model description and compiled into the binary), so that an importer that
 sets nothing runs the model. A cascade becomes one FMU per stage, ``<stem>_<i>_<Unit>.fmu``
-(i = 1.. in the order of the stages); connect stage i's output ``y`` to stage i+1's input ``u``
-(:func:`cosimulate_chain` does so, in one communication step per sample).
+(i = 1.. in the order of the stages); connect stage i's output (``y``) to stage i+1's input
+(``u``; ``v`` for a PIOperator stage, unit PIHysteresis); :func:`cosimulate_chain` does so, in
+one communication step per sample.
 """
 
 from __future__ import annotations
@@ -132,8 +133,9 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
 
 
 def cosimulate_chain(paths, u, Ts: float) -> np.ndarray:
-    """Run FMUs in series (stage i's ``y`` into stage i+1's ``u``), one step of ``Ts`` per
-    sample, with each FMU's own start values: ``y[k]`` of the last stage for input ``u[k]``.
+    """Run FMUs in series (stage i's first output into stage i+1's first input), one step of
+    ``Ts`` per sample, with each FMU's own start values: ``y[k]`` of the last stage for input
+    ``u[k]``.
 
     Parameters
     ----------
@@ -149,13 +151,16 @@ def cosimulate_chain(paths, u, Ts: float) -> np.ndarray:
     numpy.ndarray
     """
     units = [FMUUnit(p, instance_name=f"stage{i}") for i, p in enumerate(paths, start=1)]
+    ports = [(next(v.name for v in unit.md.modelVariables if v.causality == "input"),
+              next(v.name for v in unit.md.modelVariables if v.causality == "output"))
+             for unit in units]
     out = np.empty(len(u))
     try:
         for k, x in enumerate(np.asarray(u, float)):
-            for unit in units:
-                unit.set({"u": x})
+            for unit, (inp, outp) in zip(units, ports, strict=True):
+                unit.set({inp: x})
                 unit.step(Ts)
-                x = unit.get(["y"])[0]
+                x = unit.get([outp])[0]
             out[k] = x
     finally:
         for unit in units:

@@ -19,6 +19,7 @@ import numpy as np
 from ..asymmetric import AsymmetricPI, AsymmetricPIInverse
 from ..creep import CreepOperator
 from ..generalized import GeneralizedPI
+from ..operator import PIOperator
 from ..rate_dependent import RateDependentPI, RateDependentPIInverse
 from .build import ENVELOPE_KINDS, NMAX
 
@@ -48,9 +49,10 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
 
     Parameters
     ----------
-    op : GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator or an inverse of these
+    op : GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, an inverse of these, or
+        a PIOperator (unit PIHysteresis, input ``v``; no ``inverse`` variable)
         The operator (inverses: ``AsymmetricPIInverse``, ``RateDependentPIInverse``, an
-        inverted ``CreepOperator``).
+        inverted ``CreepOperator``, the result of ``GeneralizedPI.inverse()``).
     Ts : float, optional
         Sample time [s] for the rate-independent operators (default 1e-3); the rate-dependent
         and creep operators use their own ``dt`` (a different ``Ts`` raises ValueError).
@@ -110,9 +112,17 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
         name, inverse = "CreepOperator", op.inverted
         params = {**_array("c", op.gains), **_array("tau", op.time_constants),
                   "z0": _uniform(op.initial_state, "initial_state")}
+    elif isinstance(op, PIOperator):
+        if op.signed_weights:
+            raise ValueError("op: a PIOperator with signed weights (e.g. an inverse) has no FMU "
+                             "unit here; use the InversePI unit with the forward parameters")
+        return "PIHysteresis", {"Ts": Ts, "n": op.n, **_array("p", op.weights),
+                                **_array("r", op.radii),
+                                "z0": _uniform(op.initial_state, "initial_state")}
     else:
         raise TypeError(f"op: no FMU unit for {type(op).__name__}; supported: GeneralizedPI, "
-                        "AsymmetricPI, RateDependentPI, CreepOperator and their inverses")
+                        "AsymmetricPI, RateDependentPI, CreepOperator, their inverses and "
+                        "PIOperator")
     n = op.m if isinstance(op, CreepOperator) else op.n
     if n > NMAX:
         raise ValueError(f"op: {n} plays (lags), the FMU units take at most {NMAX}")
