@@ -150,7 +150,7 @@ class _Settings:
     def _build(self, values: dict):
         try:
             return self.build(values)
-        except ValueError as err:
+        except (ValueError, TypeError) as err:  # a wrong type in params is a bad value too
             raise ValueError(f"block {self.name!r}, params {sorted(self._known)}: "
                              f"{err}") from err
 

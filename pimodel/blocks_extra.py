@@ -29,9 +29,9 @@ import numpy as np
 
 from . import _native
 from .asymmetric import AsymmetricPI
+from .blocks import _Settings
 from .checks import positive_scalar
 from .creep import CreepOperator
-from .envelopes import Envelope
 from .generalized import GeneralizedPI
 from .rate_dependent import RateDependentPI
 
@@ -51,54 +51,6 @@ class _OperatorBlock(control.NonlinearIOSystem):
     def __init__(self, updfcn, outfcn, *, own_state: Callable[[dict], np.ndarray], **kwargs):
         super().__init__(updfcn, outfcn, **kwargs)
         self._own_state = own_state
-
-
-def _fingerprint(value):
-    if isinstance(value, Envelope):
-        return value.kind, value.coefficients.tobytes()
-    if isinstance(value, (list, tuple, np.ndarray)):
-        arr = np.asarray(value, dtype=float)
-        return arr.shape, arr.tobytes()
-    return value
-
-
-class _Params:
-    """Settings read from ``params`` as ``"<name>.<setting>"``; ``build`` runs again only when
-    a value changes (compared by fingerprint)."""
-
-    def __init__(self, name: str, defaults: dict, build: Callable[[dict], object]):
-        self.name = name
-        self.defaults = dict(defaults)
-        self.keys = {k: f"{name}.{k}" for k in defaults}
-        self.build = build
-        self._seen = tuple(_fingerprint(v) for v in self.defaults.values())
-        self.value = self._build(self.defaults)
-
-    @property
-    def params(self) -> dict:
-        return {self.keys[k]: v for k, v in self.defaults.items()}
-
-    def _build(self, values: dict):
-        try:
-            return self.build(values)
-        except (ValueError, TypeError) as err:
-            raise ValueError(f"block {self.name!r}, params {sorted(self.keys.values())}: "
-                             f"{err}") from err
-
-    def get(self, params: dict | None):
-        params = params or {}
-        prefix = f"{self.name}."
-        unknown = [k for k in params if isinstance(k, str) and k.startswith(prefix)
-                   and k not in self.keys.values()]
-        if unknown:
-            raise ValueError(f"params: unknown setting(s) {sorted(unknown)} for block "
-                             f"{self.name!r}; known: {sorted(self.keys.values())}")
-        values = {k: params.get(key, self.defaults[k]) for k, key in self.keys.items()}
-        seen = tuple(_fingerprint(v) for v in values.values())
-        if seen != self._seen:
-            self.value = self._build(values)
-            self._seen = seen
-        return self.value
 
 
 def _labels(base: str, n: int) -> list[str]:
@@ -138,7 +90,7 @@ def block_initial_state(sys: control.InputOutputSystem, params: dict | None = No
     return np.asarray(own({**sys.params, **(params or {})}), float).reshape(sys.nstates).copy()
 
 
-def _make_block(settings: _Params, step: Callable, *, n_states: int, labels: list[str],
+def _make_block(settings: _Settings, step: Callable, *, n_states: int, labels: list[str],
                 dt: float, name: str, input: str, output: str) -> _OperatorBlock:
     """``step(op, x, u) -> (y, x_next)``; the block checks the state size."""
 
@@ -233,7 +185,7 @@ def generalized_pi_block(op: GeneralizedPI, dt: float, *, name: str = "gpi", inp
             raise ValueError("radii: expected non-decreasing radii (they fix the state order)")
         return new
 
-    settings = _Params(name, {"weights": op.weights.copy(), "radii": op.radii.copy(),
+    settings = _Settings(name, {"weights": op.weights.copy(), "radii": op.radii.copy(),
                               "initial_state": op.initial_state.copy(),
                               "input_envelope": op.input_envelope,
                               "output_envelope": op.output_envelope}, build)
@@ -305,7 +257,7 @@ def asymmetric_pi_block(op: AsymmetricPI, dt: float, *, inverse: bool = False,
             raise ValueError(f"{input}: sample {u!r} is outside the range of {o.shape!r}")
         return float(out[0]), x
 
-    settings = _Params(name, {"direct_weight": op.direct_weight, "weights": op.weights.copy(),
+    settings = _Settings(name, {"direct_weight": op.direct_weight, "weights": op.weights.copy(),
                               "radii": op.radii.copy(), "ascending": op.ascending,
                               "descending": op.descending, "shape": op.shape,
                               "initial_state": op.initial_state.copy()}, build)
@@ -315,7 +267,7 @@ def asymmetric_pi_block(op: AsymmetricPI, dt: float, *, inverse: bool = False,
 
 # -- rate-dependent PI -----------------------------------------------------------------------
 
-def _rdpi_settings(op: RateDependentPI, name: str) -> _Params:
+def _rdpi_settings(op: RateDependentPI, name: str) -> _Settings:
     n = op.n
 
     def build(s: dict) -> RateDependentPI:
@@ -330,7 +282,7 @@ def _rdpi_settings(op: RateDependentPI, name: str) -> _Params:
                              "order)")
         return new
 
-    return _Params(name, {"weights": op.weights.copy(), "base_radii": op.base_radii.copy(),
+    return _Settings(name, {"weights": op.weights.copy(), "base_radii": op.base_radii.copy(),
                           "rate_gain": op.rate_gain,
                           "rate_time_constant": op.rate_time_constant,
                           "initial_state": op.initial_state[:n].copy(),
@@ -485,7 +437,7 @@ def creep_block(op: CreepOperator, *, name: str | None = None, input: str | None
             raise ValueError(f"gains: expected {m} lags (the block's states), got {new.m}")
         return new
 
-    settings = _Params(name, {"gains": op.gains.copy(), "time_constants":
+    settings = _Settings(name, {"gains": op.gains.copy(), "time_constants":
                               op.time_constants.copy(), "initial_state":
                               op.initial_state.copy()}, build)
     return _make_block(settings, _creep_step, n_states=m, labels=_labels("x", m), dt=op.dt,

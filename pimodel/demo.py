@@ -139,10 +139,11 @@ def step_fmu(out: Path, weights) -> tuple[dict, str]:
     """Build the FMUs and co-simulate the adaptive compensation loop; compare with native."""
     from .fmu import build_fmus
     from .fmu.compare import compare_with_native, plot_comparison
+    from .fmu.cosim import LOOP_UNITS
 
     fmu_dir = out / "fmus"
     t0 = time.perf_counter()
-    paths = build_fmus(fmu_dir)
+    paths = build_fmus(fmu_dir, LOOP_UNITS)
     t_build = time.perf_counter() - t0
     n = len(weights)
     r0 = [0.0, *np.linspace(0.3, 0.8, n - 1).round(3).tolist()]  # deliberately wrong start

@@ -213,10 +213,12 @@ class GeneralizedPI:
             When the PI part has no linear play (``r_1 > 0``).
         """
         inv = self._pi.inverse()
-        return GeneralizedPI(inv.weights, inv.radii,
-                             input_envelope=self.output_envelope.inverse(),
-                             output_envelope=self.input_envelope.inverse(),
-                             initial_state=inv.initial_state, signed_weights=True)
+        out = GeneralizedPI(inv.weights, inv.radii,
+                            input_envelope=self.output_envelope.inverse(),
+                            output_envelope=self.input_envelope.inverse(),
+                            initial_state=inv.initial_state, signed_weights=True)
+        out.forward = self  # the operator it inverts (FMU export, JSON form)
+        return out
 
     def to_dict(self) -> dict:
         """JSON-ready parameters (weights, radii, initial state, envelopes)."""

@@ -16,6 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from pimodel.compensation import STAGE  # noqa: E402
 from pimodel.fmu import build_fmus  # noqa: E402
 from pimodel.fmu.compare import compare_with_native, plot_comparison  # noqa: E402
+from pimodel.fmu.cosim import LOOP_UNITS  # noqa: E402
 from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
 
 R0 = [0.0, 0.3, 0.4, 0.8]
@@ -24,7 +25,7 @@ R0 = [0.0, 0.3, 0.4, 0.8]
 def run(out: Path, quick: bool = False) -> StudyResult:
     res = StudyResult("cosimulation")
     with tempfile.TemporaryDirectory() as tmp:
-        build_fmus(tmp)
+        build_fmus(tmp, LOOP_UNITS)
         cmp = compare_with_native(tmp, duration=0.3 if quick else 2.0, weights=STAGE.weights,
                                   initial_radii=R0, gain=20.0)
     co, steps = cmp.cosim, cmp.cosim.t.size

@@ -47,7 +47,7 @@ def test_fmi3_validates(fmus, name):
     assert validate_fmu(str(path(fmus, name))) == []
     md = fmpy.read_model_description(str(path(fmus, name)))
     assert md.fmiVersion == "3.0"
-    p = next(v for v in md.modelVariables if v.name == "p")
+    p = next(v for v in md.modelVariables if v.name in ("p", "c"))  # weights / creep gains
     assert [int(d.start) for d in p.dimensions] == [NMAX]  # a real array, not scalars
     exe = shutil.which("fmutool", path=str(Path(sys.executable).parent))
     if exe is None:
@@ -246,8 +246,9 @@ def _c_variable_table() -> dict[int, list[tuple[str, int, str, str, int]]]:
                          .read_text()).group(1))
     body = text[text.index("static const pim_var unit_vars[] = {"):]
     body = body[: body.index("};")]
-    row = re.compile(r"\{\"(\w+)\", vr_(\w+), '(\w)', PIM_(\w+), (\w+), PIM_AT\(\w+\)\}")
-    tables: dict[int, list] = {1: [], 2: [], 3: []}
+    row = re.compile(r"\{\"(\w+)\", vr_(\w+), '(\w)', PIM_(\w+), (\w+), "
+                     r"PIM_AT\([\w\[\]]+\)\}")
+    tables: dict[int, list] = {spec["id"]: [] for spec in MODELS.values()}
     current = None  # None: rows of every unit
     for line in body.splitlines():
         m = re.match(r"#(?:el)?if PIM_MODEL == (\d)", line.strip())

@@ -1,5 +1,7 @@
-"""FMU robustness (issue 14), FMI 2 and FMI 3, all three units, every call in a child process
-(tests/fmu_driver.py) so that a crash or a hang fails the test instead of killing pytest:
+"""FMU robustness (issue 14), FMI 2 and FMI 3, all units (issue 19 added GeneralizedPI,
+AsymmetricPI, RateDependentPI and CreepOperator, each with its inverse flag), every call in a
+child process (tests/fmu_driver.py) so that a crash or a hang fails
+the test instead of killing pytest:
 
 - each crash or hang case of the issue, with the logged reason: corrupted FMU states (n = 10^6,
   n = -5, NaN radius, random bytes, bit flips, truncation), Ts = 1e-300, too many samples per
@@ -45,8 +47,28 @@ CONFIGS = [(name, fmi) for name in MODELS for fmi in ("2.0", "3.0")]
 IDS = [f"{name}-fmi{fmi[0]}" for name, fmi in CONFIGS]
 OK, ERROR = 0, 3
 VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "guard": 6,
-      "slope_window": 7, "time": 9, "in1": 10, "out1": 11, "in2": 12, "out2": 13, "p": 100,
-      "r": 200, "r_hat": 300}
+      "slope_window": 7, "inverse": 8, "time": 9, "in1": 10, "out1": 11, "in2": 12, "out2": 13,
+      "in_kind": 20, "in_c0": 21, "in_c1": 22, "in_c2": 23, "in_c3": 24, "rate_gain": 40,
+      "p": 100, "r": 200, "r_hat": 300}
+OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
+TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
+CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
+
+
+def weight_message(name: str, i: int, value: float) -> str:
+    """The logged reason for weight (creep: gain) i (1-based) of a bad value."""
+    if name == "CreepOperator":
+        return f"gain c[{i}] = {value:g} is not positive"
+    if name == "AsymmetricPI":
+        return f"weight p[{i}] = {value:g} is negative"
+    return f"weight p[{i}] = {value:g} is not positive"
+
+
+def radius_message(name: str, i: int) -> str:
+    """The logged reason for radius (creep: time constant) i (1-based) = nan."""
+    if name == "CreepOperator":
+        return f"time constant tau[{i}] = nan is not positive"
+    return f"radius r[{i}] = nan is not finite"
 
 
 @pytest.fixture(scope="module")
@@ -71,8 +93,12 @@ def set_array(fmi3: bool, base: int, values, pad: float) -> list:
     return [["set_real", base + i, x] for i, x in enumerate(values)]
 
 
-def init(name: str, fmi3: bool, *, n=3, p=P, r=R, Ts=TS, t0=0.0, extra=()) -> list:
+def init(name: str, fmi3: bool, *, n=3, p=None, r=None, Ts=TS, t0=0.0, extra=()) -> list:
     """The actions of a full initialisation (the last is exit_init)."""
+    if p is None:
+        p = CREEP_GAINS if name == "CreepOperator" else P
+    if r is None:
+        r = TAU if name == "CreepOperator" else R
     acts = [["enter_init", t0]] if fmi3 else [["setup", t0], ["enter_init"]]
     acts += [["set_int", VR["n"], n], ["set_real", VR["Ts"], Ts]]
     acts += set_array(fmi3, VR["p"], p, 1.0)
@@ -114,9 +140,9 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
                        "parameter n = 1000000 out of range: 1 <= n <= 64"),
             *bad_state({**edit, "field": "n", "value": -5}, "parameter n = -5 out of range"),
             *bad_state({**edit, "field": "r", "index": 0, "value": nan},
-                       "radius r[1] = nan is not finite"),
+                       radius_message(name, 1)),
             *bad_state({**edit, "field": "p", "index": 2, "value": -1.0},
-                       "weight p[3] = -1 is not positive"),
+                       weight_message(name, 3, -1.0)),
             *bad_state({**edit, "field": "Ts", "value": 1e-300}, "parameter Ts = 1e-300"),
             *bad_state({**edit, "field": "time", "value": nan}, "time nan must be finite"),
             *bad_state({**edit, "field": "k_next", "value": 2**62}, "sample counter"),
@@ -134,7 +160,7 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
             (["set_state", 0], ERROR, "parameter n = 1000000 out of range"),
             (["get_state", 0], OK, None),
             (["corrupt_state", 0, {**edit, "field": "r", "index": 1, "value": nan}], OK, None),
-            (["set_state", 0], ERROR, "radius r[2] = nan is not finite"),
+            (["set_state", 0], ERROR, radius_message(name, 2)),
             (["get_state", 0], OK, None),
             (["corrupt_state", 0, {"kind": "random", "seed": 2}], OK, None),
             (["set_state", 0], ERROR, "bad magic"),
@@ -204,7 +230,7 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
             (["enter_init", 0.0], ERROR, "EnterInitializationMode is not allowed now"),
             *step],
         "indexed parameter messages": expect(init(name, fmi3, p=[1.0, 0.5, -1.0])[:-1]) + [
-            (["exit_init"], ERROR, "weight p[3] = -1 is not positive")],
+            (["exit_init"], ERROR, weight_message(name, 3, -1.0))],
         "n = 65": expect(init(name, fmi3, n=65)[:-1]) + [
             (["exit_init"], ERROR, "parameter n = 65 out of range: 1 <= n <= 64")],
     }
@@ -306,7 +332,7 @@ def test_sixty_four_plays_match_operator(fmu_dir, fmi):
 
 # ---- random life-cycle fuzzer -------------------------------------------------------------
 
-RUNS_PER_CONFIG = 170  # x 6 configurations = 1020 random runs
+RUNS_PER_CONFIG = 170  # x 14 configurations = 2380 random runs (about 1 s per configuration)
 BAD_FLOATS = ["nan", "inf", "-inf", -1.0, 0.0, 1e308, -1e308, 5e-324, 1e-300]
 
 
@@ -322,7 +348,7 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
     m = max(1, min(n, NMAX))
     p = [_pick_float(rng, rng.uniform(0.05, 2.0), 0.05 * hostile) for _ in range(m)]
     r = sorted(rng.uniform(0, 2) for _ in range(m))
-    if rng.random() < 0.7 or not hostile:
+    if (rng.random() < 0.7 or not hostile) and name != "CreepOperator":
         r[0] = 0.0
     if hostile and rng.random() < 0.1:
         r[rng.randrange(m)] = rng.choice(BAD_FLOATS)
@@ -342,6 +368,15 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
                   ["set_bool", VR["linear_play"], rng.random() < 0.5]]
     if name == "InversePI":
         extra.append(["set_bool", VR["adaptive"], rng.random() < 0.5])
+    if name in OPERATOR_UNITS:
+        extra.append(["set_bool", VR["inverse"], rng.random() < 0.5])
+    if name in ("GeneralizedPI", "AsymmetricPI") and rng.random() < 0.5:  # a tanh envelope
+        extra += [["set_int", VR["in_kind"], rng.choice([1, 3, 7, -1]) if hostile else 1],
+                  ["set_real", VR["in_c0"], _pick_float(rng, rng.uniform(1, 5), 0.1 * hostile)],
+                  ["set_real", VR["in_c1"], _pick_float(rng, rng.uniform(0.1, 2), 0.1 * hostile)]]
+    if name == "RateDependentPI":
+        extra.append(["set_real", VR["rate_gain"], _pick_float(rng, rng.uniform(0, 1e-3),
+                                                               0.1 * hostile)])
     acts = init(name, fmi3, n=n, p=p, r=r, Ts=Ts, t0=t0, extra=extra)
     if hostile and rng.random() < 0.2:  # drop or repeat a life-cycle call
         acts.insert(rng.randrange(len(acts) + 1), rng.choice(
@@ -411,14 +446,16 @@ def random_mutation(rng: random.Random, same_size: bool = False) -> dict:
     return spec
 
 
-def must_reject(mutation: dict, blob_mode: int) -> bool:
+def must_reject(mutation: dict, blob_mode: int, name: str = "") -> bool:
     """Whether the FMU is bound to reject this corrupted state."""
     if mutation["kind"] != "edit":
         return True  # checksum, size or magic
+    if name == "AsymmetricPI" and mutation["field"] == "p" and mutation["value"] == 0.0:
+        return False  # a zero play weight is valid there
     return mutation["field"] in ALWAYS_CHECKED or blob_mode >= 3
 
 
-def check_run(actions: list, results: list, counts: dict) -> None:
+def check_run(actions: list, results: list, counts: dict, name: str = "") -> None:
     """Every status OK or Error (errors logged), outputs finite, corrupted states rejected."""
     for i, (action, res) in enumerate(zip(actions, results, strict=True)):
         where = f"{action} -> {res}"
@@ -431,7 +468,7 @@ def check_run(actions: list, results: list, counts: dict) -> None:
             if action[0] in ("step", "step_next"):
                 counts["steps"] += 1
         corrupted = action[0] in ("deserialize", "corrupt_state") and res.get("changed")
-        if corrupted and must_reject(action[-1], res["blob_mode"]):
+        if corrupted and must_reject(action[-1], res["blob_mode"], name):
             # deserialize rejects it; a corrupted in-memory state is rejected by set_state
             got = res if action[0] == "deserialize" else results[i + 1]
             assert got["status"] == ERROR, f"corrupted state accepted: {where} / {got}"
@@ -450,7 +487,7 @@ def test_random_lifecycle_fuzz(fmu_dir, name, fmi):
     results = run_job(fmu_path(fmu_dir, name, fmi), runs, timeout=240)
     counts = {"ok": 0, "steps": 0, "errors": 0, "rejected_states": 0}
     for actions, res in zip(runs, results, strict=True):
-        check_run(actions, res, counts)
+        check_run(actions, res, counts, name)
     # the fuzzer reached both sides: successful steps and many clean rejections
     print(f"{name} FMI {fmi}: {len(runs)} runs, {counts}")
     assert counts["steps"] > 2 * RUNS_PER_CONFIG and counts["errors"] > RUNS_PER_CONFIG, counts
@@ -504,5 +541,5 @@ def test_fuzz_under_address_sanitizer(tmp_path, monkeypatch):
         counts = {"ok": 0, "steps": 0, "errors": 0, "rejected_states": 0}
         results = run_job(fmu_path(tmp_path, name, fmi), runs, timeout=300, env=env)
         for actions, res in zip(runs[:60], results[:60], strict=True):
-            check_run(actions, res, counts)
+            check_run(actions, res, counts, name)
         assert counts["steps"] > 60, (name, fmi, counts)

@@ -2,8 +2,14 @@
  * The pimodel FMU units, independent of the FMI version: variables, modes, the parameter check,
  * one internal sample, the sub-stepping rule and the checked FMU state format.  Included (static
  * functions) by the FMI 2 and FMI 3 glue after PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
- * 3 InversePI) is defined.  The numerics are the shared C core (pim_pi.c, pim_estimator.c,
- * pim_loops.c).  Functions return 0 on success, or -1 with the reason in u->msg.
+ * 3 InversePI, 4 GeneralizedPI, 5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator) is
+ * defined.  Units 4-7 have a Boolean parameter `inverse`: false runs the operator (input u = v,
+ * output y), true its exact inverse (input u = y_d, output y = v) with the same parameters,
+ * started from the forward operator's initial state (as InversePI).  The numerics are the shared
+ * C core (pim_pi.c, pim_estimator.c, pim_loops.c, pim_generalized.c, pim_asymmetric.c,
+ * pim_rate_dependent.c, pim_creep.c).  An optional PIM_MODEL_DEFAULTS(u) (defined by a
+ * model-specific model.c, `pimodel fmu build --model`) sets the parameters' start values.
+ * Functions return 0 on success, or -1 with the reason in u->msg.
  *
  * Sampling rule: internal sample k (an int64 counter) happens at time k*Ts.  A step from t over
  * h processes every sample with k*Ts in [t, t+h) (tolerance 1e-9*Ts), each with the inputs set
@@ -33,13 +39,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pim_asymmetric.h"
 #include "pim_core.h"
+#include "pim_creep.h"
 #include "pim_estimator.h"
+#include "pim_generalized.h"
 #include "pim_loops.h"
+#include "pim_rate_dependent.h"
 
-#ifndef PIM_MODEL
-#error "define PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator, 3 InversePI)"
+#if !defined(PIM_MODEL) || PIM_MODEL < 1 || PIM_MODEL > 7
+#error "define PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator, 3 InversePI, 4 GeneralizedPI, \
+5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator)"
 #endif
+#define PIM_HAS_INVERSE_FLAG (PIM_MODEL >= 4)
 
 #define PIM_NMAX PIM_MAX_PLAYS            /* declared array size: p[1..64], r[..], r_hat[..] */
 #define NMAX PIM_NMAX
@@ -57,11 +69,30 @@ typedef enum {
     vr_linear_play = 5,
     vr_guard = 6,
     vr_slope_window = 7,
+    vr_inverse = 8, /* units 4-7 */
     vr_time = 9, /* FMI 3 independent variable */
-    vr_in1 = 10,  /* v (PIHysteresis, RadiusEstimator), y_d (InversePI) */
-    vr_out1 = 11, /* y (PIHysteresis), y_hat (RadiusEstimator), v (InversePI) */
+    vr_in1 = 10,  /* v (PIHysteresis, RadiusEstimator), y_d (InversePI), u (units 4-7) */
+    vr_out1 = 11, /* y (PIHysteresis, units 4-7), y_hat (RadiusEstimator), v (InversePI) */
     vr_in2 = 12,  /* y (RadiusEstimator) */
     vr_out2 = 13, /* e (RadiusEstimator) */
+    vr_in_kind = 20, /* GeneralizedPI input envelope; AsymmetricPI shape (kind, c0..c3) */
+    vr_in_c0 = 21,
+    vr_in_c1 = 22,
+    vr_in_c2 = 23,
+    vr_in_c3 = 24,
+    vr_out_kind = 25, /* GeneralizedPI output envelope */
+    vr_out_c0 = 26,
+    vr_out_c1 = 27,
+    vr_out_c2 = 28,
+    vr_out_c3 = 29,
+    vr_p0 = 30, /* AsymmetricPI */
+    vr_a_l = 31,
+    vr_d_l = 32,
+    vr_a_r = 33,
+    vr_d_r = 34,
+    vr_rate_gain = 40, /* RateDependentPI */
+    vr_rate_time_constant = 41,
+    vr_v0 = 42,
     vr_p = 100,
     vr_r = 200,
     vr_r_hat = 300
@@ -99,6 +130,17 @@ typedef struct {
     double z[PIM_MAX_PLAYS];
     double pinv[PIM_MAX_PLAYS], rinv[PIM_MAX_PLAYS];
     pim_estimator est;
+    /* parameters of units 4-7 (GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator;
+     * the creep's gains c and time constants tau are stored in p and r) */
+    int inverse, kind_in, kind_out;
+    double c_in[4], c_out[4];
+    double p0, a_l, d_l, a_r, d_r;
+    double rate_gain, rate_tc, v0;
+    /* derived from the parameters (recomputed, never read from an FMU state) */
+    double lam, a[PIM_NMAX];
+    pim_asym asym;
+    /* rate-dependent state: v[k-1], rate[k] */
+    double hist[2];
     char msg[256]; /* reason of the last failure */
 } pim_unit;
 
@@ -111,6 +153,7 @@ static const pim_var unit_vars[] = {
     {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
     {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
     {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
 #elif PIM_MODEL == 2
     {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
     {"y", vr_in2, 'R', PIM_INPUT, 1, PIM_AT(in2)},
@@ -122,17 +165,65 @@ static const pim_var unit_vars[] = {
     {"linear_play", vr_linear_play, 'B', PIM_PARAMETER, 1, PIM_AT(linear_play)},
     {"guard", vr_guard, 'R', PIM_PARAMETER, 1, PIM_AT(guard)},
     {"slope_window", vr_slope_window, 'I', PIM_PARAMETER, 1, PIM_AT(slope_window)},
-#else
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+#elif PIM_MODEL == 3
     {"y_d", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
     {"v", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
     {"r_hat", vr_r_hat, 'R', PIM_INPUT, PIM_NMAX, PIM_AT(rhat_in)},
     {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
     {"adaptive", vr_adaptive, 'B', PIM_PARAMETER, 1, PIM_AT(adaptive)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+#elif PIM_MODEL == 4
+    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
+    {"in_kind", vr_in_kind, 'I', PIM_PARAMETER, 1, PIM_AT(kind_in)},
+    {"in_c0", vr_in_c0, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[0])},
+    {"in_c1", vr_in_c1, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[1])},
+    {"in_c2", vr_in_c2, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[2])},
+    {"in_c3", vr_in_c3, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[3])},
+    {"out_kind", vr_out_kind, 'I', PIM_PARAMETER, 1, PIM_AT(kind_out)},
+    {"out_c0", vr_out_c0, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[0])},
+    {"out_c1", vr_out_c1, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[1])},
+    {"out_c2", vr_out_c2, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[2])},
+    {"out_c3", vr_out_c3, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[3])},
+#elif PIM_MODEL == 5
+    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
+    {"p0", vr_p0, 'R', PIM_PARAMETER, 1, PIM_AT(p0)},
+    {"a_l", vr_a_l, 'R', PIM_PARAMETER, 1, PIM_AT(a_l)},
+    {"d_l", vr_d_l, 'R', PIM_PARAMETER, 1, PIM_AT(d_l)},
+    {"a_r", vr_a_r, 'R', PIM_PARAMETER, 1, PIM_AT(a_r)},
+    {"d_r", vr_d_r, 'R', PIM_PARAMETER, 1, PIM_AT(d_r)},
+    {"shape_kind", vr_in_kind, 'I', PIM_PARAMETER, 1, PIM_AT(kind_in)},
+    {"shape_c0", vr_in_c0, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[0])},
+    {"shape_c1", vr_in_c1, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[1])},
+    {"shape_c2", vr_in_c2, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[2])},
+    {"shape_c3", vr_in_c3, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[3])},
+#elif PIM_MODEL == 6
+    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
+    {"rate_gain", vr_rate_gain, 'R', PIM_PARAMETER, 1, PIM_AT(rate_gain)},
+    {"rate_time_constant", vr_rate_time_constant, 'R', PIM_PARAMETER, 1, PIM_AT(rate_tc)},
+    {"v0", vr_v0, 'R', PIM_PARAMETER, 1, PIM_AT(v0)},
+#elif PIM_MODEL == 7
+    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"tau", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"c", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
 #endif
     {"Ts", vr_Ts, 'R', PIM_PARAMETER, 1, PIM_AT(Ts)},
     {"n", vr_n, 'I', PIM_PARAMETER, 1, PIM_AT(n)},
     {"z0", vr_z0, 'R', PIM_PARAMETER, 1, PIM_AT(z0)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
     {"time", vr_time, 'R', PIM_INDEPENDENT, 1, PIM_AT(time)},
 };
 #define PIM_NVARS (sizeof unit_vars / sizeof unit_vars[0])
@@ -178,6 +269,17 @@ static void unit_defaults(pim_unit *u)
     u->slope_window = 8;
     u->mode = PIM_INSTANTIATED;
     for (int i = 0; i < PIM_NMAX; ++i) u->p[i] = 1.0;
+    u->c_in[1] = u->c_out[1] = 1.0; /* identity envelopes */
+    u->p0 = u->a_l = u->a_r = 1.0;
+#if PIM_MODEL == 7
+    for (int i = 0; i < PIM_NMAX; ++i) {
+        u->p[i] = 0.05; /* creep gain c */
+        u->r[i] = 1.0;  /* time constant tau [s] */
+    }
+#endif
+#ifdef PIM_MODEL_DEFAULTS
+    PIM_MODEL_DEFAULTS(u);
+#endif
 }
 
 /* Start time (setupExperiment / enterInitializationMode): finite and >= 0. */
@@ -192,6 +294,70 @@ static int unit_start(pim_unit *u, double t0, int stop_defined, double t_stop)
     return 0;
 }
 
+#if PIM_MODEL == 4 || PIM_MODEL == 5
+/* An envelope's kind (0..3, pim_generalized.h) and coefficients <prefix>_kind, <prefix>_c0.. */
+static int unit_check_envelope(pim_unit *u, const char *prefix, int kind, const double *c)
+{
+    if (kind < PIM_ENV_POLY2 || kind > PIM_ENV_TANH_INV)
+        return unit_error(u, "parameter %s_kind = %d out of range: 0 poly2, 1 tanh, 2 poly2_inv, "
+                             "3 tanh_inv", prefix, kind);
+    const char *msg = pim_envelope_check(kind, c);
+    if (msg)
+        return unit_error(u, "parameters %s_c0..%s_c3 = (%g, %g, %g, %g): %s", prefix, prefix,
+                          c[0], c[1], c[2], c[3], msg);
+    return 0;
+}
+#endif
+
+#if PIM_MODEL == 7
+/* Creep: gains c[i] (stored in p) finite and > 0, time constants tau[i] (in r) finite and > 0,
+ * and G minimum phase (sum_i c_i (1 - a_i) / (1 + a_i) < 1, exact for c_i > 0; pim_creep.h). */
+static int unit_check_creep(pim_unit *u)
+{
+    double s = 0.0;
+    for (int i = 0; i < u->n; ++i) {
+        if (!isfinite(u->p[i]) || !(u->p[i] > 0.0))
+            return unit_error(u, "gain c[%d] = %g is not positive (creep gains must be finite "
+                                 "and > 0)", i + 1, u->p[i]);
+        if (!isfinite(u->r[i]) || !(u->r[i] > 0.0))
+            return unit_error(u, "time constant tau[%d] = %g is not positive (must be finite "
+                                 "and > 0 s)", i + 1, u->r[i]);
+        const double a = exp(-u->Ts / u->r[i]);
+        s += u->p[i] * (1.0 - a) / (1.0 + a);
+    }
+    if (!(s < 1.0))
+        return unit_error(u, "bad parameters: the creep G(z) is not minimum phase (sum c_i "
+                             "(1 - a_i) / (1 + a_i) = %g >= 1), its inverse would be unstable",
+                          s);
+    return 0;
+}
+#endif
+
+/* Quantities derived from checked parameters (inverse PI, envelope struct, rate filter, creep
+ * poles); at setup and for every restored FMU state.  0, or -1 with the reason. */
+static int unit_derive(pim_unit *u)
+{
+    const size_t n = (size_t)u->n;
+#if PIM_MODEL == 3
+    if (!u->adaptive && pim_pi_inverse(n, u->p, u->r, NULL, u->pinv, u->rinv, NULL) != 0)
+        return unit_error(u, "bad parameters: not invertible (r[1] must be 0 with a positive "
+                             "weight p[1])");
+#elif PIM_MODEL == 4
+    if (u->inverse && pim_pi_inverse(n, u->p, u->r, NULL, u->pinv, u->rinv, NULL) != 0)
+        return unit_error(u, "bad parameters: not invertible (r[1] must be 0)");
+#elif PIM_MODEL == 5
+    const pim_asym a = {u->p0, u->a_l, u->d_l, u->a_r, u->d_r, u->kind_in,
+                        {u->c_in[0], u->c_in[1], u->c_in[2], u->c_in[3]}, u->kind_in ^ 2};
+    u->asym = a;
+#elif PIM_MODEL == 6
+    u->lam = u->rate_tc > 0.0 ? exp(-u->Ts / u->rate_tc) : 0.0;
+#elif PIM_MODEL == 7
+    for (size_t i = 0; i < n; ++i) u->a[i] = exp(-u->Ts / u->r[i]);
+#endif
+    (void)n;
+    return 0;
+}
+
 /* The parameter rules, shared by initialization and by every FMU state that is restored. */
 static int unit_check_parameters(pim_unit *u)
 {
@@ -201,12 +367,27 @@ static int unit_check_parameters(pim_unit *u)
         return unit_error(u, "parameter Ts = %g: the sample time must be > 0 (finite, >= %g)",
                           u->Ts, PIM_TS_MIN);
     if (!isfinite(u->z0)) return unit_error(u, "parameter z0 = %g: must be finite", u->z0);
+#if PIM_HAS_INVERSE_FLAG
+    if (u->inverse != 0 && u->inverse != 1)
+        return unit_error(u, "parameter inverse = %d: must be a Boolean", u->inverse);
+#endif
+#if PIM_MODEL == 7
+    return unit_check_creep(u);
+#else
     for (int i = 0; i < u->n; ++i) {
+#if PIM_MODEL == 5
+        if (!isfinite(u->p[i]))
+            return unit_error(u, "weight p[%d] = %g is not finite", i + 1, u->p[i]);
+        if (u->p[i] < 0.0)
+            return unit_error(u, "weight p[%d] = %g is negative (weights must be >= 0)", i + 1,
+                              u->p[i]);
+#else
         if (!isfinite(u->p[i]))
             return unit_error(u, "weight p[%d] = %g is not finite", i + 1, u->p[i]);
         if (!(u->p[i] > 0.0))
             return unit_error(u, "weight p[%d] = %g is not positive (weights must be > 0)",
                               i + 1, u->p[i]);
+#endif
         if (!isfinite(u->r[i]))
             return unit_error(u, "radius r[%d] = %g is not finite", i + 1, u->r[i]);
         if (u->r[i] < 0.0)
@@ -216,8 +397,10 @@ static int unit_check_parameters(pim_unit *u)
             return unit_error(u, "radii not sorted: r[%d] = %g < r[%d] = %g (need r[1] <= ... "
                                  "<= r[n])", i + 1, u->r[i], i, u->r[i - 1]);
     }
+#if PIM_MODEL != 5
     const char *msg = pim_pi_check((size_t)u->n, u->p, u->r, 0);
     if (msg) return unit_error(u, "bad parameters: %s", msg);
+#endif
 #if PIM_MODEL == 2
     if (!(u->gain >= 0.0) || !isfinite(u->gain))
         return unit_error(u, "parameter gain = %g: must be finite and >= 0", u->gain);
@@ -234,8 +417,39 @@ static int unit_check_parameters(pim_unit *u)
     if (!u->adaptive && u->r[0] != 0.0)
         return unit_error(u, "bad parameters: not invertible (r[1] = %g must be 0 with a "
                              "positive weight p[1])", u->r[0]);
+#elif PIM_MODEL == 4
+    if (unit_check_envelope(u, "in", u->kind_in, u->c_in) != 0 ||
+        unit_check_envelope(u, "out", u->kind_out, u->c_out) != 0)
+        return -1;
+    if (u->inverse && u->r[0] != 0.0)
+        return unit_error(u, "bad parameters: inverse = true needs a linear play (r[1] = %g "
+                             "must be 0)", u->r[0]);
+#elif PIM_MODEL == 5
+    if (!isfinite(u->p0) || !(u->p0 > 0.0))
+        return unit_error(u, "parameter p0 = %g: the direct weight must be finite and > 0",
+                          u->p0);
+    if (!isfinite(u->a_l) || !(u->a_l > 0.0))
+        return unit_error(u, "parameter a_l = %g: the ascending slope must be finite and > 0",
+                          u->a_l);
+    if (!isfinite(u->a_r) || !(u->a_r > 0.0))
+        return unit_error(u, "parameter a_r = %g: the descending slope must be finite and > 0",
+                          u->a_r);
+    if (!isfinite(u->d_l)) return unit_error(u, "parameter d_l = %g: must be finite", u->d_l);
+    if (!isfinite(u->d_r)) return unit_error(u, "parameter d_r = %g: must be finite", u->d_r);
+    if (unit_check_envelope(u, "shape", u->kind_in, u->c_in) != 0) return -1;
+#elif PIM_MODEL == 6
+    if (!isfinite(u->rate_gain) || u->rate_gain < 0.0)
+        return unit_error(u, "parameter rate_gain = %g: must be finite and >= 0", u->rate_gain);
+    if (!isfinite(u->rate_tc) || u->rate_tc < 0.0)
+        return unit_error(u, "parameter rate_time_constant = %g: must be finite and >= 0",
+                          u->rate_tc);
+    if (!isfinite(u->v0)) return unit_error(u, "parameter v0 = %g: must be finite", u->v0);
+    if (u->inverse && u->r[0] != 0.0)
+        return unit_error(u, "bad parameters: inverse = true needs a linear play (r[1] = %g "
+                             "must be 0)", u->r[0]);
 #endif
     return 0;
+#endif /* PIM_MODEL != 7 */
 }
 
 #if PIM_MODEL == 2
@@ -273,14 +487,23 @@ static int unit_setup(pim_unit *u)
 #else
     for (size_t i = 0; i < n; ++i) u->z[i] = u->z0;
 #endif
+    if (unit_derive(u) != 0) return -1;
+#if PIM_MODEL == 3 || PIM_MODEL == 4
 #if PIM_MODEL == 3
-    if (!u->adaptive) {
-        double zinv[PIM_MAX_PLAYS];
-        if (pim_pi_inverse(n, u->p, u->r, u->z, u->pinv, u->rinv, zinv) != 0)
+    const int inverse_pi = !u->adaptive;
+#else
+    const int inverse_pi = u->inverse;
+#endif
+    if (inverse_pi) { /* the inverse's play states consistent with the forward ones */
+        double zinv[PIM_MAX_PLAYS], pinv[PIM_MAX_PLAYS], rinv[PIM_MAX_PLAYS];
+        if (pim_pi_inverse(n, u->p, u->r, u->z, pinv, rinv, zinv) != 0)
             return unit_error(u, "bad parameters: not invertible (r[1] must be 0 with a "
                                  "positive weight p[1])");
         memcpy(u->z, zinv, n * sizeof(double));
     }
+#elif PIM_MODEL == 6
+    u->hist[0] = u->v0;
+    u->hist[1] = 0.0;
 #endif
     return 0;
 }
@@ -290,7 +513,7 @@ static int unit_check_inputs(pim_unit *u)
 {
     if (!isfinite(u->in1))
         return unit_error(u, "input %s = %g is not finite (NaN or Inf)",
-                          PIM_MODEL == 3 ? "y_d" : "v", u->in1);
+                          PIM_MODEL == 3 ? "y_d" : PIM_MODEL >= 4 ? "u" : "v", u->in1);
 #if PIM_MODEL == 2
     if (!isfinite(u->in2)) return unit_error(u, "input y = %g is not finite (NaN or Inf)", u->in2);
 #elif PIM_MODEL == 3
@@ -321,11 +544,36 @@ static void unit_sample(pim_unit *u)
     u->out1 = yh;
     u->out2 = e;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
-#else
+#elif PIM_MODEL == 3
     if (u->adaptive)
         u->out1 = pim_adaptive_inverse_step(n, u->p, u->rhat_in, u->z, u->in1);
     else
         u->out1 = pim_pi_step(n, u->pinv, u->rinv, u->z, u->in1);
+#elif PIM_MODEL == 4
+    /* the inverse envelope kinds: kind ^ 2 (poly2 <-> poly2_inv, tanh <-> tanh_inv) */
+    if (u->inverse)
+        (void)pim_gpi_run(1, n, u->pinv, u->rinv, u->z, u->kind_out ^ 2, u->c_out,
+                          u->kind_in ^ 2, u->c_in, &u->in1, &u->out1);
+    else
+        (void)pim_gpi_run(1, n, u->p, u->r, u->z, u->kind_in, u->c_in, u->kind_out, u->c_out,
+                          &u->in1, &u->out1);
+#elif PIM_MODEL == 5
+    if (u->inverse)
+        (void)pim_asym_inverse_run(&u->asym, 1, n, u->p, u->r, u->z, &u->in1, &u->out1);
+    else
+        (void)pim_asym_run(&u->asym, 1, n, u->p, u->r, u->z, &u->in1, &u->out1);
+#elif PIM_MODEL == 6
+    if (u->inverse)
+        (void)pim_rdpi_inverse_run(1, n, u->p, u->r, u->rate_gain, u->lam, u->Ts, u->z, u->hist,
+                                   &u->in1, &u->out1);
+    else
+        pim_rdpi_run(1, n, u->p, u->r, u->rate_gain, u->lam, u->Ts, u->z, u->hist, &u->in1,
+                     &u->out1);
+#else
+    if (u->inverse)
+        pim_creep_inverse_run(1, n, u->a, u->p, u->z, &u->in1, &u->out1);
+    else
+        pim_creep_run(1, n, u->a, u->p, u->z, &u->in1, &u->out1);
 #endif
 }
 
@@ -379,6 +627,7 @@ static int unit_do_step(pim_unit *u, double t, double h)
 #else
     double z_saved[PIM_MAX_PLAYS];
     for (int i = 0; i < u->n; ++i) z_saved[i] = u->z[i];
+    const double hist_saved[2] = {u->hist[0], u->hist[1]};
 #endif
     for (; u->k_next < k1; ++u->k_next) {
         unit_sample(u);
@@ -392,9 +641,13 @@ static int unit_do_step(pim_unit *u, double t, double h)
             for (int i = 0; i < u->n; ++i) u->rhat_out[i] = u->est.rhat[i];
 #else
             memcpy(u->z, z_saved, (size_t)u->n * sizeof(double));
+            u->hist[0] = hist_saved[0];
+            u->hist[1] = hist_saved[1];
 #endif
-            return unit_error(u, "the outputs overflowed (%g, %g) at sample %lld with the "
-                                 "inputs held over this step; the step was not taken", y1, y2,
+            return unit_error(u, "the outputs overflowed or are undefined (%g, %g) at sample "
+                                 "%lld with the inputs held over this step (an input beyond an "
+                                 "envelope's domain or range, or a numeric overflow); the step "
+                                 "was not taken", y1, y2,
                               (long long)u->k_next);
         }
     }
@@ -506,7 +759,7 @@ static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 1u
+#define PIM_STATE_VERSION 2u /* 2: units 4-7 fields */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {
@@ -590,10 +843,12 @@ static int unit_check_states(pim_unit *u, pim_unit *s)
     if (!unit_all_finite(s->z, n))
         return unit_error(u, "FMU state rejected: a play state z is not finite");
 #endif
-#if PIM_MODEL == 3
-    if (!s->adaptive && pim_pi_inverse(n, s->p, s->r, NULL, s->pinv, s->rinv, NULL) != 0)
-        return unit_error(u, "FMU state rejected: parameters not invertible");
+#if PIM_MODEL == 6
+    if (!unit_all_finite(s->hist, 2) || s->hist[1] < 0.0)
+        return unit_error(u, "FMU state rejected: the rate state (v[k-1], rate[k]) = (%g, %g) "
+                             "must be finite with rate >= 0", s->hist[0], s->hist[1]);
 #endif
+    if (unit_derive(s) != 0) return unit_error(u, "FMU state rejected: %s", s->msg);
     return 0;
 }
 

@@ -12,12 +12,22 @@ def register(sub) -> None:
     fsub.required = True
     b = fsub.add_parser("build", help="compile and package the FMUs (needs a C compiler)",
                         description="Compile the C core and FMI glue with the C compiler on "
-                        "PATH and write PIHysteresis.fmu, RadiusEstimator.fmu and InversePI.fmu "
-                        "(Linux binary, sources, buildDescription.xml); with --fmi-version 3.0 "
-                        "the FMI 3.0 versions NAME_fmi3.fmu (p, r, r_hat as arrays).")
+                        "PATH and write PIHysteresis.fmu, RadiusEstimator.fmu, InversePI.fmu, "
+                        "GeneralizedPI.fmu, AsymmetricPI.fmu, RateDependentPI.fmu and "
+                        "CreepOperator.fmu (Linux binary, sources, buildDescription.xml); with "
+                        "--fmi-version 3.0 the FMI 3.0 versions NAME_fmi3.fmu (arrays as "
+                        "arrays). With --model MODEL.json: one FMU per operator of the model "
+                        "(MODEL_1_Unit.fmu, ...; a Cascade in the order of its stages) with the "
+                        "model's parameters as start values.")
     b.add_argument("--out", required=True, help="output folder")
     b.add_argument("--which", nargs="+", default=None,
-                   help="units to build (default: all): PIHysteresis RadiusEstimator InversePI")
+                   help="units to build (default: all): PIHysteresis RadiusEstimator InversePI "
+                   "GeneralizedPI AsymmetricPI RateDependentPI CreepOperator")
+    b.add_argument("--model", default=None,
+                   help="a model JSON file (pimodel.models): build its operators' FMUs")
+    b.add_argument("--dt", type=float, default=None,
+                   help="with --model: sample time [s] of rate-independent stages (default: "
+                   "the dt of a rate-dependent or creep stage, else 0.001)")
     b.add_argument("--fmi-version", default="2.0", choices=["2.0", "3.0"],
                    help="FMI version (default 2.0)")
     b.set_defaults(func=run_build)
@@ -27,7 +37,20 @@ def run_build(args: argparse.Namespace) -> int:
     from ..fmu import build_fmus
 
     try:
-        paths = build_fmus(args.out, args.which, fmi_version=args.fmi_version)
+        if args.model is not None:
+            if args.which is not None:
+                raise ValueError("--which and --model exclude each other")
+            from pathlib import Path
+
+            from ..fmu.model_fmu import build_model_fmus
+            from ..models import load_model
+
+            stem = "".join(ch if ch.isalnum() else "_" for ch in Path(args.model).stem)
+            stem = stem if stem[:1].isalpha() else f"m_{stem}"
+            paths = build_model_fmus(load_model(args.model), args.out,
+                                     fmi_version=args.fmi_version, Ts=args.dt, stem=stem)
+        else:
+            paths = build_fmus(args.out, args.which, fmi_version=args.fmi_version)
     except RuntimeError as exc:  # no compiler, compile error
         raise ValueError(str(exc)) from None
     for path in paths:

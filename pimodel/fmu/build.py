@@ -19,8 +19,10 @@ from xml.sax.saxutils import escape
 
 NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
 MAX_SUBSTEPS = 10_000_000  # samples per doStep; PIM_MAX_SUBSTEPS in fmu/src/pim_unit.h
-CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c")
-HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_unit.h")
+CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c", "pim_generalized.c",
+                "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c")
+HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_generalized.h",
+           "pim_asymmetric.h", "pim_rate_dependent.h", "pim_creep.h", "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
 FMI_VERSIONS = tuple(GLUE)
 SUFFIX = {"2.0": "", "3.0": "_fmi3"}  # file NAME{suffix}.fmu per FMI version
@@ -60,13 +62,35 @@ def _arrays(prefix: str, base: int, causality: str, start: str, what: str) -> li
             for i in range(NMAX)]
 
 
-def _common() -> list[Var]:
+def _common(*, elements: str = "plays", z0: str = "initial play state (input unit)",
+            weights: tuple[str, str, str] = ("p", "1", "weight p (> 0), play")) -> list[Var]:
+    """Ts, n, z0 and the weight array (name, start, description) of a unit."""
     return [
         Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (>= 1e-12)"),
-        Var("n", 1, "Integer", "parameter", "1", f"number of plays, 1 <= n <= {NMAX}"),
-        Var("z0", 2, "Real", "parameter", "0", "initial play state (input unit)"),
-        *_arrays("p", 100, "parameter", "1", "weight p (> 0), play"),
+        Var("n", 1, "Integer", "parameter", "1", f"number of {elements}, 1 <= n <= {NMAX}"),
+        Var("z0", 2, "Real", "parameter", "0", z0),
+        *_arrays(weights[0], 100, "parameter", weights[1], weights[2]),
     ]
+
+
+def _inverse_flag(forward: str, inverse: str) -> Var:
+    return Var("inverse", 8, "Boolean", "parameter", "false",
+               f"false: u = {forward}; true: the exact inverse, u = {inverse}")
+
+
+ENVELOPE_KINDS = {"poly2": 0, "tanh": 1, "poly2_inv": 2, "tanh_inv": 3}  # PIM_ENV_* codes
+
+
+def _envelope_vars(prefix: str, base: int, what: str) -> list[Var]:
+    """kind and c0..c3 of an envelope (pim_generalized.h); the default is the identity."""
+    return [Var(f"{prefix}_kind", base, "Integer", "parameter", "0",
+                f"{what}: 0 poly2, 1 tanh, 2 poly2_inv, 3 tanh_inv"),
+            *[Var(f"{prefix}_c{j}", base + 1 + j, "Real", "parameter", "1" if j == 1 else "0",
+                  f"{what}: coefficient c{j}") for j in range(4)]]
+
+
+def _io(inp: str, out: str) -> list[Var]:
+    return [Var("u", 10, "Real", "input", "0", inp), Var("y", 11, "Real", "output", "0", out)]
 
 
 MODELS: dict[str, dict] = {
@@ -103,14 +127,77 @@ MODELS: dict[str, dict] = {
                  Var("v", 11, "Real", "output", "0", "compensator output (actuator input)"),
                  *_arrays("r_hat", 300, "input", "0", "radius input (adaptive mode), play")],
     },
+    "GeneralizedPI": {
+        "id": 4,
+        "description": "Generalized PI y = g(sum p_i Gamma_{r_i}[h(v)]) or its exact inverse "
+                       "(pimodel.generalized.GeneralizedPI)",
+        "vars": [*_common(), *_arrays("r", 200, "parameter", "0",
+                                      "radius r (>= 0, sorted, envelope units), play"),
+                 _inverse_flag("v, y = y", "y_d, y = v"),
+                 *_envelope_vars("in", 20, "input envelope h"),
+                 *_envelope_vars("out", 25, "output envelope g"),
+                 *_io("input (v, or y_d when inverse)", "output (y, or v when inverse)")],
+    },
+    "AsymmetricPI": {
+        "id": 5,
+        "description": "Asymmetric generalized PI (ascending/descending envelopes a phi + d) or "
+                       "its exact inverse (pimodel.asymmetric.AsymmetricPI)",
+        "vars": [*_common(z0="initial play state (unit of phi)",
+                          weights=("p", "1", "weight p (>= 0), play")),
+                 *_arrays("r", 200, "parameter", "0", "radius r (>= 0, sorted), play"),
+                 _inverse_flag("v, y = y", "y_d, y = v"),
+                 Var("p0", 30, "Real", "parameter", "1", "direct weight of phi(v) (> 0)"),
+                 Var("a_l", 31, "Real", "parameter", "1", "ascending envelope slope (> 0)"),
+                 Var("d_l", 32, "Real", "parameter", "0", "ascending envelope offset"),
+                 Var("a_r", 33, "Real", "parameter", "1", "descending envelope slope (> 0)"),
+                 Var("d_r", 34, "Real", "parameter", "0", "descending envelope offset"),
+                 *_envelope_vars("shape", 20, "shape function phi"),
+                 *_io("input (v, or y_d when inverse)", "output (y, or v when inverse)")],
+    },
+    "RateDependentPI": {
+        "id": 6,
+        "description": "Rate-dependent PI, radii alpha_i (1 + beta rate), or its exact inverse "
+                       "(pimodel.rate_dependent.RateDependentPI, dt = Ts)",
+        "vars": [*_common(), *_arrays("r", 200, "parameter", "0",
+                                      "base radius alpha (>= 0, sorted), play"),
+                 _inverse_flag("v, y = y", "y_d, y = v"),
+                 Var("rate_gain", 40, "Real", "parameter", "0",
+                     "beta [s per input unit] (>= 0)"),
+                 Var("rate_time_constant", 41, "Real", "parameter", "0",
+                     "rate filter time constant [s] (>= 0; 0: last interval)"),
+                 Var("v0", 42, "Real", "parameter", "0", "input before the first sample v[-1]"),
+                 *_io("input (v, or y_d when inverse)", "output (y, or v when inverse)")],
+    },
+    "CreepOperator": {
+        "id": 7,
+        "description": "Creep: sum of ZOH first-order lags with feedthrough 1, or its exact "
+                       "inverse (pimodel.creep.CreepOperator, dt = Ts)",
+        "vars": [*_common(elements="lags", z0="initial lag state x_i[0]",
+                          weights=("c", "0.05", "gain c (> 0), lag")),
+                 *_arrays("tau", 200, "parameter", "1", "time constant tau [s] (> 0), lag"),
+                 _inverse_flag("u, y = G[u]", "y, y = G^-1[y]"),
+                 *_io("input (u, or y when inverse)", "output (G[u], or u when inverse)")],
+    },
 }
 
 
+# FMUs of one model's operators (pimodel.fmu.model_fmu): identifier -> spec as in MODELS, plus
+# "salt" (in the GUID) and "defaults" (C statements setting the parameters' start values).
+MODEL_UNITS: dict[str, dict] = {}
+
+
+def spec_of(name: str) -> dict:
+    """The spec of a unit (``MODELS``) or of a model's operator FMU (``MODEL_UNITS``)."""
+    return MODEL_UNITS[name] if name in MODEL_UNITS else MODELS[name]
+
+
 def guid(name: str) -> str:
-    """Fixed GUID of a unit (changes with the interface version: v2 has 64 plays, linear_play)."""
+    """Fixed GUID of a unit (changes with the interface version: v2 has 64 plays, linear_play;
+    a model's operator FMU also with its parameter values)."""
     import uuid
 
-    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi2/{name}/v2")) + "}"
+    salt = MODEL_UNITS[name]["salt"] if name in MODEL_UNITS else ""
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi2/{name}/v2{salt}")) + "}"
 
 
 def source_dir() -> Path:
@@ -141,7 +228,7 @@ def find_compiler() -> str:
 
 
 def model_description(name: str) -> str:
-    spec = MODELS[name]
+    spec = spec_of(name)
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="2.0" modelName="{name}" guid="{guid(name)}" '
@@ -195,13 +282,16 @@ def _model_c(name: str, fmi_version: str) -> str:
         ident = f'#define PIM_MODEL_TOKEN "{token(name)}"\n'
     else:
         ident = f'#define PIM_MODEL_GUID "{guid(name)}"\n'
+    spec = spec_of(name)
+    if "defaults" in spec:
+        ident += f"#define PIM_MODEL_DEFAULTS(u) do {{ {spec['defaults']} }} while (0)\n"
     return (f"/* {name}: selects the unit in the shared FMI {fmi_version} glue. */\n"
-            f"#define PIM_MODEL {MODELS[name]['id']}\n{ident}"
+            f"#define PIM_MODEL {spec['id']}\n{ident}"
             f'#include "{GLUE[fmi_version]}"\n')
 
 
 def _documentation(name: str) -> str:
-    spec = MODELS[name]
+    spec = spec_of(name)
     rows = "".join(f"<tr><td>{v.name}</td><td>{v.causality}</td><td>{escape(v.description)}"
                    "</td></tr>" for v in spec["vars"] if "[" not in v.name or "[1]" in v.name)
     return (f"<html><body><h1>{name}</h1><p>{escape(spec['description'])}.</p>"
@@ -221,7 +311,7 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
     ``fmi_version``: ``"2.0"`` (files ``NAME.fmu``) or ``"3.0"`` (files ``NAME_fmi3.fmu``,
     arrays as FMI 3 arrays); the model identifier is ``NAME`` in both."""
     names = list(MODELS) if which is None else list(which)
-    unknown = [n for n in names if n not in MODELS]
+    unknown = [n for n in names if n not in MODELS and n not in MODEL_UNITS]
     if unknown:
         raise ValueError(f"which: unknown FMU(s) {unknown}; available: {list(MODELS)}")
     check_fmi_version(fmi_version)

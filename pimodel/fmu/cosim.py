@@ -22,6 +22,8 @@ from ..operator import PIOperator
 from .build import fmu_filename
 from .unit import FMUUnit
 
+LOOP_UNITS = ("PIHysteresis", "RadiusEstimator", "InversePI")  # the FMUs this master runs
+
 
 def _arrays(prefix: str, values) -> dict:
     return {f"{prefix}[{i + 1}]": float(x) for i, x in enumerate(values)}

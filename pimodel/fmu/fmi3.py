@@ -7,7 +7,7 @@ from __future__ import annotations
 import uuid
 from xml.sax.saxutils import escape
 
-from .build import MODELS, NMAX
+from .build import MODEL_UNITS, NMAX, spec_of
 
 TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
 PLATFORM = "x86_64-linux"
@@ -15,20 +15,23 @@ PLATFORM = "x86_64-linux"
 
 def token(name: str) -> str:
     """Fixed instantiation token of a unit (changes with the interface version)."""
-    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi3/{name}/v2")) + "}"
+    salt = MODEL_UNITS[name]["salt"] if name in MODEL_UNITS else ""
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi3/{name}/v2{salt}")) + "}"
 
 
 def _variables(name: str) -> list[tuple[str, int, str, str, str, str, bool]]:
     """(name, vr, type, causality, start, description, is_array), arrays merged."""
     out, seen = [], set()
-    for v in MODELS[name]["vars"]:
+    variables = spec_of(name)["vars"]
+    for v in variables:
         if "[" in v.name:
             base = v.name.split("[")[0]
             if base in seen:
                 continue
             seen.add(base)
             what = v.description.rsplit(",", 1)[0]
-            out.append((base, v.vr, TYPES[v.kind], v.causality, " ".join([v.start] * NMAX),
+            starts = [w.start for w in variables if w.name.split("[")[0] == base]
+            out.append((base, v.vr, TYPES[v.kind], v.causality, " ".join(starts),
                         f"{what}, per play (first n of {NMAX} used)", True))
         else:
             out.append((v.name, v.vr, TYPES[v.kind], v.causality, v.start, v.description,
@@ -37,7 +40,7 @@ def _variables(name: str) -> list[tuple[str, int, str, str, str, str, bool]]:
 
 
 def model_description3(name: str) -> str:
-    spec = MODELS[name]
+    spec = spec_of(name)
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="3.0" modelName="{name}" '

@@ -1,0 +1,129 @@
+"""Parameter values of the pimodel FMU units (``pimodel.fmu.build.MODELS``) for the Python
+operators: :func:`unit_parameters` maps a :class:`~pimodel.generalized.GeneralizedPI`,
+:class:`~pimodel.asymmetric.AsymmetricPI`, :class:`~pimodel.rate_dependent.RateDependentPI`,
+:class:`~pimodel.creep.CreepOperator` (or the inverse of one of them) to the unit that runs it
+and the values of its variables, by the FMI 2 names (``"p[2]"``) that :class:`FMUUnit` also
+accepts for FMI 3. The unit at sample time ``Ts`` then gives ``u[k] -> y[k]`` exactly as the
+operator's ``simulate`` (the tests hold them equal to 1e-12).
+
+Limits: the units take one initial state ``z0`` for all plays (lags), so an operator whose
+initial states differ raises ValueError; the object that ``GeneralizedPI.inverse()`` returns
+is exported as its forward operator (its ``forward`` attribute) with ``inverse = true``; a
+GeneralizedPI with signed weights built otherwise has no unit (ValueError).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..asymmetric import AsymmetricPI, AsymmetricPIInverse
+from ..creep import CreepOperator
+from ..generalized import GeneralizedPI
+from ..operator import PIOperator
+from ..rate_dependent import RateDependentPI, RateDependentPIInverse
+from .build import ENVELOPE_KINDS, NMAX
+
+__all__ = ["unit_parameters"]
+
+
+def _uniform(state: np.ndarray, what: str) -> float:
+    z = np.asarray(state, float)
+    if not np.all(z == z[0]):
+        raise ValueError(f"{what}: the FMU takes one initial state z0 for all elements, got "
+                         f"{z.tolist()}")
+    return float(z[0])
+
+
+def _array(name: str, values) -> dict:
+    return {f"{name}[{i + 1}]": float(x) for i, x in enumerate(values)}
+
+
+def _envelope(prefix: str, env) -> dict:
+    c = env.coefficients
+    return {f"{prefix}_kind": ENVELOPE_KINDS[env.kind],
+            **{f"{prefix}_c{j}": float(c[j]) for j in range(4)}}
+
+
+def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
+    """The FMU unit that runs ``op`` and the values of its parameters.
+
+    Parameters
+    ----------
+    op : GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, an inverse of these, or
+        a PIOperator (unit PIHysteresis, input ``v``; no ``inverse`` variable)
+        The operator (inverses: ``AsymmetricPIInverse``, ``RateDependentPIInverse``, an
+        inverted ``CreepOperator``, the result of ``GeneralizedPI.inverse()``).
+    Ts : float, optional
+        Sample time [s] for the rate-independent operators (default 1e-3); the rate-dependent
+        and creep operators use their own ``dt`` (a different ``Ts`` raises ValueError).
+
+    Returns
+    -------
+    (str, dict)
+        Unit name (a key of ``MODELS``) and ``{variable name: value}``.
+
+    Raises
+    ------
+    ValueError
+        Non-uniform initial states, more than 64 plays, a signed-weight GeneralizedPI, or a
+        ``Ts`` that differs from the operator's ``dt``.
+    TypeError
+        Another kind of object.
+
+    Examples
+    --------
+    >>> from pimodel.creep import CreepOperator
+    >>> name, params = unit_parameters(CreepOperator([0.05], [0.1], dt=1e-3).inverse())
+    >>> name, params["inverse"], params["tau[1]"]
+    ('CreepOperator', True, 0.1)
+    """
+    inverse = False
+    if isinstance(op, GeneralizedPI) and isinstance(getattr(op, "forward", None),
+                                                    GeneralizedPI):
+        op, inverse = op.forward, True
+    if isinstance(op, (AsymmetricPIInverse, RateDependentPIInverse)):
+        op, inverse = op.forward, True
+    if isinstance(op, (RateDependentPI, CreepOperator)):
+        if Ts is not None and Ts != op.dt:
+            raise ValueError(f"Ts: {Ts!r} differs from the operator's dt = {op.dt!r}")
+        Ts = op.dt
+    Ts = 1e-3 if Ts is None else float(Ts)
+    if isinstance(op, GeneralizedPI):
+        if op.pi.signed_weights:
+            raise ValueError("op: a GeneralizedPI with signed weights has no FMU unit; export "
+                             "the forward operator (or its inverse()) instead")
+        name = "GeneralizedPI"
+        params = {**_array("p", op.weights), **_array("r", op.radii),
+                  **_envelope("in", op.input_envelope), **_envelope("out", op.output_envelope),
+                  "z0": _uniform(op.initial_state, "initial_state")}
+    elif isinstance(op, AsymmetricPI):
+        name = "AsymmetricPI"
+        params = {**_array("p", op.weights), **_array("r", op.radii), "p0": op.direct_weight,
+                  "a_l": op.ascending[0], "d_l": op.ascending[1], "a_r": op.descending[0],
+                  "d_r": op.descending[1], **_envelope("shape", op.shape),
+                  "z0": _uniform(op.initial_state, "initial_state")}
+    elif isinstance(op, RateDependentPI):
+        name = "RateDependentPI"
+        params = {**_array("p", op.weights), **_array("r", op.base_radii),
+                  "rate_gain": op.rate_gain, "rate_time_constant": op.rate_time_constant,
+                  "v0": op.initial_input, "z0": _uniform(op.initial_state[:op.n],
+                                                         "initial_state")}
+    elif isinstance(op, CreepOperator):
+        name, inverse = "CreepOperator", op.inverted
+        params = {**_array("c", op.gains), **_array("tau", op.time_constants),
+                  "z0": _uniform(op.initial_state, "initial_state")}
+    elif isinstance(op, PIOperator):
+        if op.signed_weights:
+            raise ValueError("op: a PIOperator with signed weights (e.g. an inverse) has no FMU "
+                             "unit here; use the InversePI unit with the forward parameters")
+        return "PIHysteresis", {"Ts": Ts, "n": op.n, **_array("p", op.weights),
+                                **_array("r", op.radii),
+                                "z0": _uniform(op.initial_state, "initial_state")}
+    else:
+        raise TypeError(f"op: no FMU unit for {type(op).__name__}; supported: GeneralizedPI, "
+                        "AsymmetricPI, RateDependentPI, CreepOperator, their inverses and "
+                        "PIOperator")
+    n = op.m if isinstance(op, CreepOperator) else op.n
+    if n > NMAX:
+        raise ValueError(f"op: {n} plays (lags), the FMU units take at most {NMAX}")
+    return name, {"Ts": Ts, "n": n, "inverse": inverse, **params}
