@@ -36,7 +36,7 @@ import numpy as np
 
 from . import _native
 from .checks import as_vector, positive_scalar
-from .estimator import EST_WINDOW, RadiusEstimator
+from .estimator import EST_BINS, EST_WINDOW, RadiusEstimator
 from .operator import PIOperator
 
 __all__ = [
@@ -490,6 +490,7 @@ def radius_estimator(weights, *, dt: float, **settings) -> RadiusEstimator:
 
 _EST_SCALARS = ("v_first", "v_start", "v_ext", "v_rev", "dir", "have_rev", "started", "time",
                 "nseg", "head")
+_EST_PROFILE = ("t_prev", "y_ext", "x_last", "y_last", "bin_width", "top_bin", "fitted")
 
 
 def estimator_state_labels(est: RadiusEstimator) -> list[str]:
@@ -516,7 +517,9 @@ def estimator_state_labels(est: RadiusEstimator) -> list[str]:
     if own is not None and len(own) == size:
         return list(own)
     labels = (_labels("r_hat", n) + _labels("z_hat", n) + _labels("sat", n) + list(_EST_SCALARS)
-              + _labels("v_buf", EST_WINDOW) + _labels("y_buf", EST_WINDOW))
+              + _labels("v_buf", EST_WINDOW) + _labels("y_buf", EST_WINDOW)
+              + list(_EST_PROFILE) + _labels("edge", n) + _labels("bin_sum", EST_BINS)
+              + _labels("bin_travel", EST_BINS))
     if len(labels) != size:
         labels = _labels("r_hat", n) + _labels("internal", size - n)
     return labels
@@ -569,7 +572,7 @@ def estimator_block(weights, dt: float, *, gains=10.0, initial_radii=None,
     ``initial_radii`` and ``initial_state`` define the own initial state; the others change the
     law from the next sample.
 
-    State layout (``sys.state_labels``, ``3 n + 138`` values, the estimator's flat state):
+    State layout (``sys.state_labels``, ``4 n + 657`` values, the estimator's flat state):
 
     ``r_hat[j]``
         radius estimate used at the next sample (n)
@@ -601,6 +604,16 @@ def estimator_block(weights, dt: float, *, gains=10.0, initial_radii=None,
         last inputs (slope check ring buffer, 64)
     ``y_buf[i]``
         last outputs (slope check ring buffer, 64)
+    ``t_prev``, ``y_ext``, ``x_last``, ``y_last``
+        branch profile: travel of the segment that ended at the last reversal, output at the
+        running extreme, travel and output of the last profiled point
+    ``bin_width``, ``top_bin``, ``fitted``
+        travel-bin width (0 before the first reversal), highest bin with data (-1: none),
+        1 once the regime table has been fitted
+    ``edge[j]``
+        fitted breakpoint: travel where play j joins its envelope (n)
+    ``bin_sum[i]``, ``bin_travel[i]``
+        pooled output change and travel per travel bin (256 each)
 
     At its first sample (``started == 0``) the block warns (:class:`InitialStateWarning`) when
     the state differs from its own initial state.

@@ -53,9 +53,9 @@ def test_estimator_block_equals_c_core(record, start):
     ref = core(record, start)
     blk = estimator_block(P, TS, initial_radii=STARTS[start], **SETTINGS)
     res = simulate(blk, t, {"v": v, "y": y})
-    hist = np.column_stack([res[f"r_hat[{i}]"] for i in range(P.size)])
+    hist = np.column_stack([res[f"r_hat[{i + 1}]"] for i in range(P.size)])
     np.testing.assert_allclose(hist, ref.history, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(res["estimator_y_hat"], ref.model_output, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(res["y_hat"], ref.model_output, rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
