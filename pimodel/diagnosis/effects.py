@@ -23,26 +23,38 @@ MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
-EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift")
+EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
+DRIFT_CLOCKS = ("record", "absolute")  # t - t[0] of each record, or t as given
+STEP_SHARE = 0.05  # rate candidate: a one-sample jump above this share of the range is a step
 
 
 @dataclass
 class Segment:
-    """One record: time [s], input, measured output, play outputs ``Z`` of the radius grid."""
+    """One record: time [s] as given, input, measured output, play outputs ``Z`` of the radius
+    grid, and ``mask``: the samples that are fitted and scored (False in a start-up region
+    whose initial memory is unknown)."""
 
     t: np.ndarray
     v: np.ndarray
     y: np.ndarray
     Z: np.ndarray
+    mask: np.ndarray | None = None
+    rate_column: np.ndarray | None = None  # see :func:`rate_column`, set by the diagnosis
+
+    @property
+    def used(self) -> np.ndarray:
+        """Indices or slice of the fitted and scored samples."""
+        return slice(None) if self.mask is None else self.mask
 
     @property
     def dt(self) -> float:
         return float(self.t[1] - self.t[0])
 
 
-def make_segment(t, v, y, radii) -> Segment:
+def make_segment(t, v, y, radii, mask=None) -> Segment:
+    """Segment of one record with the play outputs of ``radii`` (play states start at 0)."""
     Z = PIOperator(np.ones(len(radii)), radii).play_outputs(v)
-    return Segment(t, v, y, Z)
+    return Segment(t, v, y, Z, mask)
 
 
 def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
@@ -111,14 +123,15 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     """Least squares over all train records through the normal equations (columns scaled to
     unit norm; the Gram matrix is small), so a grid search costs one pass over the data per
     point; the residual sum of squares is computed from the residuals themselves."""
-    blocks = [features(s) for s in train]
+    blocks = [features(s)[s.used] for s in train]
+    ys = [s.y[s.used] for s in train]
     G = sum(A.T @ A for A in blocks)
-    g = sum(A.T @ s.y for A, s in zip(blocks, train, strict=True))
+    g = sum(A.T @ y for A, y in zip(blocks, ys, strict=True))
     d = np.sqrt(np.diag(G))
     d[d == 0] = 1.0
     c, *_ = np.linalg.lstsq(G / d[:, None] / d[None, :], g / d, rcond=1e-13)
     coef = c / d
-    rss = float(sum(np.sum((A @ coef - s.y) ** 2) for A, s in zip(blocks, train, strict=True)))
+    rss = float(sum(np.sum((A @ coef - y) ** 2) for A, y in zip(blocks, ys, strict=True)))
     return Model(name, k, features, coef, params or {}), rss
 
 
@@ -133,7 +146,11 @@ def base_features(s: Segment) -> np.ndarray:
 def fit_nominal(train) -> Model:
     model = _fit("nominal", 0, base_features, train)[0]
     h = np.concatenate([model.predict(s) for s in train])
-    model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12)}
+    rate = np.concatenate([np.abs(np.diff(s.v)) / s.dt for s in train])
+    moving = rate[rate > 1e-9 * (float(np.ptp(rate)) or 1.0)]
+    model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
+                    "slope_sum": float(np.sum(model.coef[:-1])),
+                    "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0}
     return model
 
 
@@ -175,6 +192,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
+        elif e == "drift":
+            grids.append([{"clock": fixed["clock"]}] if "clock" in fixed else
+                         [{"clock": c} for c in DRIFT_CLOCKS])
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
@@ -216,7 +236,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
 def _combo_k(effects) -> int:
     return sum({"creep": len(CREEP_TAUS), "dynamics": 2, "delay": 1, "asymmetry": 2,
-                "drift": 1}[e] for e in effects)
+                "drift": 1, "rate": 1}[e] for e in effects)
 
 
 def _combo_features(effects, p, nominal: Model, static: dict):
@@ -233,8 +253,8 @@ def _combo_features(effects, p, nominal: Model, static: dict):
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 cols.append(np.column_stack((u**2, u**3)))
-            if "drift" in effects:
-                cols.append((s.t - s.t[0])[:, None])
+            if "rate" in effects:
+                cols.append(s.rate_column[:, None])
             static[key] = (s, np.hstack(cols))  # keep s alive so its id stays unique
         return static[key][1]
 
@@ -244,9 +264,58 @@ def _combo_features(effects, p, nominal: Model, static: dict):
             Z = mode(Z, p["fn"], p["zeta"], s.dt)
         if "delay" in effects:
             Z = shift(Z, p["d"])
-        return np.hstack((Z, static_columns(s)))
+        cols = [Z, static_columns(s)]
+        if "drift" in effects:
+            cols.append((s.t - s.t[0] if p["clock"] == "record" else s.t)[:, None])
+        return np.hstack(cols)
 
     return feats
+
+
+def rate_column(Z: np.ndarray, radii, weights, v: np.ndarray, dt: float,
+                rate_scale: float) -> np.ndarray:
+    """Output change per unit ``c`` when the play radii grow with the input rate,
+    ``r_i[k] = r_i (1 + c rho[k])``, ``rho = |v[k] - v[k-1]| / dt / rate_scale`` (0 at a
+    sampled step, a one-sample jump of more than ``STEP_SHARE`` of the input range: no rate a
+    play can follow), to first order:
+    ``sum_i w_i (-s_i) r_i rho[j_i]``, where ``j_i <= k`` is the last sample at which play ``i``
+    was pushed (its output moved) and ``s_i`` the sign of that move (a wider play lags further
+    behind the input on the branch it was last pushed along).
+
+    Parameters
+    ----------
+    Z : numpy.ndarray
+        Play outputs ``z_i[k]``, shape (N, n).
+    radii, weights : array_like
+        Play radii ``r_i`` [input units] and weights ``w_i`` of the nominal model.
+    v : numpy.ndarray
+        Input ``v[k]``.
+    dt : float
+        Sample time [s].
+    rate_scale : float
+        Input rate [input units / s] that makes ``rho = 1``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The column, shape (N,), output units.
+
+    Examples
+    --------
+    >>> v = np.array([0.0, 1.0, 2.0, 2.0])
+    >>> Z = np.array([[0.0], [0.5], [1.5], [1.5]])
+    >>> rate_column(Z, [0.5], [1.0], v, 1.0, 1.0).tolist()
+    [0.0, -0.5, -0.5, -0.5]
+    """
+    dv = np.abs(np.diff(v, prepend=v[0]))
+    rho = np.where(dv <= STEP_SHARE * float(np.ptp(v)), dv / dt / rate_scale, 0.0)
+    dz = np.diff(Z, axis=0, prepend=Z[:1])
+    pushed = dz != 0
+    k = np.arange(Z.shape[0])[:, None]
+    last = np.maximum.accumulate(np.where(pushed, k, -1), axis=0)
+    sign = np.sign(dz)[np.maximum(last, 0), np.arange(Z.shape[1])[None, :]]
+    per_play = np.where(last >= 0, -sign * rho[np.maximum(last, 0)], 0.0)
+    return per_play @ (np.asarray(weights, float) * np.asarray(radii, float))
 
 
 def _describe(effects, model: Model, nominal: Model) -> dict:
@@ -254,7 +323,7 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
     n = nominal.coef.size - 1
     extra = model.coef[n + 1:]
     i = 0
-    for e in effects:
+    for e in (e for e in ("creep", "asymmetry", "rate") if e in effects):  # column order
         if e == "creep":
             out["creep_lag_gains"] = extra[i:i + len(CREEP_TAUS)].tolist()
             out["creep_time_constants_s"] = list(CREEP_TAUS)
@@ -262,9 +331,12 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
         elif e == "asymmetry":
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2
-        elif e == "drift":
-            out["drift_per_s"] = float(extra[i])
+        elif e == "rate":
+            out["rate_radius_gain"] = float(extra[i])
             i += 1
+    if "drift" in effects:
+        out["drift_per_s"] = float(model.coef[-1])
+        out["drift_clock"] = model.params["clock"]
     if "fn" in model.params:
         out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
     if "d" in model.params:
