@@ -16,9 +16,7 @@ from pimodel import Record, save_record
 from pimodel.cli import main
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.effects import EFFECTS as CANDIDATES
-from pimodel.truth import excitation, random_truth
-
-FOUND = ("creep", "dynamics", "delay", "asymmetry", "drift")  # "rate": see test_rate_not_none
+from pimodel.truth import EFFECTS, excitation, random_truth
 
 
 def records(effects, seed, drift_clock="record"):
@@ -30,16 +28,17 @@ def records(effects, seed, drift_clock="record"):
     return [truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed, "val")]
 
 
-@pytest.mark.parametrize("effect", FOUND)
+@pytest.mark.parametrize("effect", EFFECTS)
 def test_withheld_single_effect(effect):
     train, validate = records([effect], 0)
     v = diagnose(train, validate).verdict
     assert v["effects"] == [effect]
-    assert v["shrink"] >= 0.5
+    assert v["shrink"] >= (0.7 if effect in ("asymmetry", "rate") else 0.5)
 
 
 @pytest.mark.parametrize("pair,seed,clock", [
     (("creep", "asymmetry"), 3, "record"),
+    (("rate", "creep"), 0, "record"),
     (("dynamics", "drift"), 1, "record"),  # a light 2 kHz mode (damping 0.02)
     (("delay", "drift"), 0, "record"),  # drift restarting with each record
     (("asymmetry", "drift"), 0, "absolute"),  # drift on the clock the records share
@@ -51,15 +50,6 @@ def test_withheld_pair(pair, seed, clock):
     assert v["shrink"] >= 0.5
     if "drift" in pair:
         assert v["model"]["drift_clock"] == clock
-
-
-def test_rate_not_none():
-    # rate-dependent radii: the rate candidate does not yet explain them (see docs/notes/i16.md),
-    # but the gap is reported as unexplained, never hidden as "none"
-    train, validate = records(["rate"], 0)
-    v = diagnose(train, validate).verdict
-    assert "unexplained" in v["effects"]
-    assert v["gap_after"] > 2 * v["noise_floor"]
 
 
 def test_clean_pi_says_none():
@@ -115,9 +105,13 @@ def test_real_record_diagnosis(real_record_path):
     mid = k0 + (len(rec) - k0) // 2
     rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)])
     v = rep.verdict
-    # the real stage is not a clean PI operator: its output lags the voltage by about 12 ms
-    assert v["effects"] == ["delay"]
-    assert 0.008 < v["model"]["delay_samples"] * rec.dt < 0.016
+    # the real stage is not a clean PI operator: its loop is wider than a static PI's, as a lag
+    # of about 11 ms or rate-dependent hysteresis makes it; one 1 Hz sine cannot tell the two
+    # apart, and the verdict says so
+    assert v["effects"] in (["delay"], ["rate"])
+    assert {"delay", "rate"} <= set(v["effects"] + v["alternatives"])
+    delay = next(c for c in rep.candidates if c["effect"] == "delay")
+    assert 0.008 < delay["params"]["delay_s"] < 0.016
     # the sine cycles repeat exactly: the noise floor comes from the difference of periods
     assert v["noise_floor_method"] == "repeated periods"
     assert v["gap_after"] < 1.5 * v["noise_floor"] < v["gap_before"]

@@ -16,7 +16,9 @@ Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
 gap after the best combination stays above 2 times the noise floor and its excess over the noise
 is more than 10 % of the gap's energy before. ``unexplained`` gives that share and where the
-remaining residual lies.
+remaining residual lies. ``alternatives`` lists effects that alone explain the gap within 10 %
+of the validate RMS of the first chosen one: the records cannot tell them apart (for example a
+delay and rate-dependent hysteresis under a single-frequency sine).
 """
 
 from __future__ import annotations
@@ -32,12 +34,13 @@ from ..data import Record
 from .effects import (
     DRIFT_CLOCKS,
     EFFECTS,
+    RATE_BANDS,
     Model,
     Segment,
     fit_effect,
     fit_nominal,
     make_segment,
-    rate_column,
+    rate_columns,
 )
 from .noise import measure_noise_floor
 from .where import residual_breakdown, startup_length
@@ -48,6 +51,7 @@ MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
 NOISE_STOP = 1.5  # no further effect once the validate RMS is within this factor of the noise
 UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
 UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
+ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
 INITIAL_STATES = ("rest", "unknown")
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
@@ -242,13 +246,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                     "initial_state": initial_state}
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
     for s in tr + va:
-        s.rate_column = rate_column(s.Z, radii, nominal.coef[:n_plays], s.v, s.dt,
-                                    nominal.params["rate_scale"])
+        s.rate_column = rate_columns(s.Z, radii, s.v, s.dt, nominal.params["rate_scale"],
+                                     RATE_BANDS)
     tr, va, nominal = _compressed(tr, va, nominal)
     segs = tr + va
-    noise_info = measure_noise_floor([(s.v[s.used], s.y[s.used]) for s in segs],
-                                     [o[s.used] for s, o in zip(segs, out_tr + out_va,
-                                                                strict=True)])
+    noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
 
     cache: dict = {}
@@ -313,6 +315,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                          "concentration": regions.get(reg, {}).get("concentration"),
                          "band": band, "band_energy_share": bands.get(band)})
     unexplained = _unexplained(va, cur_out, before["rms"], after["rms"], noise)
+    alternatives: list[str] = []
+    if chosen:  # effects that alone explain the gap about as well as the first one chosen
+        alone = {c["effect"]: c["validate"]["rms"] for c in candidates}
+        alternatives = [e for e, r in alone.items()
+                        if e != chosen[0] and r <= ALTERNATIVE_RMS * alone[chosen[0]]]
     effects = list(chosen) + (["unexplained"] if unexplained["present"] else [])
     verdict = {"effects": effects or ["none"], "gap_before": before["rms"],
                "gap_after": after["rms"], "shrink": 1 - after["rms"] / before["rms"],
@@ -322,7 +329,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                "noise_floor_method": noise_info["method"],
                "noise_floor_detail": noise_info["detail"],
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
-               "unexplained": unexplained, "model": current.params, "evidence": evidence}
+               "unexplained": unexplained, "alternatives": alternatives,
+               "model": current.params, "evidence": evidence}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out)
 
 

@@ -25,6 +25,7 @@ MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Ny
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 DRIFT_CLOCKS = ("record", "absolute")  # t - t[0] of each record, or t as given
+RATE_BANDS = 8  # the rate candidate's play groups (one column each)
 STEP_SHARE = 0.05  # rate candidate: a one-sample jump above this share of the range is a step
 
 
@@ -97,11 +98,17 @@ def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
     return out.T
 
 
-def shift(x: np.ndarray, d: int) -> np.ndarray:
-    if d == 0:
+def shift(x: np.ndarray, d: float) -> np.ndarray:
+    """``x`` delayed by ``d >= 0`` samples (rows; held at ``x[0]`` before the start); a
+    fractional part interpolates linearly between the two neighbouring whole delays."""
+    n = int(np.floor(d))
+    f = float(d) - n
+    if f > 1e-12:
+        return (1.0 - f) * shift(x, n) + f * shift(x, n + 1)
+    if n == 0:
         return x
-    pad = np.repeat(x[:1], d, axis=0)
-    return np.concatenate((pad, x[: x.shape[0] - d]), axis=0)
+    pad = np.repeat(x[:1], n, axis=0)
+    return np.concatenate((pad, x[: x.shape[0] - n]), axis=0)
 
 
 @dataclass
@@ -204,6 +211,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
         best = search([{**best[0].params, "d": int(d)} for d in range(lo, hi + 1)
                        if d not in dgrid], best)
+        d0 = best[0].params["d"]  # then a fraction of a sample on either side
+        best = search([{**best[0].params, "d": d0 + f} for f in (-0.75, -0.5, -0.25, 0.25,
+                                                                  0.5, 0.75) if d0 + f >= 0],
+                      best)
     if "dynamics" in effects and "fn" not in fixed:
         # refine the mode around the grid optimum, then polish it continuously (a light
         # mode's resonance is narrower than the grid)
@@ -236,7 +247,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
 def _combo_k(effects) -> int:
     return sum({"creep": len(CREEP_TAUS), "dynamics": 2, "delay": 1, "asymmetry": 2,
-                "drift": 1, "rate": 1}[e] for e in effects)
+                "drift": 1, "rate": RATE_BANDS}[e] for e in effects)
 
 
 def _combo_features(effects, p, nominal: Model, static: dict):
@@ -254,7 +265,7 @@ def _combo_features(effects, p, nominal: Model, static: dict):
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 cols.append(np.column_stack((u**2, u**3)))
             if "rate" in effects:
-                cols.append(s.rate_column[:, None])
+                cols.append(s.rate_column)
             static[key] = (s, np.hstack(cols))  # keep s alive so its id stays unique
         return static[key][1]
 
@@ -272,39 +283,42 @@ def _combo_features(effects, p, nominal: Model, static: dict):
     return feats
 
 
-def rate_column(Z: np.ndarray, radii, weights, v: np.ndarray, dt: float,
-                rate_scale: float) -> np.ndarray:
-    """Output change per unit ``c`` when the play radii grow with the input rate,
+def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
+                 bands: int = 4) -> np.ndarray:
+    """Output change per unit weight and unit ``c`` when the play radii grow with the input rate,
     ``r_i[k] = r_i (1 + c rho[k])``, ``rho = |v[k] - v[k-1]| / dt / rate_scale`` (0 at a
     sampled step, a one-sample jump of more than ``STEP_SHARE`` of the input range: no rate a
     play can follow), to first order:
-    ``sum_i w_i (-s_i) r_i rho[j_i]``, where ``j_i <= k`` is the last sample at which play ``i``
-    was pushed (its output moved) and ``s_i`` the sign of that move (a wider play lags further
-    behind the input on the branch it was last pushed along).
+    ``(-s_i) r_i rho[j_i]``, where ``j_i <= k`` is the last sample at which play ``i`` was
+    pushed (its output moved) and ``s_i`` the sign of that move (a wider play lags further
+    behind the input on the branch it was last pushed along), summed over ``bands`` contiguous
+    groups of plays (the fit gives each group its weight times ``c``).
 
     Parameters
     ----------
     Z : numpy.ndarray
         Play outputs ``z_i[k]``, shape (N, n).
-    radii, weights : array_like
-        Play radii ``r_i`` [input units] and weights ``w_i`` of the nominal model.
+    radii : array_like
+        Play radii ``r_i`` [input units].
     v : numpy.ndarray
         Input ``v[k]``.
     dt : float
         Sample time [s].
     rate_scale : float
         Input rate [input units / s] that makes ``rho = 1``.
+    bands : int
+        Groups of plays.
 
     Returns
     -------
     numpy.ndarray
-        The column, shape (N,), output units.
+        The columns, shape (N, min(bands, n)), input units.
 
     Examples
     --------
     >>> v = np.array([0.0, 1.0, 2.0, 2.0])
     >>> Z = np.array([[0.0], [0.5], [1.5], [1.5]])
-    >>> rate_column(Z, [0.5], [1.0], v, 1.0, 1.0).tolist()
+    >>> rate_columns(Z, [0.5], v, 1.0, 1.0).ravel().tolist()
     [0.0, -0.5, -0.5, -0.5]
     """
     dv = np.abs(np.diff(v, prepend=v[0]))
@@ -315,7 +329,9 @@ def rate_column(Z: np.ndarray, radii, weights, v: np.ndarray, dt: float,
     last = np.maximum.accumulate(np.where(pushed, k, -1), axis=0)
     sign = np.sign(dz)[np.maximum(last, 0), np.arange(Z.shape[1])[None, :]]
     per_play = np.where(last >= 0, -sign * rho[np.maximum(last, 0)], 0.0)
-    return per_play @ (np.asarray(weights, float) * np.asarray(radii, float))
+    per_play = per_play * np.asarray(radii, float)
+    groups = np.array_split(np.arange(Z.shape[1]), min(bands, Z.shape[1]))
+    return np.column_stack([per_play[:, g].sum(axis=1) for g in groups])
 
 
 def _describe(effects, model: Model, nominal: Model) -> dict:
@@ -332,8 +348,8 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2
         elif e == "rate":
-            out["rate_radius_gain"] = float(extra[i])
-            i += 1
+            out["rate_band_gains"] = extra[i:i + RATE_BANDS].tolist()
+            i += RATE_BANDS
     if "drift" in effects:
         out["drift_per_s"] = float(model.coef[-1])
         out["drift_clock"] = model.params["clock"]

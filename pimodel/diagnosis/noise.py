@@ -40,24 +40,25 @@ def robust_std(x: np.ndarray) -> float:
 
 
 def _candidate_periods(v: np.ndarray) -> list[int]:
-    """Lags of the largest autocorrelation peaks of the input direction ``sign(dv)`` (robust to
-    single large steps), from 10 samples to half the record."""
-    n = v.size
-    dv = np.sign(np.diff(v))
-    dv = dv - dv.mean()
-    if not np.any(dv):
+    """Most frequent index distances between consecutive input reversals of the same kind at
+    the same level (a repeated input repeats its reversals), at least 10 samples."""
+    s = np.sign(np.diff(v))
+    k = np.flatnonzero(s)
+    if k.size < 3:
         return []
-    m = 1 << int(np.ceil(np.log2(2 * dv.size)))
-    f = np.fft.rfft(dv, m)
-    ac = np.fft.irfft(f * np.conj(f), m)[: n // 2]
-    lo = 10
-    if ac.size <= lo + 2:
+    turn = k[1:][s[k[1:]] != s[k[:-1]]]  # first sample of each new direction
+    if turn.size < 2:
         return []
-    a = ac[lo:]
-    peaks = np.flatnonzero((a[1:-1] > a[:-2]) & (a[1:-1] >= a[2:])) + 1
-    peaks = peaks[a[peaks] > 0.05 * ac[0]]
-    order = peaks[np.argsort(a[peaks])[::-1]]
-    return [int(p + lo) for p in order[:MAX_PERIODS_TRIED]]
+    tol = 1e-6 * (float(np.ptp(v)) or 1.0)
+    counts: dict[int, int] = {}
+    last: dict[tuple, int] = {}  # (level, direction) -> index of its latest reversal
+    for k in turn:
+        key = (int(np.round(v[k] / tol)), int(s[k]))
+        if key in last and k - last[key] >= 10:
+            P = int(k - last[key])
+            counts[P] = counts.get(P, 0) + 1
+        last[key] = int(k)
+    return sorted(counts, key=lambda P: -counts[P])[:MAX_PERIODS_TRIED]
 
 
 def _repeated_differences(v: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
