@@ -13,6 +13,7 @@ Each case is a plain picklable dict (``generator``, ``effects``, ``drift_clock``
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -89,14 +90,19 @@ def run_case(case: dict) -> dict:
             "noise_floor": v["noise_floor"], "noise_method": v["noise_floor_method"]}
 
 
+def group_name(row: dict) -> str:
+    """Name of a case group: the withheld effects (and the drift's clock)."""
+    key = "+".join(row["effects"]) or "none (clean)"
+    if "drift" in row["effects"]:
+        key += f" [{row['drift_clock']} clock]"
+    return key
+
+
 def confusion(rows: list[dict]) -> list[list]:
     """One table row per case group: right / cases, shrink, verdict counts."""
     groups: dict = {}
     for r in rows:
-        key = "+".join(r["effects"]) or "none (clean)"
-        if "drift" in r["effects"]:
-            key += f" [{r['drift_clock']} clock]"
-        groups.setdefault(key, []).append(r)
+        groups.setdefault(group_name(r), []).append(r)
     table = []
     for key, rs in groups.items():
         found: dict[str, int] = {}
@@ -127,7 +133,17 @@ def run(out: Path, quick: bool = False) -> StudyResult:
 
     res = StudyResult("sim_to_real")
     rows = [run_case(c) for c in tqdm(cases(quick), desc="withheld-effect cases", disable=None)]
-    numbers: dict = {"cases": rows}
+    numbers: dict = {}
+    for r in rows:
+        key = f"{r['generator']}: {group_name(r)}"
+        kind = "clean" if not r["effects"] else "outside" if expected(r) == ["unexplained"] \
+            else "effect"
+        d = numbers.setdefault(key, {"hits": 0, "n": 0, "min_shrink": np.inf, "kind": kind})
+        d["hits"] += int(r["right"])
+        d["n"] += 1
+        d["min_shrink"] = min(d["min_shrink"], float(r["shrink"]))
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "cases.json").write_text(json.dumps(rows, indent=1, default=float))
     for gen, title in (("truth", "pimodel.truth (PI family)"),
                        ("truth_alt", "pimodel.truth_alt (independent: Preisach, log creep, "
                                      "two modes, coloured noise)")):

@@ -90,11 +90,12 @@ def test_cli_diagnose(tmp_path):
     out = tmp_path / "d.json"
     assert main(["diagnose", "--train", str(tmp_path / "a.csv"), "--validate",
                  str(tmp_path / "b.csv"), "--json", str(out), "--plots",
-                 str(tmp_path / "plots")]) == 0
+                 str(tmp_path / "plots"), "--initial-state", "unknown"]) == 0
     data = json.loads(out.read_text())
     assert data["verdict"]["effects"] == ["drift"]
     assert 0.5 <= data["verdict"]["shrink"] <= 1
     assert (tmp_path / "plots" / "residuals.png").exists()
+    assert data["nominal"]["initial_state"] == "unknown"
 
 
 def test_real_record_diagnosis(real_record_path):
