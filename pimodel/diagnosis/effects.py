@@ -22,6 +22,7 @@ MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
 MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
+SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 DRIFT_CLOCKS = ("record", "absolute")  # t - t[0] of each record, or t as given
@@ -93,9 +94,14 @@ def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
     zi = lfilter_zi(b, a)
     if x.ndim == 1:
         return lfilter(b, a, x, zi=zi * x[0])[0]
-    xt = np.ascontiguousarray(x.T)
-    out, _ = lfilter(b, a, xt, axis=-1, zi=zi[None, :] * xt[:, :1])
-    return out.T
+    return mode_rows(np.ascontiguousarray(x.T), fn, zeta, dt).T
+
+
+def mode_rows(xt: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
+    """:func:`mode` applied to each row of ``xt`` (signals as rows, C-contiguous)."""
+    b, a = mode_coefficients(fn, zeta, dt)
+    out, _ = lfilter(b, a, xt, axis=-1, zi=lfilter_zi(b, a)[None, :] * xt[:, :1])
+    return out
 
 
 def shift(x: np.ndarray, d: float) -> np.ndarray:
@@ -176,14 +182,18 @@ def delay_grid(dt: float) -> np.ndarray:
 
 
 def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> Model:
-    """Joint fit; the nonlinear parameters (mode, delay) by grid search on the train RSS, then
-    refined around the grid optimum."""
+    """Joint fit; the nonlinear parameters (mode, delay, drift clock) by grid search on the
+    train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
+    the grid optimum, then refitted with every play column."""
     name, k = "+".join(effects), _combo_k(effects)
     static: dict = {}
+    # a mode search filters every column at every point: there, the leading columns only
+    ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
 
     def search(points, best=None):
         for p in points:
-            model, rss = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)
+            model, rss = _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
+                              train, p)
             if best is None or rss < best[1]:
                 best = (model, rss)
         return best
@@ -220,8 +230,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         # mode's resonance is narrower than the grid)
         f0, z0 = best[0].params["fn"], best[0].params["zeta"]
         best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
-                       for f in f0 * np.linspace(0.88, 1.12, 13)
-                       for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0])
+                       for f in f0 * np.linspace(0.88, 1.12, 9)
+                       for z in z0 * np.array([0.5, 0.75, 1.0, 1.35, 2.0])
                        if f <= fmax and MODE_DAMPING_RANGE[0] <= z <= MODE_DAMPING_RANGE[1]],
                       best)
         base = dict(best[0].params)
@@ -230,7 +240,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
             if p["fn"] > fmax or not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
                 return np.inf
-            return _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[1]
+            return _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
+                        train, p)[1]
 
         x0 = np.log([base["fn"], base["zeta"]])
         r = minimize(cost, x0, method="Nelder-Mead", options={
@@ -239,7 +250,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
-    model = best[0]
+    p = best[0].params  # the grid optimum, refitted with every play column
+    model = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[0]
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
     return model
@@ -250,7 +262,7 @@ def _combo_k(effects) -> int:
                 "drift": 1, "rate": RATE_BANDS}[e] for e in effects)
 
 
-def _combo_features(effects, p, nominal: Model, static: dict):
+def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
     """Feature builder for the effects with grid parameters ``p``; the columns that do not
     depend on ``p`` (offset, creep, asymmetry, drift) are memoised per segment in ``static``."""
 
@@ -270,9 +282,12 @@ def _combo_features(effects, p, nominal: Model, static: dict):
         return static[key][1]
 
     def feats(s: Segment) -> np.ndarray:
-        Z = s.Z
-        if "dynamics" in effects:
-            Z = mode(Z, p["fn"], p["zeta"], s.dt)
+        Z = s.Z if ncols is None else s.Z[:, :ncols]
+        if "dynamics" in effects:  # filter the (memoised) transposed columns
+            key = ("rows", id(s), ncols)
+            if key not in static:
+                static[key] = (s, np.ascontiguousarray(Z.T))
+            Z = mode_rows(static[key][1], p["fn"], p["zeta"], s.dt).T
         if "delay" in effects:
             Z = shift(Z, p["d"])
         cols = [Z, static_columns(s)]
@@ -316,10 +331,10 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
 
     Examples
     --------
-    >>> v = np.array([0.0, 1.0, 2.0, 2.0])
-    >>> Z = np.array([[0.0], [0.5], [1.5], [1.5]])
-    >>> rate_columns(Z, [0.5], v, 1.0, 1.0).ravel().tolist()
-    [0.0, -0.5, -0.5, -0.5]
+    >>> v = np.r_[np.linspace(0.0, 1.0, 41), 1.0]  # a ramp at 0.025 per sample, then a hold
+    >>> Z = np.maximum(v - 0.5, 0.0)[:, None]  # one play of radius 0.5, pushed from v = 0.5
+    >>> np.round(rate_columns(Z, [0.5], v, 1.0, 0.025)[[0, 20, 21, 41], 0], 6).tolist()
+    [0.0, 0.0, -0.5, -0.5]
     """
     dv = np.abs(np.diff(v, prepend=v[0]))
     rho = np.where(dv <= STEP_SHARE * float(np.ptp(v)), dv / dt / rate_scale, 0.0)
