@@ -10,7 +10,9 @@ refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are ad
 each round fits every remaining candidate on train (on top of those already chosen) and scores
 it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by more
 than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the noise
-floor (:mod:`.noise`: repeated input periods, else a flexible local model).
+floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
+effect passes in the first round, every pair is fitted jointly and the best pair kept on the
+same terms (two effects can mask each other).
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
@@ -299,10 +301,25 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 best = (dbic, name, m, o)
         if best is None:
             break
-        dbic, name, m, o = best
-        if dbic > -MIN_BIC_DROP or _errors(va, o)["rms"] > (1 - MIN_RMS_CUT) * rms_now:
+
+        def accepted(b_, rms_now=rms_now):
+            return b_[0] <= -MIN_BIC_DROP and _errors(va, b_[3])["rms"] <= (1 - MIN_RMS_CUT) * \
+                rms_now
+
+        if not accepted(best) and not chosen and max_effects >= 2:
+            # two effects can mask each other (a drift confounds an asymmetry fitted alone):
+            # when no single effect passes in the first round, try every pair jointly
+            rest = [e for e in EFFECTS if e not in chosen]
+            for i, first in enumerate(rest):
+                for name in rest[i + 1:]:
+                    m, o = fit(name, (*chosen, first), dict(fixed) if chosen else None)
+                    dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
+                    if dbic < best[0]:
+                        best = (dbic, (first, name), m, o)
+        if not accepted(best):
             break
-        chosen += (name,)
+        dbic, name, m, o = best
+        chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
         current, cur_out = m, o
     after = _errors(va, cur_out)
