@@ -60,6 +60,12 @@ STRICT_MODULES = [
     "pimodel.branches",
     "pimodel.blocks",
     "pimodel.describing",
+    "pimodel.sweep",
+    "pimodel.truth_sweep",
+    "pimodel.models",
+    "pimodel.blocks_extra",
+    "pimodel.estimator_settings",
+    "pimodel.fmu.operators",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the

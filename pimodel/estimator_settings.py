@@ -83,7 +83,31 @@ def stability_bound(weights, dt: float) -> float:
 
 
 def check_gains(gains, weights, dt: float) -> None:
-    """Warn (``UserWarning``) when a gain exceeds :func:`stability_bound`."""
+    """Warn (``UserWarning``) when a gain exceeds :func:`stability_bound`.
+
+    Parameters
+    ----------
+    gains : float or array_like
+        The estimator's gains (scalar or per play).
+    weights : array_like
+        Play weights p_j > 0.
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    None
+        Nothing; a gain above ``2 / (dt |p|^2)`` gives a ``UserWarning`` naming it and the bound.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     check_gains(1e6, [0.3, 0.5, 0.8, 0.3, 0.2], 1e-3)
+    >>> "exceeds the stability bound" in str(caught[0].message)
+    True
+    """
     g = np.atleast_1d(np.asarray(gains, float))
     bound = stability_bound(weights, dt)
     if np.any(g > bound):

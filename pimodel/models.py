@@ -168,10 +168,12 @@ def load_model(path):
     Parameters
     ----------
     path : str or Path
+        A file written by :func:`save_model` (or by hand in the same form).
 
     Returns
     -------
     object
+        The operator, inverse or :class:`~pimodel.cascade.Cascade`.
 
     Raises
     ------
@@ -179,6 +181,15 @@ def load_model(path):
         No such file.
     ValueError
         Not JSON, or not a valid model (the message names the file and the place).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from pimodel.creep import CreepOperator
+    >>> path = save_model(CreepOperator([0.05], [0.1], dt=1e-3),
+    ...                   os.path.join(tempfile.mkdtemp(), "creep.json"))
+    >>> load_model(path).gains
+    array([0.05])
     """
     p = Path(path)
     try:
@@ -192,7 +203,29 @@ def load_model(path):
 
 
 def save_model(model, path) -> Path:
-    """Write :func:`model_to_dict` of ``model`` as JSON to ``path`` and return the path."""
+    """Write :func:`model_to_dict` of ``model`` as JSON to ``path`` and return the path.
+
+    Parameters
+    ----------
+    model : object
+        An operator, an inverse or a :class:`~pimodel.cascade.Cascade` of them.
+    path : str or Path
+        The JSON file to write (overwritten).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import json, os, tempfile
+    >>> from pimodel.creep import CreepOperator
+    >>> path = save_model(CreepOperator([0.05], [0.1], dt=1e-3),
+    ...                   os.path.join(tempfile.mkdtemp(), "creep.json"))
+    >>> json.loads(path.read_text())["type"]
+    'CreepOperator'
+    """
     p = Path(path)
     p.write_text(json.dumps(model_to_dict(model), indent=2) + "\n")
     return p

@@ -53,12 +53,27 @@ __all__ = ["CaseFailed", "DEFAULT_MEMORY_LIMIT", "WORKER_ENV", "available_cores"
 class CaseFailed(RuntimeError):
     """A case function raised; the message names the case, its params and the kept results.
 
+    Parameters
+    ----------
+    message : str
+        What failed, which case, and how many finished cases were kept.
+    index : int
+        Position of the failing case in the case list.
+    params : dict
+        The failing case's parameters.
+
     Attributes
     ----------
     index : int
         Position of the failing case in the case list.
     params : dict
         The failing case's parameters.
+
+    Examples
+    --------
+    >>> err = CaseFailed("case 2 of 5 failed", 1, {"seed": 1})
+    >>> err.index, err.params
+    (1, {'seed': 1})
     """
 
     def __init__(self, message: str, index: int, params: dict):
