@@ -1,5 +1,6 @@
 """The docs (docs/*.md and the API reference from the docstrings) build with Sphinx without a
-single warning (-W), from the checkout as it is: the README's build command, into a temp dir."""
+single warning (-W), from the checkout as it is: docs/DEVELOPING.md's build command, into a
+temp dir."""
 
 from __future__ import annotations
 
