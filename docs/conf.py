@@ -60,6 +60,17 @@ STRICT_MODULES = [
     "pimodel.branches",
     "pimodel.blocks",
     "pimodel.describing",
+    "pimodel.operator",
+    "pimodel.estimator_health",
+    "pimodel.estimator_settings",
+    "pimodel.sweep",
+    "pimodel.truth_sweep",
+    "pimodel.play_reduction",
+    "pimodel.models",
+    "pimodel.fit_operators",
+    "pimodel.blocks_extra",
+    "pimodel.fmu.block",
+    "pimodel.fmu.operators",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the

@@ -83,7 +83,31 @@ def stability_bound(weights, dt: float) -> float:
 
 
 def check_gains(gains, weights, dt: float) -> None:
-    """Warn (``UserWarning``) when a gain exceeds :func:`stability_bound`."""
+    """Warn (``UserWarning``) when a gain exceeds :func:`stability_bound`.
+
+    Parameters
+    ----------
+    gains : float or array_like of float
+        Adaptation gains (one, or one per play).
+    weights : array_like of float
+        Play weights ``p_j``.
+    dt : float
+        Sample time [s].
+
+    Warns
+    -----
+    UserWarning
+        If a gain exceeds ``2 / (dt |p|^2)``: the estimate would diverge.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     check_gains(1e6, [1.0, 1.0], 1e-3)
+    >>> len(caught)
+    1
+    """
     g = np.atleast_1d(np.asarray(gains, float))
     bound = stability_bound(weights, dt)
     if np.any(g > bound):

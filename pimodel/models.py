@@ -168,10 +168,12 @@ def load_model(path):
     Parameters
     ----------
     path : str or Path
+        The JSON file written by :func:`save_model`.
 
     Returns
     -------
     object
+        The model (a PI operator, cascade, creep operator, ...).
 
     Raises
     ------
@@ -179,6 +181,15 @@ def load_model(path):
         No such file.
     ValueError
         Not JSON, or not a valid model (the message names the file and the place).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from pimodel.creep import CreepOperator
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = save_model(CreepOperator([0.05], [0.1], dt=1e-3), os.path.join(tmp, "m.json"))
+    ...     load_model(path).m
+    1
     """
     p = Path(path)
     try:
@@ -192,7 +203,33 @@ def load_model(path):
 
 
 def save_model(model, path) -> Path:
-    """Write :func:`model_to_dict` of ``model`` as JSON to ``path`` and return the path."""
+    """Write :func:`model_to_dict` of ``model`` as JSON to ``path`` and return the path.
+
+    Parameters
+    ----------
+    model : object
+        A model :func:`model_to_dict` knows.
+    path : str or Path
+        The file to write (overwritten).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is of a type :func:`model_to_dict` does not know (nothing is written).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from pimodel.creep import CreepOperator
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     save_model(CreepOperator([0.05], [0.1], dt=1e-3), os.path.join(tmp, "m.json")).name
+    'm.json'
+    """
     p = Path(path)
     p.write_text(json.dumps(model_to_dict(model), indent=2) + "\n")
     return p

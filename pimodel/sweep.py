@@ -53,12 +53,20 @@ __all__ = ["CaseFailed", "DEFAULT_MEMORY_LIMIT", "WORKER_ENV", "available_cores"
 class CaseFailed(RuntimeError):
     """A case function raised; the message names the case, its params and the kept results.
 
-    Attributes
+    Parameters
     ----------
+    message : str
+        The error message.
     index : int
-        Position of the failing case in the case list.
+        Position of the failing case in the case list (kept as ``.index``).
     params : dict
-        The failing case's parameters.
+        The failing case's parameters (kept as ``.params``).
+
+    Examples
+    --------
+    >>> err = CaseFailed("case 1 failed", 1, {"x": 3})
+    >>> err.index, err.params
+    (1, {'x': 3})
     """
 
     def __init__(self, message: str, index: int, params: dict):
