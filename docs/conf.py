@@ -71,6 +71,12 @@ STRICT_MODULES = [
     "pimodel.blocks_extra",
     "pimodel.fmu.block",
     "pimodel.fmu.operators",
+    "pimodel.data",
+    "pimodel.envelopes",
+    "pimodel.cascade",
+    "pimodel.fmu.model_fmu",
+    "pimodel.checks",
+    "pimodel.simulation",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
