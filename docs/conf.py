@@ -77,6 +77,10 @@ STRICT_MODULES = [
     "pimodel.fmu.model_fmu",
     "pimodel.checks",
     "pimodel.simulation",
+    "pimodel.generalized",
+    "pimodel.asymmetric",
+    "pimodel.rate_dependent",
+    "pimodel.creep",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
