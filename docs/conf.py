@@ -81,6 +81,8 @@ STRICT_MODULES = [
     "pimodel.asymmetric",
     "pimodel.rate_dependent",
     "pimodel.creep",
+    "pimodel.estimator",
+    "pimodel.estimator_reference",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
