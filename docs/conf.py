@@ -83,6 +83,8 @@ STRICT_MODULES = [
     "pimodel.creep",
     "pimodel.estimator",
     "pimodel.estimator_reference",
+    "pimodel.identify",
+    "pimodel.joint",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
