@@ -85,6 +85,8 @@ STRICT_MODULES = [
     "pimodel.estimator_reference",
     "pimodel.identify",
     "pimodel.joint",
+    "pimodel.loops",
+    "pimodel.compensation",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
