@@ -88,6 +88,8 @@ STRICT_MODULES = [
     "pimodel.loops",
     "pimodel.compensation",
     "pimodel.study_runner",
+    "pimodel.fmu.build",
+    "pimodel.fmu.fmi3",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
