@@ -90,6 +90,9 @@ STRICT_MODULES = [
     "pimodel.study_runner",
     "pimodel.fmu.build",
     "pimodel.fmu.fmi3",
+    "pimodel.fmu.unit",
+    "pimodel.fmu.cosim",
+    "pimodel.fmu.compare",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
