@@ -98,8 +98,8 @@ def cosimulate_adaptive_loop(fmu_dir, ref, dt: float, plant: PIOperator, *, weig
     >>> native = run_loop(ref, plant, 1e-3, feedforward="adaptive", estimator=est)
     >>> fmu_dir = tempfile.mkdtemp()
     >>> _ = build_fmus(fmu_dir, LOOP_UNITS)  # doctest: +SKIP
-    >>> res = cosimulate_adaptive_loop(fmu_dir, ref, 1e-3, plant, weights=[1.0, 0.5],  # doctest: +SKIP
-    ...                                gain=10.0, initial_radii=[0.0, 0.1])
+    >>> res = cosimulate_adaptive_loop(fmu_dir, ref, 1e-3, plant, weights=[1.0, 0.5],
+    ...                                gain=10.0, initial_radii=[0.0, 0.1])  # doctest: +SKIP
     >>> bool(np.allclose(res.y, native.y, atol=1e-12)), res.radii.shape  # doctest: +SKIP
     (True, (200, 2))
     """
