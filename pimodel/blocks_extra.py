@@ -1,5 +1,5 @@
 """python-control blocks for the generalized PI, rate-dependent PI and creep operators (and
-their exact inverses): discrete-time ``NonlinearIOSystem``s on the C core.
+their exact inverses): discrete-time ``NonlinearIOSystem`` objects on the C core.
 
 The blocks follow the contract of :mod:`pimodel.blocks`:
 
