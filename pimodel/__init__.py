@@ -27,7 +27,7 @@ fit_conventional    conventional baseline: preset radii, least-squares weights
 **Estimators**
 
 ==================  ===============================================================
-RadiusEstimator     the paper's adaptive radius law, streaming (C core)
+RadiusEstimator     the adaptive radius law (regime from the data), streaming (C core)
 estimate_radii      the radius law over a whole record
 RadiusEstimate      estimate_radii's result: final radii and history
 JointEstimator      online estimation of weights and radii together, streaming
@@ -46,18 +46,34 @@ save_record         write a record to CSV or NPZ
 
 **Submodules**
 
-=========================  ========================================================
-pimodel.signals            test inputs: sinusoid, triangle, minor loops, staircase
-pimodel.blocks             python-control blocks: PI, inverse, estimator, PID
-pimodel.simulation         simulate a python-control system from its initial states
-pimodel.actuators          stage dynamics: mode, creep, delay (discretised)
-pimodel.describing         describing function, sector, circle criterion, limit cycles
-pimodel.loops              compiled loops: feedforward, adaptive inverse, PID
-pimodel.long_records       long noisy records made in chunks
-pimodel.diagnosis          sim-to-real gap diagnosis: where, which effect, how far
-pimodel.truth              simulated stages with creep, dynamics, delay, ...
-pimodel.fmu                build FMUs; drive them; wrap them as blocks; co-simulate
-=========================  ========================================================
+============================  ==========================================================
+pimodel.signals               test inputs: sinusoid, triangle, minor loops, staircase
+pimodel.blocks                python-control blocks: PI, inverse, estimator, PID
+pimodel.simulation            simulate a python-control system from its initial states
+pimodel.actuators             stage dynamics: mode, creep, delay (discretised)
+pimodel.describing            describing function, sector, circle criterion, limit cycles
+pimodel.loops                 compiled loops: feedforward, adaptive inverse, PID
+pimodel.long_records          long noisy records made in chunks
+pimodel.estimator_settings    radius estimator settings chosen from the record
+pimodel.estimator_health      health report of a radius estimate: can it be trusted?
+pimodel.play_reduction        joint fit: merge or drop the plays the data do not resolve
+pimodel.envelopes             input/output envelopes (poly2, tanh) with exact inverses
+pimodel.generalized           GeneralizedPI: plays between envelopes, exact inverse
+pimodel.asymmetric            AsymmetricPI: distinct loading/unloading envelopes
+pimodel.rate_dependent        RateDependentPI: radii growing with the input rate
+pimodel.creep                 CreepOperator: sum of first-order lags, exact inverse
+pimodel.cascade               Cascade: operators in series and the chain's inverse
+pimodel.fit_operators         identify the generalized, rate-dependent and creep operators
+pimodel.blocks_extra          python-control blocks of those operators
+pimodel.models                the JSON form of a model (load_model, save_model)
+pimodel.sweep                 sweeps over cases, serially or on Dask (run_cases, grid)
+pimodel.truth_sweep           sweeps of identify/diagnose over simulated stages
+pimodel.diagnosis             sim-to-real gap diagnosis: where, which effect, how far
+pimodel.truth                 simulated stages with creep, dynamics, delay, ...
+pimodel.fmu                   build FMUs; drive them; wrap them as blocks; co-simulate
+pimodel.fmu.operators         FMU unit and parameter values for an operator or inverse
+pimodel.fmu.model_fmu         FMUs of a model, one per stage; co-simulate the chain
+============================  ==========================================================
 """
 
 from .conventional import fit_conventional

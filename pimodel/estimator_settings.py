@@ -87,26 +87,26 @@ def check_gains(gains, weights, dt: float) -> None:
 
     Parameters
     ----------
-    gains : float or array_like of float
-        Adaptation gains (one, or one per play).
-    weights : array_like of float
-        Play weights ``p_j``.
+    gains : float or array_like
+        The estimator's gains (scalar or per play).
+    weights : array_like
+        Play weights p_j > 0.
     dt : float
         Sample time [s].
 
-    Warns
-    -----
-    UserWarning
-        If a gain exceeds ``2 / (dt |p|^2)``: the estimate would diverge.
+    Returns
+    -------
+    None
+        Nothing; a gain above ``2 / (dt |p|^2)`` gives a ``UserWarning`` naming it and the bound.
 
     Examples
     --------
     >>> import warnings
     >>> with warnings.catch_warnings(record=True) as caught:
     ...     warnings.simplefilter("always")
-    ...     check_gains(1e6, [1.0, 1.0], 1e-3)
-    >>> len(caught)
-    1
+    ...     check_gains(1e6, [0.3, 0.5, 0.8, 0.3, 0.2], 1e-3)
+    >>> "exceeds the stability bound" in str(caught[0].message)
+    True
     """
     g = np.atleast_1d(np.asarray(gains, float))
     bound = stability_bound(weights, dt)

@@ -168,12 +168,12 @@ def load_model(path):
     Parameters
     ----------
     path : str or Path
-        The JSON file written by :func:`save_model`.
+        A file written by :func:`save_model` (or by hand in the same form).
 
     Returns
     -------
     object
-        The model (a PI operator, cascade, creep operator, ...).
+        The operator, inverse or :class:`~pimodel.cascade.Cascade`.
 
     Raises
     ------
@@ -184,12 +184,12 @@ def load_model(path):
 
     Examples
     --------
-    >>> import tempfile, os
+    >>> import os, tempfile
     >>> from pimodel.creep import CreepOperator
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     path = save_model(CreepOperator([0.05], [0.1], dt=1e-3), os.path.join(tmp, "m.json"))
-    ...     load_model(path).m
-    1
+    >>> path = save_model(CreepOperator([0.05], [0.1], dt=1e-3),
+    ...                   os.path.join(tempfile.mkdtemp(), "creep.json"))
+    >>> load_model(path).gains
+    array([0.05])
     """
     p = Path(path)
     try:
@@ -208,27 +208,23 @@ def save_model(model, path) -> Path:
     Parameters
     ----------
     model : object
-        A model :func:`model_to_dict` knows.
+        An operator, an inverse or a :class:`~pimodel.cascade.Cascade` of them.
     path : str or Path
-        The file to write (overwritten).
+        The JSON file to write (overwritten).
 
     Returns
     -------
-    pathlib.Path
+    Path
         ``path``.
-
-    Raises
-    ------
-    TypeError
-        If ``model`` is of a type :func:`model_to_dict` does not know (nothing is written).
 
     Examples
     --------
-    >>> import tempfile, os
+    >>> import json, os, tempfile
     >>> from pimodel.creep import CreepOperator
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     save_model(CreepOperator([0.05], [0.1], dt=1e-3), os.path.join(tmp, "m.json")).name
-    'm.json'
+    >>> path = save_model(CreepOperator([0.05], [0.1], dt=1e-3),
+    ...                   os.path.join(tempfile.mkdtemp(), "creep.json"))
+    >>> json.loads(path.read_text())["type"]
+    'CreepOperator'
     """
     p = Path(path)
     p.write_text(json.dumps(model_to_dict(model), indent=2) + "\n")

@@ -56,17 +56,24 @@ class CaseFailed(RuntimeError):
     Parameters
     ----------
     message : str
-        The error message.
+        What failed, which case, and how many finished cases were kept.
     index : int
-        Position of the failing case in the case list (kept as ``.index``).
+        Position of the failing case in the case list.
     params : dict
-        The failing case's parameters (kept as ``.params``).
+        The failing case's parameters.
+
+    Attributes
+    ----------
+    index : int
+        Position of the failing case in the case list.
+    params : dict
+        The failing case's parameters.
 
     Examples
     --------
-    >>> err = CaseFailed("case 1 failed", 1, {"x": 3})
+    >>> err = CaseFailed("case 2 of 5 failed", 1, {"seed": 1})
     >>> err.index, err.params
-    (1, {'x': 3})
+    (1, {'seed': 1})
     """
 
     def __init__(self, message: str, index: int, params: dict):

@@ -22,7 +22,9 @@ from .operator import PIOperator
 
 STAGE_WEIGHTS = (6.3460, 1.6735, 1.1552, 0.4477)
 STAGE_RADII = (0.0, 0.1945, 0.4826, 0.5707)
-EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift")
+EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
+RATE_REFERENCE = 250.0  # V/s: the fastest validate sine (1 V at 40 Hz)
+STEP_SHARE = 0.05  # a one-sample jump above this share of the input range is a step
 
 
 @dataclass
@@ -37,6 +39,8 @@ class Truth:
     delay_s: float | None = None
     asymmetry: float | None = None  # quadratic output term, fraction of the half range
     drift_um_per_s: float | None = None
+    drift_clock: str = "record"  # "record": t - t[0] of each record; "absolute": t as given
+    rate_gain: float | None = None  # play radii r_i (1 + rate_gain |dv/dt| / RATE_REFERENCE)
     noise_um: float = 0.005
     extra: dict = field(default_factory=dict)
 
@@ -44,13 +48,16 @@ class Truth:
     def effects(self) -> list[str]:
         on = {"creep": self.creep_percent_per_decade, "dynamics": self.mode_hz,
               "delay": self.delay_s, "asymmetry": self.asymmetry,
-              "drift": self.drift_um_per_s}
+              "drift": self.drift_um_per_s, "rate": self.rate_gain}
         return [k for k, v in on.items() if v is not None]
 
     def simulate(self, t: np.ndarray, v: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t`` [s]."""
         dt = float(t[1] - t[0])
-        y = PIOperator(self.weights, self.radii).simulate(v)
+        if self.rate_gain is None:
+            y = PIOperator(self.weights, self.radii).simulate(v)
+        else:
+            y = rate_dependent_pi(self.weights, self.radii, v, dt, self.rate_gain)
         if self.asymmetry is not None:
             half = 0.5 * float(np.sum(self.weights)) * 1.0
             y = y + self.asymmetry * (y**2) / half
@@ -63,11 +70,28 @@ class Truth:
             d = delay_samples(self.delay_s, dt)
             y = np.concatenate((np.full(d, y[0]), y[: y.size - d])) if d else y
         if self.drift_um_per_s is not None:
-            y = y + self.drift_um_per_s * (t - t[0])
+            y = y + self.drift_um_per_s * (t - t[0] if self.drift_clock == "record" else t)
         return y + rng.normal(0.0, self.noise_um, y.size)
 
     def record(self, t, v, seed: int, name: str = "truth") -> Record:
         return Record(t, v, self.simulate(t, v, np.random.default_rng(seed)), source=name)
+
+
+def rate_dependent_pi(weights, radii, v: np.ndarray, dt: float, gain: float) -> np.ndarray:
+    """PI output ``y[k] = sum_i w_i z_i[k]`` with play radii that grow with the input rate,
+    ``r_i[k] = r_i (1 + gain |v[k] - v[k-1]| / (dt RATE_REFERENCE))``; plays start at 0. A
+    sampled step (a jump of more than ``STEP_SHARE`` of the input range in one sample) is no
+    rate the stage follows: its rate counts as 0."""
+    w, r = np.asarray(weights, float), np.asarray(radii, float)
+    z = np.zeros(r.size)
+    y = np.empty(v.size)
+    dv = np.abs(np.diff(v, prepend=v[0]))
+    rate = np.where(dv <= STEP_SHARE * float(np.ptp(v)), dv / dt / RATE_REFERENCE, 0.0)
+    for k, vk in enumerate(v):
+        rk = r * (1.0 + gain * rate[k])
+        z = np.minimum(np.maximum(z, vk - rk), vk + rk)
+        y[k] = w @ z
+    return y
 
 
 def _filter(G, x: np.ndarray, dt: float) -> np.ndarray:
@@ -112,8 +136,9 @@ def excitation(kind: str, *, fs: float = 10_000.0, seed: int = 0) -> tuple[np.nd
     return np.arange(v.size) * dt, v
 
 
-def random_truth(effects, seed: int) -> Truth:
-    """A truth with the named effects at random realistic magnitudes (seeded)."""
+def random_truth(effects, seed: int, drift_clock: str = "record") -> Truth:
+    """A truth with the named effects at random realistic magnitudes (seeded); a drift runs on
+    ``drift_clock`` (``"record"``: each record's own clock, ``"absolute"``: ``t`` as given)."""
     rng = np.random.default_rng(1000 + seed)
     unknown = set(effects) - set(EFFECTS)
     if unknown:
@@ -130,4 +155,6 @@ def random_truth(effects, seed: int) -> Truth:
         kw["asymmetry"] = rng.uniform(0.03, 0.08) * rng.choice([-1, 1])
     if "drift" in effects:
         kw["drift_um_per_s"] = rng.uniform(0.05, 0.15) * rng.choice([-1, 1])
-    return Truth(noise_um=rng.uniform(0.003, 0.01), **kw)
+    if "rate" in effects:
+        kw["rate_gain"] = rng.uniform(0.3, 0.6)
+    return Truth(noise_um=rng.uniform(0.003, 0.01), drift_clock=drift_clock, **kw)

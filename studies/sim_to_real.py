@@ -1,13 +1,19 @@
-"""Study: sim-to-real gap diagnosis with withheld effects (confusion table) and on the shared
-real piezo record.
+"""Study: sim-to-real gap diagnosis with withheld effects on two generators (confusion tables)
+and on the shared real piezo record.
 
-For each effect (and two pairs, and a clean PI stage) the truth simulator generates train and
-validate records with seeded random magnitudes; the diagnosis never sees the effect's name.
-Full size: 10 seeds per case; ``--quick``: 1 seed, no pairs.
+Generators: ``pimodel.truth`` (PI hysteresis, the same model family as the candidates) and the
+independently written ``pimodel.truth_alt`` (Preisach hysteresis, log-law creep, two modes,
+exponential static map, coloured noise; also effects outside the vocabulary that must come
+back "unexplained"). The diagnosis never sees the effect's name. Full size: 10 seeds per case;
+``--quick``: 1 seed, single effects only.
+
+Each case is a plain picklable dict (``generator``, ``effects``, ``drift_clock``, ``seed``) and
+:func:`run_case` turns one into a verdict row, so the cases can be spread over workers.
 """
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -15,37 +21,98 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from pimodel.data import Record  # noqa: E402
 from pimodel.diagnosis import diagnose  # noqa: E402
 from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
-from pimodel.truth import EFFECTS, excitation, random_truth  # noqa: E402
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / \
     "smarthysteresis-piezo-1hz" / "piezo_1hz.csv"
-
-
-def withheld_cases(quick: bool):
-    cases = [(e,) for e in EFFECTS] + [()]
-    if not quick:
-        cases += [("creep", "asymmetry"), ("dynamics", "drift")]
-    return cases
+SINGLE = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
+PAIRS = ((("rate", "creep"), "record"), (("delay", "drift"), "record"),
+         (("asymmetry", "drift"), "absolute"))
+OUTSIDE = ("dead_zone", "second_input", "bouc_wen")  # truth_alt only: expect "unexplained"
 
 
 def cases(quick: bool) -> list[dict]:
-    """One case per withheld effect set and seed (the sweep's plain parameter dicts)."""
+    """All cases of the study as plain dicts."""
     seeds = range(1 if quick else 10)
-    return [{"effects": list(effects), "seed": s} for effects in withheld_cases(quick)
-            for s in seeds]
+    groups = [((), "record")] + [((e,), "record") for e in SINGLE]
+    if not quick:
+        groups += list(PAIRS) + [(("drift",), "absolute")]
+    out = []
+    for gen in ("truth", "truth_alt"):
+        extra = [((e,), "record") for e in OUTSIDE] if gen == "truth_alt" else []
+        for effects, clock in groups + extra:
+            for seed in seeds:
+                out.append({"generator": gen, "effects": list(effects), "drift_clock": clock,
+                            "seed": seed})
+    return out
 
 
-def run_case(params: dict) -> dict:
-    """The diagnosis' verdict on train/validate records of a random truth (seeded)."""
-    effects, seed = params["effects"], params["seed"]
-    tt, vt = excitation("train", seed=2 * seed + 1)
-    tv, vv = excitation("validate", seed=2 * seed + 2)
-    truth = random_truth(list(effects), seed)
-    rep = diagnose([truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed,
-                                                                        "validate")])
-    return rep.verdict
+def _records(case: dict):
+    seed, effects, clock = case["seed"], case["effects"], case["drift_clock"]
+    if case["generator"] == "truth":
+        from pimodel.truth import excitation, random_truth
+
+        tt, vt = excitation("train", seed=2 * seed + 1)
+        tv, vv = excitation("validate", seed=2 * seed + 2)
+        tv = tv + tt[-1] + 1.0  # the validate clock continues after train
+        truth = random_truth(effects, seed, drift_clock=clock)
+        return [truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed,
+                                                                   "validate")], "rest"
+    from pimodel.truth_alt import excitations, random_alt_truth
+
+    (tt, vt), (tv, vv) = excitations(seed + 1)
+    truth = random_alt_truth(effects, seed, "absolute" if clock == "absolute" else "record")
+    rng = np.random.default_rng(3 + seed)
+    return ([Record(tt, vt, truth.simulate(tt, vt, rng), source="alt-train")],
+            [Record(tv, vv, truth.simulate(tv, vv, rng), source="alt-validate")], "unknown")
+
+
+def expected(case: dict) -> list[str]:
+    """The right verdict: the withheld effects, "unexplained" for effects outside the
+    vocabulary, "none" for a clean stage."""
+    if set(case["effects"]) & set(OUTSIDE):
+        return ["unexplained"]
+    return sorted(case["effects"]) or ["none"]
+
+
+def run_case(case: dict) -> dict:
+    """Diagnose one case; returns the case, the verdict's effects and figures, and whether the
+    verdict is right (for effects outside the vocabulary: "unexplained" among the effects)."""
+    train, validate, initial_state = _records(case)
+    v = diagnose(train, validate, initial_state=initial_state).verdict
+    want = expected(case)
+    right = ("unexplained" in v["effects"]) if want == ["unexplained"] else \
+        sorted(v["effects"]) == want
+    return {**case, "verdict": v["effects"], "right": bool(right), "shrink": v["shrink"],
+            "gap_before": v["gap_before"], "gap_after": v["gap_after"],
+            "noise_floor": v["noise_floor"], "noise_method": v["noise_floor_method"]}
+
+
+def group_name(row: dict) -> str:
+    """Name of a case group: the withheld effects (and the drift's clock)."""
+    key = "+".join(row["effects"]) or "none (clean)"
+    if "drift" in row["effects"]:
+        key += f" [{row['drift_clock']} clock]"
+    return key
+
+
+def confusion(rows: list[dict]) -> list[list]:
+    """One table row per case group: right / cases, shrink, verdict counts."""
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault(group_name(r), []).append(r)
+    table = []
+    for key, rs in groups.items():
+        found: dict[str, int] = {}
+        for r in rs:
+            k = "+".join(sorted(r["verdict"]))
+            found[k] = found.get(k, 0) + 1
+        sh = [r["shrink"] for r in rs]
+        table.append([key, f"{sum(r['right'] for r in rs)}/{len(rs)}", float(np.min(sh)),
+                      float(np.median(sh)), ", ".join(f"{k}: {n}" for k, n in found.items())])
+    return table
 
 
 def real_record(out: Path):
@@ -62,27 +129,27 @@ def real_record(out: Path):
 
 
 def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) -> StudyResult:
-    """Confusion table over the cases (grouped by withheld effects) and the real record."""
+    """Confusion tables per generator (from the finished cases) and the real record."""
     res = StudyResult("sim_to_real")
-    rows, numbers = [], {}
-    groups: dict[tuple, list[dict]] = {}
-    for params, verdict in zip(cases, results, strict=True):
-        groups.setdefault(tuple(params["effects"]), []).append(verdict)
-    for effects, verdicts in groups.items():
-        expected = sorted(effects) or ["none"]
-        hits = sum(sorted(v["effects"]) == expected for v in verdicts)
-        shrinks = [v["shrink"] for v in verdicts]
-        found: dict[str, int] = {}
-        for v in verdicts:
-            key = "+".join(sorted(v["effects"]))
-            found[key] = found.get(key, 0) + 1
-        name = "+".join(effects) or "none (clean PI)"
-        rows.append([name, f"{hits}/{len(verdicts)}", float(np.min(shrinks)),
-                     float(np.median(shrinks)), ", ".join(f"{k}: {n}" for k, n in found.items())])
-        numbers[name] = {"hits": hits, "n": len(verdicts), "min_shrink": float(np.min(shrinks))}
-    res.tables.append(Table("Withheld effects: verdicts (correct / cases) and validate-gap shrink",
-                            ["truth", "correct", "min shrink", "median shrink", "verdicts"],
-                            rows))
+    rows = results
+    numbers: dict = {}
+    for r in rows:
+        key = f"{r['generator']}: {group_name(r)}"
+        kind = "clean" if not r["effects"] else "outside" if expected(r) == ["unexplained"] \
+            else "effect"
+        d = numbers.setdefault(key, {"hits": 0, "n": 0, "min_shrink": np.inf, "kind": kind})
+        d["hits"] += int(r["right"])
+        d["n"] += 1
+        d["min_shrink"] = min(d["min_shrink"], float(r["shrink"]))
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "cases.json").write_text(json.dumps(rows, indent=1, default=float))
+    for gen, title in (("truth", "pimodel.truth (PI family)"),
+                       ("truth_alt", "pimodel.truth_alt (independent: Preisach, log creep, "
+                                     "two modes, coloured noise)")):
+        res.tables.append(Table(f"Withheld effects, {title}: right verdicts / cases, "
+                                "validate-gap shrink, verdicts",
+                                ["truth", "right", "min shrink", "median shrink", "verdicts"],
+                                confusion([r for r in rows if r["generator"] == gen])))
     if REAL.exists():
         rep, figs = real_record(out)
         v = rep.verdict
@@ -90,10 +157,11 @@ def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) ->
         res.tables.append(Table("Shared real record (train: first half of the sine cycles, "
                                 "validate: second half)",
                                 ["verdict", "gap before [um]", "gap after [um]", "shrink",
-                                 "noise floor [um]"],
+                                 "noise floor [um]", "noise floor method"],
                                 [["+".join(v["effects"]), v["gap_before"], v["gap_after"],
-                                  v["shrink"], v["noise_floor"]]]))
-        numbers["real"] = {k: v[k] for k in ("effects", "gap_before", "gap_after", "shrink")}
+                                  v["shrink"], v["noise_floor"], v["noise_floor_method"]]]))
+        numbers["real"] = {k: v[k] for k in ("effects", "gap_before", "gap_after", "shrink",
+                                             "noise_floor", "noise_floor_method")}
         rep.save_json(out / "real_diagnosis.json")
     else:
         res.notes.append(f"shared real record not found at {REAL}: real-data part skipped")

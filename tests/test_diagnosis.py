@@ -1,8 +1,9 @@
-"""Sim-to-real gap diagnosis: withheld effects (generation and diagnosis kept apart: the effect
-name never reaches diagnose), a clean record, bad input, the CLI, and the real record.
+"""Sim-to-real gap diagnosis on records of ``pimodel.truth``: withheld effects (generation and
+diagnosis kept apart: the effect name never reaches diagnose), a clean record, bad input, the
+CLI, and the real record. The independent generator is tested in ``test_diagnosis_alt.py``.
 
-The unit suite runs one seed per effect and one pair; the full sweep (10 seeds per effect and
-pairs) is ``studies/sim_to_real.py`` (figures in the README)."""
+The unit suite runs one seed per effect and per pair; the full sweep (10 seeds per case) is
+``studies/sim_to_real.py``."""
 
 from __future__ import annotations
 
@@ -14,13 +15,16 @@ import pytest
 from pimodel import Record, save_record
 from pimodel.cli import main
 from pimodel.diagnosis import diagnose
+from pimodel.diagnosis.effects import EFFECTS as CANDIDATES
 from pimodel.truth import EFFECTS, excitation, random_truth
 
 
-def records(effects, seed):
+def records(effects, seed, drift_clock="record"):
+    """Train and validate records; the validate clock continues 1 s after train ends."""
     tt, vt = excitation("train", seed=2 * seed + 1)
     tv, vv = excitation("validate", seed=2 * seed + 2)
-    truth = random_truth(list(effects), seed)
+    truth = random_truth(list(effects), seed, drift_clock=drift_clock)
+    tv = tv + tt[-1] + 1.0
     return [truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed, "val")]
 
 
@@ -29,16 +33,23 @@ def test_withheld_single_effect(effect):
     train, validate = records([effect], 0)
     v = diagnose(train, validate).verdict
     assert v["effects"] == [effect]
-    assert v["shrink"] >= 0.5
+    assert v["shrink"] >= (0.7 if effect in ("asymmetry", "rate") else 0.5)
 
 
-@pytest.mark.parametrize("pair,seed", [(("creep", "asymmetry"), 3), (("dynamics", "drift"), 1)])
-def test_withheld_pair(pair, seed):
-    # seed 1 of dynamics+drift: a light 2 kHz mode (damping 0.02), narrower than the mode grid
-    train, validate = records(list(pair), seed)
+@pytest.mark.parametrize("pair,seed,clock", [
+    (("creep", "asymmetry"), 3, "record"),
+    (("rate", "creep"), 0, "record"),
+    (("dynamics", "drift"), 1, "record"),  # a light 2 kHz mode (damping 0.02)
+    (("delay", "drift"), 0, "record"),  # drift restarting with each record
+    (("asymmetry", "drift"), 0, "absolute"),  # drift on the clock the records share
+])
+def test_withheld_pair(pair, seed, clock):
+    train, validate = records(list(pair), seed, clock)
     v = diagnose(train, validate).verdict
     assert sorted(v["effects"]) == sorted(pair)
     assert v["shrink"] >= 0.5
+    if "drift" in pair:
+        assert v["model"]["drift_clock"] == clock
 
 
 def test_clean_pi_says_none():
@@ -47,7 +58,9 @@ def test_clean_pi_says_none():
     assert rep.verdict["effects"] == ["none"]
     data = rep.to_json()
     assert {"nominal", "where", "candidates", "verdict"} <= set(data)
-    assert len(data["candidates"]) == len(EFFECTS)
+    assert len(data["candidates"]) == len(CANDIDATES)
+    assert rep.verdict["noise_floor_method"] == "repeated periods"
+    assert rep.verdict["gap_before"] < 2 * rep.verdict["noise_floor"]
     assert data["where"]["regions"][0]["concentration"] >= data["where"]["regions"][-1][
         "concentration"]
 
@@ -77,11 +90,12 @@ def test_cli_diagnose(tmp_path):
     out = tmp_path / "d.json"
     assert main(["diagnose", "--train", str(tmp_path / "a.csv"), "--validate",
                  str(tmp_path / "b.csv"), "--json", str(out), "--plots",
-                 str(tmp_path / "plots")]) == 0
+                 str(tmp_path / "plots"), "--initial-state", "unknown"]) == 0
     data = json.loads(out.read_text())
     assert data["verdict"]["effects"] == ["drift"]
     assert 0.5 <= data["verdict"]["shrink"] <= 1
     assert (tmp_path / "plots" / "residuals.png").exists()
+    assert data["nominal"]["initial_state"] == "unknown"
 
 
 def test_real_record_diagnosis(real_record_path):
@@ -92,7 +106,18 @@ def test_real_record_diagnosis(real_record_path):
     mid = k0 + (len(rec) - k0) // 2
     rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)])
     v = rep.verdict
-    # the real stage is not a clean PI operator: its output lags the voltage by about 12 ms
-    assert v["effects"] == ["delay"]
-    assert 0.008 < v["model"]["delay_samples"] * rec.dt < 0.016
-    assert v["shrink"] >= 0.5
+    # the real stage is not a clean PI operator: its loop is wider than a static PI's, as a lag
+    # of about 11 ms or rate-dependent hysteresis makes it; one 1 Hz sine cannot tell the two
+    # apart, and the verdict says so
+    assert v["effects"] in (["delay"], ["rate"])
+    assert {"delay", "rate"} <= set(v["effects"] + v["alternatives"])
+    delay = next(c for c in rep.candidates if c["effect"] == "delay")
+    assert 0.008 < delay["params"]["delay_s"] < 0.016
+    # the sine cycles repeat exactly: the noise floor comes from the difference of periods
+    assert v["noise_floor_method"] == "repeated periods"
+    assert v["gap_after"] < 1.5 * v["noise_floor"] < v["gap_before"]
+    # most of the gap lies in the start-up region (the stage's memory before the record is
+    # unknown); without it the validate gap is within the noise
+    rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)], initial_state="unknown")
+    assert rep.verdict["effects"] == ["none"]
+    assert rep.verdict["gap_before"] < 1.5 * rep.verdict["noise_floor"]

@@ -1,15 +1,26 @@
 """The sim-to-real gap diagnosis: nominal PI model, where the residual lies, which unmodelled
-effect explains it, and how far the gap shrinks on held-out records.
+effect explains it, how far the gap shrinks on held-out records, and what stays unexplained.
 
 Train records fit every model; validate records only score. The nominal model is the PI
-operator in the conventional parametrisation (20 plays on a radius grid over half the input
-range, weights and an output offset by least squares: the identification chain's baseline,
-linear in its parameters) so that each candidate effect can be refitted *jointly* with the
-hysteresis weights (:mod:`.effects`). Effects are added greedily: each round fits every
-remaining candidate on train (on top of those already chosen) and scores it on validate with
-``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by more than 10, cuts the
-validate RMS by at least 10 %, and the current RMS is above 1.5 times the noise floor
-(estimated from sample-to-sample residual differences). No accepted effect: ``none``.
+operator in the conventional parametrisation (plays on a uniform radius grid over half the input
+range, weights and an output offset by least squares, linear in its parameters). The grid is
+refined (20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits
+clean hysteresis whose radii lie off a coarse grid down to the noise. Each candidate effect is
+refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are added greedily:
+each round fits every remaining candidate on train (on top of those already chosen) and scores
+it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by more
+than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the noise
+floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
+effect passes in the first round, every pair is fitted jointly and the best pair kept on the
+same terms (two effects can mask each other).
+
+Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
+noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
+gap after the best combination stays above 2 times the noise floor and its excess over the noise
+is more than 10 % of the gap's energy before. ``unexplained`` gives that share and where the
+remaining residual lies. ``alternatives`` lists effects that alone explain the gap within 10 %
+of the validate RMS of the first chosen one: the records cannot tell them apart (for example a
+delay and rate-dependent hysteresis under a single-frequency sine).
 """
 
 from __future__ import annotations
@@ -23,18 +34,35 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..data import Record
-from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment
-from .where import residual_breakdown
+from .effects import (
+    DRIFT_CLOCKS,
+    EFFECTS,
+    RATE_BANDS,
+    Model,
+    Segment,
+    fit_effect,
+    fit_nominal,
+    make_segment,
+    rate_columns,
+)
+from .noise import measure_noise_floor
+from .where import residual_breakdown, startup_length
 
-N_GRID = 20
+GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
 MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
+NOISE_STOP = 1.5  # no further effect once the validate RMS is within this factor of the noise
+UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
+UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
+ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
+INITIAL_STATES = ("rest", "unknown")
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
     "dynamics": ("near a reversal (travel < 10 % of range)", "> 1 kHz"),
     "delay": ("fast input (top quarter of |dv/dt|)", "10-100 Hz"),
     "asymmetry": ("input extremes (outer 20 % of range)", "1-10 Hz"),
+    "rate": ("fast input (top quarter of |dv/dt|)", "1-10 Hz"),
 }
 
 
@@ -70,21 +98,16 @@ def _plain(x):
 
 
 def _errors(segs: list[Segment], outputs) -> dict:
-    r = np.concatenate([s.y - o for s, o in zip(segs, outputs, strict=True)])
-    rng = float(np.ptp(np.concatenate([s.y for s in segs]))) or 1.0
+    r = np.concatenate([(s.y - o)[s.used] for s, o in zip(segs, outputs, strict=True)])
+    rng = float(np.ptp(np.concatenate([s.y[s.used] for s in segs]))) or 1.0
     rms, mx = float(np.sqrt(np.mean(r**2))), float(np.max(np.abs(r)))
     return {"rms": rms, "max": mx, "rms_percent": 100 * rms / rng,
             "max_percent": 100 * mx / rng, "range": rng}
 
 
 def _bic(segs, outputs, k) -> float:
-    r = np.concatenate([s.y - o for s, o in zip(segs, outputs, strict=True)])
+    r = np.concatenate([(s.y - o)[s.used] for s, o in zip(segs, outputs, strict=True)])
     return float(r.size * np.log(max(np.mean(r**2), 1e-300)) + k * np.log(r.size))
-
-
-def _noise_floor(segs, outputs) -> float:
-    d = np.concatenate([np.diff(s.y - o) for s, o in zip(segs, outputs, strict=True)])
-    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2))
 
 
 def _check(records: list[Record], role: str) -> None:
@@ -103,12 +126,54 @@ def _check(records: list[Record], role: str) -> None:
             raise ValueError(f"{rec.source}: the input has no reversal (no hysteresis loop)")
 
 
-def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 3
-             ) -> DiagnosisReport:
+def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 3,
+             initial_state: str = "rest") -> DiagnosisReport:
     """Diagnose the gap between a PI model fitted on ``train`` and the ``validate`` records.
 
-    Warns (UserWarning) when a validate record is also a train record: nothing is held out.
+    Parameters
+    ----------
+    train, validate : list of Record
+        Records sharing one sample time; ``t`` is used as given (a drift may run on each
+        record's own clock or on the clock the records share).
+    max_effects : int
+        Most effects combined.
+    initial_state : {"rest", "unknown"}
+        ``"rest"``: every model starts with its plays at rest at ``v[0]`` and every sample is
+        fitted and scored. ``"unknown"``: the stage's memory at the start of a record is
+        unknown; the start-up region (until the input first spans 90 % of the record's range)
+        is left out of fitting and scoring.
+
+    Returns
+    -------
+    DiagnosisReport
+        ``verdict`` holds ``effects`` (``["none"]``, effect names, possibly followed by
+        ``"unexplained"``, or ``["unexplained"]``), ``gap_before``/``gap_after`` (validate
+        RMS), ``shrink``, ``noise_floor`` (and how it was measured), ``unexplained``.
+
+    Raises
+    ------
+    ValueError
+        Empty lists, records shorter than 200 samples or without a reversal, differing sample
+        times, an unknown ``initial_state``.
+
+    Warns
+    -----
+    UserWarning
+        When a validate record is also a train record: nothing is held out.
+
+    Examples
+    --------
+    >>> from pimodel.truth import excitation, random_truth
+    >>> truth = random_truth(["creep"], 0)
+    >>> tt, vt = excitation("train", seed=1)
+    >>> tv, vv = excitation("validate", seed=2)
+    >>> rep = diagnose([truth.record(tt, vt, 1)], [truth.record(tv, vv, 2)])
+    >>> rep.verdict["effects"]
+    ['creep']
     """
+    if initial_state not in INITIAL_STATES:
+        raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got "
+                         f"{initial_state!r}")
     shared = [r.source for r in validate if any(
         r.t.size == t.t.size and np.array_equal(r.v, t.v) and np.array_equal(r.y, t.y)
         for t in train)]
@@ -116,10 +181,65 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         warnings.warn(f"validate: {shared} also in train; nothing is held out, so the validate "
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
     with threadpool_limits(1, user_api="blas"):
-        return _diagnose(train, validate, max_effects)
+        return _diagnose(train, validate, max_effects, initial_state)
 
 
-def _diagnose(train: list[Record], validate: list[Record], max_effects: int) -> DiagnosisReport:
+def _segments(records: list[Record], radii, initial_state: str) -> list[Segment]:
+    out = []
+    for r in records:
+        mask = None
+        if initial_state == "unknown":
+            mask = np.arange(len(r)) >= startup_length(r.v)
+        out.append(make_segment(r.t, r.v, r.y, radii, mask))
+    return out
+
+
+def _nominal(train, validate, initial_state):
+    """The radius grid with the lowest train BIC and its fitted nominal model."""
+    span = float(np.ptp(np.concatenate([r.v for r in train])))
+    best = None
+    for n in GRID_SIZES:
+        radii = np.linspace(0.0, span / 2, n)
+        tr = _segments(train, radii, initial_state)
+        model = fit_nominal(tr)
+        bic = _bic(tr, [model.predict(s) for s in tr], n + 1)
+        if best is None or bic < best[0]:
+            best = (bic, radii, tr, model)
+    _, radii, tr, model = best
+    return radii, tr, _segments(validate, radii, initial_state), model
+
+
+def _compressed(tr, va, nominal: Model):
+    """Segments whose play columns are replaced by a few combinations (the nominal's own
+    weights, then the leading principal directions of the train play outputs), as few as keep
+    the nominal train RSS within 1 %; the candidates' grid searches filter these columns only.
+    Returns the new segments and the nominal refitted on them (with the full model's
+    ``params``)."""
+    n = tr[0].Z.shape[1]
+    G = sum(s.Z[s.used].T @ s.Z[s.used] for s in tr)
+    _, vecs = np.linalg.eigh(G)
+    w = nominal.coef[:n]
+    rss_full = sum(float(np.sum((nominal.predict(s) - s.y)[s.used] ** 2)) for s in tr)
+    for q in (32, n):
+        if q >= n:
+            return tr, va, nominal
+        V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :q]))
+        ctr = [Segment(s.t, s.v, s.y, s.Z @ V, s.mask, s.rate_column) for s in tr]
+        m = fit_nominal(ctr)
+        rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
+        if rss <= 1.01 * rss_full:
+            m.params = dict(nominal.params)
+            return ctr, [Segment(s.t, s.v, s.y, s.Z @ V, s.mask, s.rate_column) for s in va], m
+    return tr, va, nominal
+
+
+def _variants(name: str) -> list[dict]:
+    """Discrete variants of an effect chosen on validate (the drift's clock)."""
+    return [{"clock": c} for c in DRIFT_CLOCKS] if name == "drift" else [{}]
+
+
+def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
+              initial_state: str) -> DiagnosisReport:
     _check(train, "train")
     _check(validate, "validate")
     dts = [(r.source, r.dt) for r in train + validate]
@@ -128,32 +248,45 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int) -> 
             raise ValueError(f"{src}: sample time {dt:g} s differs from {dts[0][0]} "
                              f"({dts[0][1]:g} s); resample the records to one sample time")
     dt = dts[0][1]
-    vt = np.concatenate([r.v for r in train])
-    radii = np.linspace(0.0, float(np.ptp(vt)) / 2, N_GRID)
-    tr = [make_segment(r.t, r.v, r.y, radii) for r in train]
-    va = [make_segment(r.t, r.v, r.y, radii) for r in validate]
-    nominal = fit_nominal(tr)
+    radii, tr, va, nominal = _nominal(train, validate, initial_state)
+    n_plays = radii.size
     out_tr = [nominal.predict(s) for s in tr]
     out_va = [nominal.predict(s) for s in va]
     before = _errors(va, out_va)
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
-                              "weights": nominal.coef[:N_GRID], "offset": nominal.coef[N_GRID]},
-                    "train": _errors(tr, out_tr), "validate": before}
+                              "weights": nominal.coef[:n_plays], "offset": nominal.coef[n_plays],
+                              "grid_sizes_tried": list(GRID_SIZES)},
+                    "train": _errors(tr, out_tr), "validate": before,
+                    "initial_state": initial_state}
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
-    noise = _noise_floor(va, out_va)
+    for s in tr + va:
+        s.rate_column = rate_columns(s.Z, radii, s.v, s.dt, nominal.params["rate_scale"],
+                                     RATE_BANDS)
+    tr, va, nominal = _compressed(tr, va, nominal)
+    segs = tr + va
+    noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
+    noise = noise_info["value"]
 
     cache: dict = {}
 
     def fit(name, combo=(), fixed_=None):
-        key = (combo, name, tuple(sorted((fixed_ or {}).items())))
-        if key not in cache:
-            cache[key] = fit_effect(name, tr, combo, fixed_, nominal)
-        return cache[key]
+        """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
+        best = None
+        for var in _variants(name):
+            fx = {**(fixed_ or {}), **var}
+            key = (combo, name, tuple(sorted(fx.items())))
+            if key not in cache:
+                m = fit_effect(name, tr, combo, fx, nominal)
+                cache[key] = (m, [m.predict(s) for s in va])
+            m, o = cache[key]
+            score = _bic(va, o, m.k)
+            if best is None or score < best[0]:
+                best = (score, m, o)
+        return best[1], best[2]
 
     candidates = []
     for name in EFFECTS:
-        m = fit(name)
-        o = [m.predict(s) for s in va]
+        m, o = fit(name)
         params = dict(m.params)
         if "delay_samples" in params:
             params["delay_s"] = params["delay_samples"] * dt
@@ -168,23 +301,37 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int) -> 
     cur_out = out_va
     for _ in range(max_effects):
         rms_now = _errors(va, cur_out)["rms"]
-        if rms_now <= 1.5 * noise:
+        if rms_now <= NOISE_STOP * noise:
             break
         best = None
         for name in EFFECTS:
             if name in chosen:
                 continue
-            m = fit(name, chosen, {k: v for k, v in fixed.items()} if chosen else None)
-            o = [m.predict(s) for s in va]
+            m, o = fit(name, chosen, dict(fixed) if chosen else None)
             dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
             if best is None or dbic < best[0]:
                 best = (dbic, name, m, o)
         if best is None:
             break
-        dbic, name, m, o = best
-        if dbic > -MIN_BIC_DROP or _errors(va, o)["rms"] > (1 - MIN_RMS_CUT) * rms_now:
+
+        def accepted(b_, rms_now=rms_now):
+            return b_[0] <= -MIN_BIC_DROP and _errors(va, b_[3])["rms"] <= (1 - MIN_RMS_CUT) * \
+                rms_now
+
+        if not accepted(best) and not chosen and max_effects >= 2:
+            # two effects can mask each other (a drift confounds an asymmetry fitted alone):
+            # when no single effect passes in the first round, try every pair jointly
+            rest = [e for e in EFFECTS if e not in chosen]
+            for i, first in enumerate(rest):
+                for name in rest[i + 1:]:
+                    m, o = fit(name, (*chosen, first), dict(fixed) if chosen else None)
+                    dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
+                    if dbic < best[0]:
+                        best = (dbic, (first, name), m, o)
+        if not accepted(best):
             break
-        chosen += (name,)
+        dbic, name, m, o = best
+        chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
         current, cur_out = m, o
     after = _errors(va, cur_out)
@@ -196,10 +343,34 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int) -> 
         evidence.append({"effect": name, "region": reg,
                          "concentration": regions.get(reg, {}).get("concentration"),
                          "band": band, "band_energy_share": bands.get(band)})
-    verdict = {"effects": list(chosen) or ["none"], "gap_before": before["rms"],
+    unexplained = _unexplained(va, cur_out, before["rms"], after["rms"], noise)
+    alternatives: list[str] = []
+    if chosen:  # effects that alone explain the gap about as well as the first one chosen
+        alone = {c["effect"]: c["validate"]["rms"] for c in candidates}
+        alternatives = [e for e, r in alone.items()
+                        if e != chosen[0] and r <= ALTERNATIVE_RMS * alone[chosen[0]]]
+    effects = list(chosen) + (["unexplained"] if unexplained["present"] else [])
+    verdict = {"effects": effects or ["none"], "gap_before": before["rms"],
                "gap_after": after["rms"], "shrink": 1 - after["rms"] / before["rms"],
                "max_before": before["max"], "max_after": after["max"],
                "gap_before_percent": before["rms_percent"],
                "gap_after_percent": after["rms_percent"], "noise_floor": noise,
+               "noise_floor_method": noise_info["method"],
+               "noise_floor_detail": noise_info["detail"],
+               "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
+               "unexplained": unexplained, "alternatives": alternatives,
                "model": current.params, "evidence": evidence}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out)
+
+
+def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float) -> dict:
+    """The part of the validate gap no accepted effect explains: its share of the gap energy
+    before (``(gap_after^2 - noise^2) / gap_before^2``) and where the remaining residual lies."""
+    share = max(gap_after**2 - noise**2, 0.0) / max(gap_before**2, 1e-300)
+    present = gap_after > UNEXPLAINED_FACTOR * noise and share > UNEXPLAINED_SHARE
+    out: dict = {"present": bool(present), "share": share}
+    if present:
+        wb = residual_breakdown(va, [s.y - o for s, o in zip(va, outputs, strict=True)])
+        out["where"] = [r["region"] for r in wb["regions"][:3]]
+        out["band"] = max(wb["spectrum"], key=lambda b: b["energy_share"])["band"]
+    return out

@@ -22,27 +22,41 @@ MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
 MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
+SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
-EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift")
+EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
+DRIFT_CLOCKS = ("record", "absolute")  # t - t[0] of each record, or t as given
+RATE_BANDS = 8  # the rate candidate's play groups (one column each)
+STEP_SHARE = 0.05  # rate candidate: a one-sample jump above this share of the range is a step
 
 
 @dataclass
 class Segment:
-    """One record: time [s], input, measured output, play outputs ``Z`` of the radius grid."""
+    """One record: time [s] as given, input, measured output, play outputs ``Z`` of the radius
+    grid, and ``mask``: the samples that are fitted and scored (False in a start-up region
+    whose initial memory is unknown)."""
 
     t: np.ndarray
     v: np.ndarray
     y: np.ndarray
     Z: np.ndarray
+    mask: np.ndarray | None = None
+    rate_column: np.ndarray | None = None  # see :func:`rate_column`, set by the diagnosis
+
+    @property
+    def used(self) -> np.ndarray:
+        """Indices or slice of the fitted and scored samples."""
+        return slice(None) if self.mask is None else self.mask
 
     @property
     def dt(self) -> float:
         return float(self.t[1] - self.t[0])
 
 
-def make_segment(t, v, y, radii) -> Segment:
+def make_segment(t, v, y, radii, mask=None) -> Segment:
+    """Segment of one record with the play outputs of ``radii`` (play states start at 0)."""
     Z = PIOperator(np.ones(len(radii)), radii).play_outputs(v)
-    return Segment(t, v, y, Z)
+    return Segment(t, v, y, Z, mask)
 
 
 def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
@@ -80,16 +94,27 @@ def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
     zi = lfilter_zi(b, a)
     if x.ndim == 1:
         return lfilter(b, a, x, zi=zi * x[0])[0]
-    xt = np.ascontiguousarray(x.T)
-    out, _ = lfilter(b, a, xt, axis=-1, zi=zi[None, :] * xt[:, :1])
-    return out.T
+    return mode_rows(np.ascontiguousarray(x.T), fn, zeta, dt).T
 
 
-def shift(x: np.ndarray, d: int) -> np.ndarray:
-    if d == 0:
+def mode_rows(xt: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
+    """:func:`mode` applied to each row of ``xt`` (signals as rows, C-contiguous)."""
+    b, a = mode_coefficients(fn, zeta, dt)
+    out, _ = lfilter(b, a, xt, axis=-1, zi=lfilter_zi(b, a)[None, :] * xt[:, :1])
+    return out
+
+
+def shift(x: np.ndarray, d: float) -> np.ndarray:
+    """``x`` delayed by ``d >= 0`` samples (rows; held at ``x[0]`` before the start); a
+    fractional part interpolates linearly between the two neighbouring whole delays."""
+    n = int(np.floor(d))
+    f = float(d) - n
+    if f > 1e-12:
+        return (1.0 - f) * shift(x, n) + f * shift(x, n + 1)
+    if n == 0:
         return x
-    pad = np.repeat(x[:1], d, axis=0)
-    return np.concatenate((pad, x[: x.shape[0] - d]), axis=0)
+    pad = np.repeat(x[:1], n, axis=0)
+    return np.concatenate((pad, x[: x.shape[0] - n]), axis=0)
 
 
 @dataclass
@@ -111,14 +136,15 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     """Least squares over all train records through the normal equations (columns scaled to
     unit norm; the Gram matrix is small), so a grid search costs one pass over the data per
     point; the residual sum of squares is computed from the residuals themselves."""
-    blocks = [features(s) for s in train]
+    blocks = [features(s)[s.used] for s in train]
+    ys = [s.y[s.used] for s in train]
     G = sum(A.T @ A for A in blocks)
-    g = sum(A.T @ s.y for A, s in zip(blocks, train, strict=True))
+    g = sum(A.T @ y for A, y in zip(blocks, ys, strict=True))
     d = np.sqrt(np.diag(G))
     d[d == 0] = 1.0
     c, *_ = np.linalg.lstsq(G / d[:, None] / d[None, :], g / d, rcond=1e-13)
     coef = c / d
-    rss = float(sum(np.sum((A @ coef - s.y) ** 2) for A, s in zip(blocks, train, strict=True)))
+    rss = float(sum(np.sum((A @ coef - y) ** 2) for A, y in zip(blocks, ys, strict=True)))
     return Model(name, k, features, coef, params or {}), rss
 
 
@@ -133,7 +159,11 @@ def base_features(s: Segment) -> np.ndarray:
 def fit_nominal(train) -> Model:
     model = _fit("nominal", 0, base_features, train)[0]
     h = np.concatenate([model.predict(s) for s in train])
-    model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12)}
+    rate = np.concatenate([np.abs(np.diff(s.v)) / s.dt for s in train])
+    moving = rate[rate > 1e-9 * (float(np.ptp(rate)) or 1.0)]
+    model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
+                    "slope_sum": float(np.sum(model.coef[:-1])),
+                    "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0}
     return model
 
 
@@ -152,14 +182,18 @@ def delay_grid(dt: float) -> np.ndarray:
 
 
 def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> Model:
-    """Joint fit; the nonlinear parameters (mode, delay) by grid search on the train RSS, then
-    refined around the grid optimum."""
+    """Joint fit; the nonlinear parameters (mode, delay, drift clock) by grid search on the
+    train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
+    the grid optimum, then refitted with every play column."""
     name, k = "+".join(effects), _combo_k(effects)
     static: dict = {}
+    # a mode search filters every column at every point: there, the leading columns only
+    ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
 
     def search(points, best=None):
         for p in points:
-            model, rss = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)
+            model, rss = _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
+                              train, p)
             if best is None or rss < best[1]:
                 best = (model, rss)
         return best
@@ -175,6 +209,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
+        elif e == "drift":
+            grids.append([{"clock": fixed["clock"]}] if "clock" in fixed else
+                         [{"clock": c} for c in DRIFT_CLOCKS])
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
@@ -184,13 +221,17 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
         best = search([{**best[0].params, "d": int(d)} for d in range(lo, hi + 1)
                        if d not in dgrid], best)
+        d0 = best[0].params["d"]  # then a fraction of a sample on either side
+        best = search([{**best[0].params, "d": d0 + f} for f in (-0.75, -0.5, -0.25, 0.25,
+                                                                  0.5, 0.75) if d0 + f >= 0],
+                      best)
     if "dynamics" in effects and "fn" not in fixed:
         # refine the mode around the grid optimum, then polish it continuously (a light
         # mode's resonance is narrower than the grid)
         f0, z0 = best[0].params["fn"], best[0].params["zeta"]
         best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
-                       for f in f0 * np.linspace(0.88, 1.12, 13)
-                       for z in z0 * np.array([0.5, 0.7, 0.85, 1.0, 1.2, 1.4, 2.0])
+                       for f in f0 * np.linspace(0.88, 1.12, 9)
+                       for z in z0 * np.array([0.5, 0.75, 1.0, 1.35, 2.0])
                        if f <= fmax and MODE_DAMPING_RANGE[0] <= z <= MODE_DAMPING_RANGE[1]],
                       best)
         base = dict(best[0].params)
@@ -199,7 +240,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
             if p["fn"] > fmax or not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
                 return np.inf
-            return _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[1]
+            return _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
+                        train, p)[1]
 
         x0 = np.log([base["fn"], base["zeta"]])
         r = minimize(cost, x0, method="Nelder-Mead", options={
@@ -208,7 +250,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
-    model = best[0]
+    p = best[0].params  # the grid optimum, refitted with every play column
+    model = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[0]
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
     return model
@@ -216,10 +259,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
 def _combo_k(effects) -> int:
     return sum({"creep": len(CREEP_TAUS), "dynamics": 2, "delay": 1, "asymmetry": 2,
-                "drift": 1}[e] for e in effects)
+                "drift": 1, "rate": RATE_BANDS}[e] for e in effects)
 
 
-def _combo_features(effects, p, nominal: Model, static: dict):
+def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
     """Feature builder for the effects with grid parameters ``p``; the columns that do not
     depend on ``p`` (offset, creep, asymmetry, drift) are memoised per segment in ``static``."""
 
@@ -233,20 +276,77 @@ def _combo_features(effects, p, nominal: Model, static: dict):
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 cols.append(np.column_stack((u**2, u**3)))
-            if "drift" in effects:
-                cols.append((s.t - s.t[0])[:, None])
+            if "rate" in effects:
+                cols.append(s.rate_column)
             static[key] = (s, np.hstack(cols))  # keep s alive so its id stays unique
         return static[key][1]
 
     def feats(s: Segment) -> np.ndarray:
-        Z = s.Z
-        if "dynamics" in effects:
-            Z = mode(Z, p["fn"], p["zeta"], s.dt)
+        Z = s.Z if ncols is None else s.Z[:, :ncols]
+        if "dynamics" in effects:  # filter the (memoised) transposed columns
+            key = ("rows", id(s), ncols)
+            if key not in static:
+                static[key] = (s, np.ascontiguousarray(Z.T))
+            Z = mode_rows(static[key][1], p["fn"], p["zeta"], s.dt).T
         if "delay" in effects:
             Z = shift(Z, p["d"])
-        return np.hstack((Z, static_columns(s)))
+        cols = [Z, static_columns(s)]
+        if "drift" in effects:
+            cols.append((s.t - s.t[0] if p["clock"] == "record" else s.t)[:, None])
+        return np.hstack(cols)
 
     return feats
+
+
+def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
+                 bands: int = 4) -> np.ndarray:
+    """Output change per unit weight and unit ``c`` when the play radii grow with the input rate,
+    ``r_i[k] = r_i (1 + c rho[k])``, ``rho = |v[k] - v[k-1]| / dt / rate_scale`` (0 at a
+    sampled step, a one-sample jump of more than ``STEP_SHARE`` of the input range: no rate a
+    play can follow), to first order:
+    ``(-s_i) r_i rho[j_i]``, where ``j_i <= k`` is the last sample at which play ``i`` was
+    pushed (its output moved) and ``s_i`` the sign of that move (a wider play lags further
+    behind the input on the branch it was last pushed along), summed over ``bands`` contiguous
+    groups of plays (the fit gives each group its weight times ``c``).
+
+    Parameters
+    ----------
+    Z : numpy.ndarray
+        Play outputs ``z_i[k]``, shape (N, n).
+    radii : array_like
+        Play radii ``r_i`` [input units].
+    v : numpy.ndarray
+        Input ``v[k]``.
+    dt : float
+        Sample time [s].
+    rate_scale : float
+        Input rate [input units / s] that makes ``rho = 1``.
+    bands : int
+        Groups of plays.
+
+    Returns
+    -------
+    numpy.ndarray
+        The columns, shape (N, min(bands, n)), input units.
+
+    Examples
+    --------
+    >>> v = np.r_[np.linspace(0.0, 1.0, 41), 1.0]  # a ramp at 0.025 per sample, then a hold
+    >>> Z = np.maximum(v - 0.5, 0.0)[:, None]  # one play of radius 0.5, pushed from v = 0.5
+    >>> np.round(rate_columns(Z, [0.5], v, 1.0, 0.025)[[0, 20, 21, 41], 0], 6).tolist()
+    [0.0, 0.0, -0.5, -0.5]
+    """
+    dv = np.abs(np.diff(v, prepend=v[0]))
+    rho = np.where(dv <= STEP_SHARE * float(np.ptp(v)), dv / dt / rate_scale, 0.0)
+    dz = np.diff(Z, axis=0, prepend=Z[:1])
+    pushed = dz != 0
+    k = np.arange(Z.shape[0])[:, None]
+    last = np.maximum.accumulate(np.where(pushed, k, -1), axis=0)
+    sign = np.sign(dz)[np.maximum(last, 0), np.arange(Z.shape[1])[None, :]]
+    per_play = np.where(last >= 0, -sign * rho[np.maximum(last, 0)], 0.0)
+    per_play = per_play * np.asarray(radii, float)
+    groups = np.array_split(np.arange(Z.shape[1]), min(bands, Z.shape[1]))
+    return np.column_stack([per_play[:, g].sum(axis=1) for g in groups])
 
 
 def _describe(effects, model: Model, nominal: Model) -> dict:
@@ -254,7 +354,7 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
     n = nominal.coef.size - 1
     extra = model.coef[n + 1:]
     i = 0
-    for e in effects:
+    for e in (e for e in ("creep", "asymmetry", "rate") if e in effects):  # column order
         if e == "creep":
             out["creep_lag_gains"] = extra[i:i + len(CREEP_TAUS)].tolist()
             out["creep_time_constants_s"] = list(CREEP_TAUS)
@@ -262,9 +362,12 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
         elif e == "asymmetry":
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2
-        elif e == "drift":
-            out["drift_per_s"] = float(extra[i])
-            i += 1
+        elif e == "rate":
+            out["rate_band_gains"] = extra[i:i + RATE_BANDS].tolist()
+            i += RATE_BANDS
+    if "drift" in effects:
+        out["drift_per_s"] = float(model.coef[-1])
+        out["drift_clock"] = model.params["clock"]
     if "fn" in model.params:
         out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
     if "d" in model.params:

@@ -8,6 +8,34 @@ import numpy as np
 
 from ..branches import find_reversals
 
+STARTUP_SPAN = 0.9  # the start-up region ends when the input first spans this share of its range
+STARTUP_REGION = "start-up (until the input first spans 90 % of its range)"
+
+
+def startup_length(v: np.ndarray) -> int:
+    """Samples of the start-up region of a record: before index ``k`` the input has not yet
+    spanned ``STARTUP_SPAN`` of its range, so the memory of plays with large radii still
+    depends on the (unknown) state before the record.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        Input ``v[k]`` of one record.
+
+    Returns
+    -------
+    int
+        First sample index after the start-up region.
+
+    Examples
+    --------
+    >>> startup_length(np.array([0.0, 0.5, 1.0, -1.0, 0.0]))
+    3
+    """
+    v = np.asarray(v, float)
+    span = np.maximum.accumulate(v) - np.minimum.accumulate(v)
+    return int(np.argmax(span >= STARTUP_SPAN * float(np.ptp(v))))
+
 
 def _region_masks(t: np.ndarray, v: np.ndarray, fs: float) -> dict[str, np.ndarray]:
     rng = float(np.ptp(v)) or 1.0
@@ -41,6 +69,7 @@ def _region_masks(t: np.ndarray, v: np.ndarray, fs: float) -> dict[str, np.ndarr
         "hold after a step (after 50 ms)": (~moving) & (since_step >= 0.05) & np.isfinite(
             since_step),
         "late in the record (last third)": tt > 2 * tt[-1] / 3,
+        STARTUP_REGION: np.arange(v.size) < startup_length(v),
     }
 
 
