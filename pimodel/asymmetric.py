@@ -145,7 +145,16 @@ class AsymmetricPI:
         self._z = self._state(value)
 
     def reset(self) -> None:
-        """Return the streaming state to :attr:`initial_state`."""
+        """Return the streaming state to :attr:`initial_state`.
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> _ = op.step(1.0)
+        >>> op.reset()
+        >>> op.state
+        array([0.])
+        """
         self._z = self._z0.copy()
 
     def _run(self, x: np.ndarray, z: np.ndarray, *, inverse: bool, name: str) -> np.ndarray:
@@ -174,6 +183,18 @@ class AsymmetricPI:
         Returns
         -------
         numpy.ndarray or tuple
+            ``y[k]`` (depends on ``v[0..k]``), or ``(y, z_final)`` with ``return_state``.
+
+        Raises
+        ------
+        ValueError
+            Non-finite input, or a sample outside the shape function's domain (named).
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> op.simulate([0.0, 1.0, 0.4])
+        array([0. , 1.4, 0.8])
         """
         x = as_signal(v, "v")
         z = self._z0.copy() if state is None else self._state(state)
@@ -181,14 +202,49 @@ class AsymmetricPI:
         return (y, z) if return_state else y
 
     def step(self, v: float) -> float:
-        """Advance one sample with ``v[k]`` and return ``y[k]``."""
+        """Advance one sample with ``v[k]`` and return ``y[k]``.
+
+        Parameters
+        ----------
+        v : float
+            Input sample ``v[k]``.
+
+        Returns
+        -------
+        float
+            Output ``y[k]``, from the updated play states ``z_i[k]``.
+
+        Raises
+        ------
+        ValueError
+            Non-finite input, or a sample outside the shape function's domain.
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> op.step(1.0), op.state
+        (1.4, array([0.8]))
+        """
         z = self._z.copy()
         y = self._run(as_signal(v, "v"), z, inverse=False, name="v")
         self._z = z
         return float(y[0])
 
     def to_dict(self) -> dict:
-        """JSON-ready parameters."""
+        """JSON-ready parameters.
+
+        Returns
+        -------
+        dict
+            ``type``, ``direct_weight``, ``weights``, ``radii``, ``ascending``, ``descending``,
+            ``shape`` and ``initial_state`` (see :func:`pimodel.models.model_to_dict`).
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> op.to_dict()["descending"]
+        [2.0, 0.0]
+        """
         return {"type": "AsymmetricPI", "direct_weight": self.direct_weight,
                 "weights": self._p.tolist(), "radii": self._r.tolist(),
                 "ascending": list(self.ascending), "descending": list(self.descending),
@@ -201,6 +257,13 @@ class AsymmetricPI:
         -------
         AsymmetricPIInverse
             ``simulate(y_d)`` gives ``v`` with ``self.simulate(v) == y_d`` to rounding.
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> y_d = np.array([0.0, 1.5, 1.0])
+        >>> bool(np.allclose(op.simulate(op.inverse().simulate(y_d)), y_d))
+        True
         """
         return AsymmetricPIInverse(self)
 
@@ -212,6 +275,7 @@ class AsymmetricPIInverse:
     Parameters
     ----------
     forward : AsymmetricPI
+        The operator to invert (kept as ``.forward``).
 
     Examples
     --------
@@ -234,7 +298,17 @@ class AsymmetricPIInverse:
         self._z = self.forward._state(value)
 
     def reset(self) -> None:
-        """Return to the forward operator's initial state."""
+        """Return to the forward operator's initial state.
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> inv = op.inverse()
+        >>> _ = inv.step(1.5)
+        >>> inv.reset()
+        >>> inv.state
+        array([0.])
+        """
         self._z = self.forward.initial_state.copy()
 
     def simulate(self, y_d, *, state=None, return_state: bool = False):
@@ -257,6 +331,12 @@ class AsymmetricPIInverse:
         ------
         ValueError
             A ``y_d`` sample no input reaches (beyond a saturation level), named.
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> op.inverse().simulate([0.0, 1.5, 1.0])
+        array([0.        , 1.06666667, 0.56666667])
         """
         x = as_signal(y_d, "y_d")
         f = self.forward
@@ -265,7 +345,30 @@ class AsymmetricPIInverse:
         return (v, z) if return_state else v
 
     def step(self, y_d: float) -> float:
-        """Advance one sample with ``y_d[k]`` and return ``v[k]``."""
+        """Advance one sample with ``y_d[k]`` and return ``v[k]``.
+
+        Parameters
+        ----------
+        y_d : float
+            Desired output ``y_d[k]``.
+
+        Returns
+        -------
+        float
+            Input ``v[k]`` with forward output ``y[k] = y_d[k]``; the state advances with it.
+
+        Raises
+        ------
+        ValueError
+            A ``y_d`` sample no input reaches (beyond a saturation level).
+
+        Examples
+        --------
+        >>> op = AsymmetricPI(1.0, [0.5], [0.2], ascending=(1.0, 0.0), descending=(2.0, 0.0))
+        >>> inv = op.inverse()
+        >>> round(inv.step(1.5), 12), inv.state
+        (1.066666666667, array([0.86666667]))
+        """
         z = self._z.copy()
         v = self.forward._run(as_signal(y_d, "y_d"), z, inverse=True, name="y_d")
         self._z = z

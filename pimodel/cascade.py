@@ -60,12 +60,24 @@ class Cascade:
 
         Parameters
         ----------
-        v : array_like
-            Input of the first stage.
+        v : array_like of float, shape (N,)
+            Input of the first stage, ``v[k]``.
 
         Returns
         -------
-        numpy.ndarray
+        numpy.ndarray of float, shape (N,)
+            Output of the last stage; ``y[k]`` depends on ``v[0..k]`` (no delay added).
+
+        Raises
+        ------
+        ValueError
+            If ``v`` is not a finite 1-D signal.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> Cascade(PIOperator([1.0], [0.0]), PIOperator([2.0], [0.0])).simulate([0.0, 1.0])
+        array([0., 2.])
         """
         x = as_signal(v, "v")
         for s in self.stages:
@@ -73,14 +85,41 @@ class Cascade:
         return x
 
     def step(self, v: float) -> float:
-        """Advance every stage one sample (streaming state of each stage)."""
+        """Advance every stage one sample (streaming state of each stage).
+
+        Parameters
+        ----------
+        v : float
+            Input sample ``v[k]`` of the first stage.
+
+        Returns
+        -------
+        float
+            Output ``y[k]`` of the last stage.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> Cascade(PIOperator([1.0], [0.0]), PIOperator([2.0], [0.0])).step(0.5)
+        1.0
+        """
         x = float(v)
         for s in self.stages:
             x = s.step(x)
         return x
 
     def reset(self) -> None:
-        """Reset every stage's streaming state."""
+        """Reset every stage's streaming state.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> chain = Cascade(PIOperator([1.0], [0.5]))
+        >>> _ = chain.step(2.0)
+        >>> chain.reset()
+        >>> chain.step(0.0)
+        0.0
+        """
         for s in self.stages:
             s.reset()
 
@@ -90,5 +129,12 @@ class Cascade:
         Returns
         -------
         Cascade
+            The inverse chain: ``inverse().simulate(simulate(v))`` returns ``v``.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> Cascade(PIOperator([1.0], [0.0]), PIOperator([2.0], [0.0])).inverse().stages
+        (PIOperator(weights=[0.5], radii=[0.]), PIOperator(weights=[1.], radii=[0.]))
         """
         return Cascade(*(s.inverse() for s in reversed(self.stages)))

@@ -6,7 +6,37 @@ import numpy as np
 
 
 def as_signal(value, name: str, *, min_length: int = 1) -> np.ndarray:
-    """Return ``value`` as a finite 1-D float64 array, or raise ValueError naming ``name``."""
+    """Return ``value`` as a finite 1-D float64 array, or raise ValueError naming ``name``.
+
+    Parameters
+    ----------
+    value : array_like
+        The samples; a scalar becomes one sample.
+    name : str
+        The argument's name, used in the error message.
+    min_length : int, optional
+        Fewest samples accepted. Default 1.
+
+    Returns
+    -------
+    numpy.ndarray of float64
+        A C-contiguous 1-D array.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not numeric, not 1-D, too short, or holds a NaN/inf (the first one is
+        named by its index).
+
+    Examples
+    --------
+    >>> as_signal([0, 1, 2], "v")
+    array([0., 1., 2.])
+    >>> as_signal([0.0, float("nan")], "v")
+    Traceback (most recent call last):
+    ...
+    ValueError: v: sample 1 is nan; all samples must be finite (1 non-finite in total)
+    """
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -29,7 +59,36 @@ def as_signal(value, name: str, *, min_length: int = 1) -> np.ndarray:
 
 
 def as_vector(value, name: str, *, length: int | None = None) -> np.ndarray:
-    """Return a finite 1-D float64 parameter vector (at least one entry, optional length)."""
+    """Return a finite 1-D float64 parameter vector (at least one entry, optional length).
+
+    Parameters
+    ----------
+    value : array_like
+        The entries; a scalar becomes one entry.
+    name : str
+        The parameter's name, used in the error message.
+    length : int, optional
+        Required number of entries.
+
+    Returns
+    -------
+    numpy.ndarray of float64
+        A C-contiguous 1-D array.
+
+    Raises
+    ------
+    ValueError
+        As :func:`as_signal`, or if the length differs from ``length``.
+
+    Examples
+    --------
+    >>> as_vector(0.5, "radii")
+    array([0.5])
+    >>> as_vector([1.0, 2.0], "weights", length=3)
+    Traceback (most recent call last):
+    ...
+    ValueError: weights: expected 3 values, got 2
+    """
     arr = as_signal(value, name)
     if length is not None and arr.shape[0] != length:
         raise ValueError(f"{name}: expected {length} values, got {arr.shape[0]}")
@@ -37,7 +96,34 @@ def as_vector(value, name: str, *, length: int | None = None) -> np.ndarray:
 
 
 def positive_scalar(value, name: str) -> float:
-    """Return ``value`` as a finite float > 0, or raise ValueError naming ``name``."""
+    """Return ``value`` as a finite float > 0, or raise ValueError naming ``name``.
+
+    Parameters
+    ----------
+    value : float
+        The number (anything ``float()`` accepts).
+    name : str
+        The argument's name, used in the error message.
+
+    Returns
+    -------
+    float
+        ``float(value)``.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not a number, not finite or not > 0.
+
+    Examples
+    --------
+    >>> positive_scalar("1e-3", "dt")
+    0.001
+    >>> positive_scalar(0, "dt")
+    Traceback (most recent call last):
+    ...
+    ValueError: dt: expected a finite number > 0, got 0
+    """
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -52,6 +138,27 @@ def integer_in(value, name: str, lo: int, hi: int | None = None) -> int:
 
     Accepts Python and NumPy integers; rejects floats (also integral ones such as ``4.0``),
     booleans and anything else with a message saying what was given.
+
+    Parameters
+    ----------
+    value : int
+        The value to check.
+    name : str
+        The argument's name, used in the error message.
+    lo : int
+        Smallest value accepted.
+    hi : int, optional
+        Largest value accepted (default: no upper bound).
+
+    Returns
+    -------
+    int
+        ``value`` as a Python int.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not an integer or lies outside ``[lo, hi]``.
 
     Examples
     --------

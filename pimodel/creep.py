@@ -148,11 +148,35 @@ class CreepOperator:
         return self._x0
 
     def zeros(self) -> np.ndarray:
-        """Zeros of ``G`` (poles of the inverse): eigenvalues of ``diag(a) - (1 - a) c^T``."""
+        """Zeros of ``G`` (poles of the inverse): eigenvalues of ``diag(a) - (1 - a) c^T``.
+
+        Returns
+        -------
+        numpy.ndarray
+            The m zeros (complex in general); all inside the unit circle for a valid operator.
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> cr.zeros().round(6)
+        array([0.051819])
+        """
         return np.linalg.eigvals(np.diag(self._a) - np.outer(1.0 - self._a, self._c))
 
     def static_gain(self) -> float:
-        """``G(1) = 1 + sum c_i`` (for the inverse, its reciprocal)."""
+        """``G(1) = 1 + sum c_i`` (for the inverse, its reciprocal).
+
+        Returns
+        -------
+        float
+            The steady-state gain (output per input unit, dimensionless here).
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> cr.static_gain(), round(cr.inverse().static_gain(), 12)
+        (1.5, 0.666666666667)
+        """
         g = 1.0 + float(self._c.sum())
         return 1.0 / g if self.inverted else g
 
@@ -160,6 +184,19 @@ class CreepOperator:
         """``(A, B, C, D)`` of ``x[k+1] = A x[k] + B u[k]``, ``y[k] = C x[k] + D u[k]``.
 
         For the inverse (``inverted``) the input is ``y`` and the output ``u``.
+
+        Returns
+        -------
+        A, B, C, D : numpy.ndarray
+            Discrete-time state-space matrices, shapes (m, m), (m, 1), (1, m), (1, 1), with
+            sample time ``dt`` (e.g. ``control.ss(A, B, C, D, dt)``).
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> A, B, C, D = cr.state_space()
+        >>> A.round(6), B.round(6), C, D
+        (array([[0.367879]]), array([[0.632121]]), array([[0.5]]), array([[1.]]))
         """
         a, c = self._a, self._c
         B = (1.0 - a)[:, None]
@@ -189,6 +226,19 @@ class CreepOperator:
         Returns
         -------
         numpy.ndarray or tuple
+            The output samples (``y[k] = u[k] + sum_i c_i x_i[k]``: direct feedthrough, the
+            lags act from the next sample), or ``(output, final lag states)``.
+
+        Raises
+        ------
+        ValueError
+            Non-finite input, or a ``state`` of the wrong length.
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> cr.simulate([1.0, 1.0, 1.0])
+        array([1.        , 1.31606028, 1.43233236])
         """
         x = as_signal(u, "u")
         s = self._x0.copy() if state is None else self._check_state(state)
@@ -211,11 +261,42 @@ class CreepOperator:
         self._x = self._check_state(value)
 
     def reset(self) -> None:
-        """Return the streaming state to :attr:`initial_state`."""
+        """Return the streaming state to :attr:`initial_state`.
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> _ = cr.step(1.0)
+        >>> cr.reset()
+        >>> cr.step(1.0)
+        1.0
+        """
         self._x = self._x0.copy()
 
     def step(self, u: float) -> float:
-        """Advance one sample and return the output."""
+        """Advance one sample and return the output.
+
+        Parameters
+        ----------
+        u : float
+            Input sample ``u[k]`` (``y_d[k]`` for the inverse).
+
+        Returns
+        -------
+        float
+            Output at sample k; the lag states advance to ``x[k+1]``.
+
+        Raises
+        ------
+        ValueError
+            If ``u`` is not finite.
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> cr.step(1.0), round(cr.step(1.0), 8)
+        (1.0, 1.31606028)
+        """
         return float(_native.creep_run(self._a, self._c, self._x, as_signal(u, "u"),
                                        inverse=self.inverted)[0])
 
@@ -226,12 +307,30 @@ class CreepOperator:
         -------
         CreepOperator
             With ``inverted`` flipped: ``inverse().simulate(self.simulate(u)) == u``.
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> cr.inverse().simulate([1.0, 1.31606028, 1.43233236]).round(6)
+        array([1., 1., 1.])
         """
         return CreepOperator(self._c, self._tau, dt=self.dt, initial_state=self._x0,
                              inverted=not self.inverted)
 
     def to_dict(self) -> dict:
-        """JSON-ready parameters."""
+        """JSON-ready parameters.
+
+        Returns
+        -------
+        dict
+            ``type``, ``gains``, ``time_constants``, ``dt``, ``initial_state``, ``inverted``.
+
+        Examples
+        --------
+        >>> cr = CreepOperator([0.5], [1e-3], dt=1e-3)
+        >>> cr.to_dict()["time_constants"]
+        [0.001]
+        """
         return {"type": "CreepOperator", "gains": self._c.tolist(),
                 "time_constants": self._tau.tolist(), "dt": self.dt,
                 "initial_state": self._x0.tolist(), "inverted": self.inverted}

@@ -100,12 +100,39 @@ class Envelope:
         return self.kind in ("poly2", "poly2_inv") and tuple(self._c[:3]) == (0.0, 1.0, 0.0)
 
     def inverse(self) -> Envelope:
-        """The exact inverse function, again an :class:`Envelope`."""
+        """The exact inverse function, again an :class:`Envelope`.
+
+        Returns
+        -------
+        Envelope
+            ``poly2`` <-> ``poly2_inv``, ``tanh`` <-> ``tanh_inv``, same coefficients.
+
+        Examples
+        --------
+        >>> Envelope.poly2(0.0, 1.0, 0.25).inverse()
+        Envelope('poly2_inv', [0.0, 1.0, 0.25])
+        """
         m = 4 if self.kind.startswith("tanh") else 3
         return Envelope(_INVERSE[self.kind], self._c[:m])
 
     def reference(self, x) -> np.ndarray:
-        """NumPy spec of ``f(x)`` (NaN outside the domain), held equal to the C core by tests."""
+        """NumPy spec of ``f(x)`` (NaN outside the domain), held equal to the C core by tests.
+
+        Parameters
+        ----------
+        x : array_like of float
+            Arguments.
+
+        Returns
+        -------
+        numpy.ndarray of float
+            ``f(x)`` elementwise, NaN where ``x`` lies outside the domain.
+
+        Examples
+        --------
+        >>> Envelope.poly2(0.0, 1.0, 0.25).reference([0.0, 1.0, -3.0])
+        array([0.  , 1.25,  nan])
+        """
         x = np.asarray(x, float)
         c0, c1, c2, c3 = self._c
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -136,7 +163,18 @@ class Envelope:
         return y if np.ndim(x) else y[0]
 
     def to_dict(self) -> dict:
-        """JSON-ready form ``{"kind": ..., "coefficients": [...]}``."""
+        """JSON-ready form ``{"kind": ..., "coefficients": [...]}``.
+
+        Returns
+        -------
+        dict
+            ``kind`` (str) and ``coefficients`` (list of float).
+
+        Examples
+        --------
+        >>> Envelope.poly2(0.0, 1.0, 0.25).to_dict()
+        {'kind': 'poly2', 'coefficients': [0.0, 1.0, 0.25]}
+        """
         m = 4 if self.kind.startswith("tanh") else 3
         return {"kind": self.kind, "coefficients": self._c[:m].tolist()}
 

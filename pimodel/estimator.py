@@ -99,7 +99,38 @@ MAX_PLAYS = 64
 
 
 def project_ordered(x, weights=None, *, fix_first: bool = False) -> np.ndarray:
-    """Weighted projection of ``x`` onto ``0 <= x_1 <= ... <= x_n`` (C core)."""
+    """Weighted projection of ``x`` onto ``0 <= x_1 <= ... <= x_n`` (C core).
+
+    Minimises ``sum_j w_j (x'_j - x_j)^2`` over the ordered set (pool-adjacent-violators, then
+    clipping at 0); :func:`pimodel.estimator_reference.project_ordered_reference` is the NumPy
+    specification.
+
+    Parameters
+    ----------
+    x : array_like of float, shape (n,)
+        The point to project (e.g. radii, input unit).
+    weights : array_like of float, shape (n,), optional
+        Positive weights ``w_j`` of the norm (default all 1).
+    fix_first : bool, optional
+        Also hold ``x_1 = 0`` (a linear play).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (n,)
+        The projection (a new array).
+
+    Raises
+    ------
+    ValueError
+        If ``x`` or ``weights`` is not a finite vector, or their lengths differ.
+
+    Examples
+    --------
+    >>> project_ordered([0.5, 0.2, 1.0])
+    array([0.35, 0.35, 1.  ])
+    >>> project_ordered([0.5, 0.2, 1.0], fix_first=True)
+    array([0. , 0.2, 1. ])
+    """
     out = np.array(as_vector(x, "x"), dtype=float)
     w = np.ones_like(out) if weights is None else as_vector(weights, "weights", length=out.size)
     _lib.pim_project_ordered(out.size, out, np.ascontiguousarray(w), int(fix_first))
@@ -110,14 +141,41 @@ def project_ordered(x, weights=None, *, fix_first: bool = False) -> np.ndarray:
 class RadiusEstimate:
     """Result of :func:`estimate_radii` and :meth:`RadiusEstimator.run`.
 
-    ``history[k]`` is the estimate used at step k (before that step's update), so
-    ``history[0]`` is the (projected) initial guess and ``radii`` the estimate after the last
-    sample. ``error[k] = yhat[k] - y[k]``, ``modified_error[k]`` is ``e_delta[k]`` (0 where
-    the sample was not used), ``used[k]`` whether sample k adapted the radii.
-    ``radii_mean`` is the mean of ``history`` over the last half of the record (None below
-    ``MIN_MEAN_SAMPLES`` samples): under output noise the constant-gain iterate keeps
-    fluctuating and the mean is the estimate to use. ``health`` (from :func:`estimate_radii`)
-    says whether the estimate can be trusted, see :mod:`pimodel.estimator_health`.
+    Parameters
+    ----------
+    radii : numpy.ndarray of float, shape (n,)
+        The estimate after the last sample, ``rhat[N]`` (input unit).
+    history : numpy.ndarray of float, shape (N, n)
+        ``history[k]`` is the estimate used at step k (before that step's update), so
+        ``history[0]`` is the (projected) initial guess.
+    error : numpy.ndarray of float, shape (N,)
+        ``e[k] = yhat[k] - y[k]`` (output unit).
+    modified_error : numpy.ndarray of float, shape (N,)
+        ``e_delta[k]`` (output unit; 0 where the sample was not used).
+    model_output : numpy.ndarray of float, shape (N,)
+        ``yhat[k]``, the model with the current estimate (output unit).
+    used : numpy.ndarray of bool, shape (N,)
+        Whether sample k adapted the radii.
+    dt : float
+        Sample time [s].
+    radii_mean : numpy.ndarray of float, shape (n,), optional
+        Mean of ``history`` over the last half of the record (None below
+        ``MIN_MEAN_SAMPLES`` samples): under output noise the constant-gain iterate keeps
+        fluctuating and the mean is the estimate to use.
+    health : EstimatorHealth, optional
+        From :func:`estimate_radii`: whether the estimate can be trusted, see
+        :mod:`pimodel.estimator_health`.
+    settings : dict, optional
+        The settings :func:`estimate_radii` used (gains, threshold, guard, slope window, law).
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = np.sin(np.linspace(0, 20, 2000))          # 2 s at dt = 1 ms
+    >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+    >>> res = RadiusEstimator([1.0, 1.0], dt=1e-3).run(v, y)
+    >>> res.history.shape, res.radii.round(2)
+    ((2000, 2), array([0. , 0.3]))
     """
 
     radii: np.ndarray
@@ -132,7 +190,27 @@ class RadiusEstimate:
     settings: dict | None = None
 
     def mean_radii(self, last_seconds: float) -> np.ndarray:
-        """Average of the estimate over the last ``last_seconds`` of the record."""
+        """Average of the estimate over the last ``last_seconds`` of the record.
+
+        Parameters
+        ----------
+        last_seconds : float
+            Length of the averaged tail [s] (at least one sample).
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (n,)
+            Mean of ``history`` over that tail (input unit).
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = np.sin(np.linspace(0, 20, 2000))          # 2 s at dt = 1 ms
+        >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+        >>> res = RadiusEstimator([1.0, 1.0], dt=1e-3).run(v, y)
+        >>> res.mean_radii(0.5).round(2)
+        array([0. , 0.3])
+        """
         k = max(1, int(round(last_seconds / self.dt)))
         return self.history[-k:].mean(axis=0)
 
@@ -152,18 +230,46 @@ def _renamed_linear_play(linear_play: bool, known_linear_play: bool | None, wher
 class RadiusEstimator:
     """Streaming radius estimator: :meth:`step` takes one sample ``(v[k], y[k])``.
 
-    Parameters: ``weights`` p_j > 0 (known, e.g. from the loop slopes), ``dt`` sample time [s],
-    ``gains`` (scalar or per play, >= 0; the paper's Lambda diagonal; above the stability
-    bound ``2 / (dt |p|^2)`` a ``UserWarning`` is issued), ``law`` (``"data"``: regime from the
-    measured branches, the default; ``"paper"``: regime from the estimate), ``initial_radii``
-    (projected onto the ordered set), ``linear_play`` (hold rhat_1 = 0; the old name
-    ``known_linear_play`` is deprecated), ``threshold``
-    (reversal threshold, input unit), ``max_step`` (per-sample clip of the update, input unit),
-    ``guard`` (breakpoint guard band, input unit), ``slope_window`` and ``slope_tol`` (the slope
-    check: samples, 0 to disable; tolerance in units of the smallest weight),
-    ``anneal_time`` (gain annealing time constant [s]), ``initial_state`` (model play state).
-    The slope check applies to ``law="paper"`` only. See the module docstring for the exact
-    discrete-time law.
+    See the module docstring for the exact discrete-time law.
+
+    Parameters
+    ----------
+    weights : array_like of float, shape (n,)
+        Play weights ``p_j > 0`` (known, e.g. from the loop slopes), n <= 64.
+    dt : float
+        Sample time [s].
+    gains : float or array_like of float, optional
+        Adaptation gains (scalar or per play, >= 0; the paper's Lambda diagonal). Above the
+        stability bound ``2 / (dt |p|^2)`` a ``UserWarning`` is issued. Default 10.
+    initial_radii : array_like of float, shape (n,), optional
+        Start of the estimate (projected onto the ordered set); default all 0.
+    linear_play : bool, optional
+        Hold ``rhat_1 = 0``.
+    threshold : float, optional
+        Reversal threshold (input unit). Default 0.
+    max_step : float, optional
+        Per-sample clip of the update (input unit); default no clip.
+    anneal_time : float, optional
+        Gain annealing time constant [s]; default constant gains.
+    guard : float, optional
+        Breakpoint guard band (input unit). Default 0.
+    slope_window : int, optional
+        Samples of the slope check (0 disables it; ``law="paper"`` only). Default 8.
+    slope_tol : float, optional
+        Tolerance of the slope check, in units of the smallest weight. Default 0.5.
+    initial_state : float, optional
+        Model play state ``zhat_j[-1]`` (input unit). Default 0.
+    law : {"data", "paper"}, optional
+        ``"data"`` (default): regime from the measured branches; ``"paper"``: regime from the
+        estimate.
+    known_linear_play : bool, optional
+        Deprecated name of ``linear_play`` (DeprecationWarning).
+
+    Raises
+    ------
+    ValueError
+        Bad weights (non-positive, more than 64), gains, initial radii, ``dt``, threshold,
+        guard, slope check settings or ``law`` (the message names the argument).
 
     Examples
     --------
@@ -275,11 +381,53 @@ class RadiusEstimator:
             raise ValueError(msg.decode())
 
     def reset(self) -> None:
-        """Back to the state right after construction."""
+        """Back to the state right after construction.
+
+        Examples
+        --------
+        >>> est = RadiusEstimator([1.0, 1.0], dt=1e-3, initial_radii=[0.2, 0.1])
+        >>> _ = est.step(0.5, 1.0)
+        >>> est.reset()
+        >>> est.radii
+        array([0.15, 0.15])
+        """
         self.state = self._initial
 
     def step(self, v: float, y: float) -> tuple[np.ndarray, float, float, float]:
-        """Process sample k: returns ``(rhat[k+1], yhat[k], e[k], e_delta[k])``."""
+        """Process sample k: returns ``(rhat[k+1], yhat[k], e[k], e_delta[k])``.
+
+        Parameters
+        ----------
+        v : float
+            Input sample ``v[k]`` (input unit).
+        y : float
+            Measured output ``y[k]`` (output unit).
+
+        Returns
+        -------
+        radii : numpy.ndarray of float, shape (n,)
+            ``rhat[k+1]``, the estimate after this sample's update.
+        model_output : float
+            ``yhat[k]``, the model output with ``rhat[k]``.
+        error : float
+            ``e[k] = yhat[k] - y[k]``.
+        modified_error : float
+            ``e_delta[k]`` (0 when the sample was not used).
+
+        Raises
+        ------
+        ValueError
+            If ``v`` or ``y`` is not finite.
+
+        Examples
+        --------
+        >>> est = RadiusEstimator([1.0, 1.0], dt=1e-3, initial_radii=[0.2, 0.1])
+        >>> est.radii                       # the start, projected onto the ordered set
+        array([0.15, 0.15])
+        >>> rhat, yhat, e, e_delta = est.step(0.5, 1.0)
+        >>> rhat, yhat, round(e, 12)
+        (array([0.15, 0.15]), 0.7, -0.3)
+        """
         yh, e, ed = ctypes.c_double(), ctypes.c_double(), ctypes.c_double()
         rc = _lib.pim_est_step(self._buf, float(v), float(y), None, ctypes.byref(yh),
                                ctypes.byref(e), ctypes.byref(ed))
@@ -288,7 +436,34 @@ class RadiusEstimator:
         return self.radii, yh.value, e.value, ed.value
 
     def run(self, v, y) -> RadiusEstimate:
-        """Process whole arrays from the current state (batch, C loop)."""
+        """Process whole arrays from the current state (batch, C loop).
+
+        Parameters
+        ----------
+        v : array_like of float, shape (N,)
+            Input samples ``v[k]`` (input unit), N >= 2.
+        y : array_like of float, shape (N,)
+            Measured output ``y[k]`` (output unit).
+
+        Returns
+        -------
+        RadiusEstimate
+            History, errors and the final estimate; the estimator's state has advanced by N
+            samples (no ``health``: see :func:`estimate_radii`).
+
+        Raises
+        ------
+        ValueError
+            Non-finite samples or unequal lengths.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = np.sin(np.linspace(0, 20, 2000))          # 2 s at dt = 1 ms
+        >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+        >>> RadiusEstimator([1.0, 1.0], dt=1e-3).run(v, y).radii.round(2)
+        array([0. , 0.3])
+        """
         x = as_signal(v, "v", min_length=2)
         m = as_signal(y, "y", min_length=2)
         if x.size != m.size:
@@ -388,6 +563,41 @@ def stream_tail_average(estimator: RadiusEstimator, chunks: Iterable[tuple], *, 
     allow under heavy output noise; the constant-gain iterate itself keeps fluctuating. Memory
     is bounded by the chunk size, so records of 10^8 samples are fine
     (:mod:`pimodel.long_records` makes such chunks).
+
+    Parameters
+    ----------
+    estimator : RadiusEstimator
+        Runs from its current state and is advanced by ``total`` samples.
+    chunks : iterable of tuple of array_like
+        ``(v, y)`` pieces of the record, in order, of equal lengths each.
+    total : int
+        Number of samples in all the chunks (>= 2).
+    tail : float, optional
+        Fraction of the samples, at the end, averaged (0 < tail <= 1). Default 0.5.
+
+    Returns
+    -------
+    radii : numpy.ndarray of float, shape (n,)
+        The final estimate (input unit).
+    tail_mean : numpy.ndarray of float, shape (n,)
+        Mean of the estimate ``rhat[k]`` used at the samples of the tail (input unit).
+
+    Raises
+    ------
+    ValueError
+        If ``tail`` is outside (0, 1], a chunk's ``v`` and ``y`` differ in length, or the chunks
+        do not hold exactly ``total`` samples.
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = np.sin(np.linspace(0, 20, 2000))          # 2 s at dt = 1 ms
+    >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+    >>> chunks = [(v[:1000], y[:1000]), (v[1000:], y[1000:])]
+    >>> final, mean = stream_tail_average(RadiusEstimator([1.0, 1.0], dt=1e-3), chunks,
+    ...                                   total=2000)
+    >>> final.round(2), mean.round(2)
+    (array([0. , 0.3]), array([0. , 0.3]))
     """
     total = integer_in(total, "total", 2)
     if not 0 < tail <= 1:
@@ -418,7 +628,42 @@ def stream_tail_average(estimator: RadiusEstimator, chunks: Iterable[tuple], *, 
 
 def run_tail_average(estimator: RadiusEstimator, v, y, *, tail: float = 0.5,
                      chunk: int = 1_000_000) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`stream_tail_average` over whole arrays ``v``, ``y``, processed in chunks."""
+    """:func:`stream_tail_average` over whole arrays ``v``, ``y``, processed in chunks.
+
+    Parameters
+    ----------
+    estimator : RadiusEstimator
+        Runs from its current state and is advanced by ``len(v)`` samples.
+    v : array_like of float, shape (N,)
+        Input samples (input unit), N >= 2.
+    y : array_like of float, shape (N,)
+        Measured output (output unit).
+    tail : float, optional
+        Fraction of the samples, at the end, averaged (0 < tail <= 1). Default 0.5.
+    chunk : int, optional
+        Samples per chunk (bounds the memory). Default 10^6.
+
+    Returns
+    -------
+    radii : numpy.ndarray of float, shape (n,)
+        The final estimate (input unit).
+    tail_mean : numpy.ndarray of float, shape (n,)
+        Mean of the estimate over the tail (input unit).
+
+    Raises
+    ------
+    ValueError
+        Non-finite samples, unequal lengths, or ``tail`` outside (0, 1].
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = np.sin(np.linspace(0, 20, 2000))          # 2 s at dt = 1 ms
+    >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+    >>> final, mean = run_tail_average(RadiusEstimator([1.0, 1.0], dt=1e-3), v, y, chunk=500)
+    >>> mean.round(2)
+    array([0. , 0.3])
+    """
     x = as_signal(v, "v", min_length=2)
     m = as_signal(y, "y", min_length=2)
     if x.size != m.size:

@@ -30,7 +30,7 @@ from .excitation import check_excitation
 class EstimatorHealth:
     """Result of :func:`estimator_health`; ``ok`` is False when any check failed.
 
-    Attributes
+    Parameters
     ----------
     ok : bool
         All checks passed.
@@ -50,6 +50,11 @@ class EstimatorHealth:
         RMS of ``e`` over the last quarter [output unit] (None when not checked).
     messages : list of str
         One sentence per failed check.
+
+    Examples
+    --------
+    >>> EstimatorHealth(ok=True, excitation_ok=True).fit_rms is None
+    True
     """
 
     ok: bool
@@ -63,7 +68,18 @@ class EstimatorHealth:
     messages: list = field(default_factory=list)
 
     def to_json(self) -> dict:
-        """Plain dict of the fields."""
+        """Plain dict of the fields.
+
+        Returns
+        -------
+        dict
+            Field name -> value (JSON-serialisable: lists, floats, bools, None).
+
+        Examples
+        --------
+        >>> EstimatorHealth(ok=False, excitation_ok=True, pinned=[2]).to_json()["pinned"]
+        [2]
+        """
         return asdict(self)
 
 

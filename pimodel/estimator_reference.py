@@ -13,7 +13,29 @@ BINS = 256  # PIM_EST_BINS
 
 
 def project_ordered_reference(x: np.ndarray, w: np.ndarray, fix_first: bool) -> np.ndarray:
-    """Weighted projection onto ``0 <= x_1 <= ... <= x_n`` by pooling adjacent violators."""
+    """Weighted projection onto ``0 <= x_1 <= ... <= x_n`` by pooling adjacent violators.
+
+    The specification of :func:`pimodel.estimator.project_ordered`.
+
+    Parameters
+    ----------
+    x : array_like of float, shape (n,)
+        The point to project.
+    w : array_like of float, shape (n,)
+        Positive weights of the norm.
+    fix_first : bool
+        Also hold ``x_1 = 0``.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (n,)
+        The projection (a new array).
+
+    Examples
+    --------
+    >>> project_ordered_reference([0.5, 0.2, 1.0], np.ones(3), False)
+    array([0.35, 0.35, 1.  ])
+    """
     x = np.array(x, dtype=float)
     start = 1 if fix_first else 0
     if fix_first:
@@ -31,7 +53,27 @@ def project_ordered_reference(x: np.ndarray, w: np.ndarray, fix_first: bool) -> 
 
 
 class BranchProfile:
-    """Pooled branch slopes over travel bins and the regime table fitted to them (data law)."""
+    """Pooled branch slopes over travel bins and the regime table fitted to them (data law).
+
+    Parameters
+    ----------
+    p : numpy.ndarray of float, shape (n,)
+        Play weights; the slope levels are ``P_0 = 0, P_i = p_1 + ... + p_i``.
+    linear_play : bool
+        Play 1 is always on its envelope (``r_1 = 0``).
+
+    Examples
+    --------
+    Two branch pieces of slope 1 then 2 put play 2's breakpoint at travel 0.5:
+
+    >>> prof = BranchProfile(np.array([1.0, 1.0]), False)
+    >>> prof.width = 0.01                  # bin width (input unit), set by the law at first
+    >>> prof.add(0.0, 0.5, 0.5)
+    >>> prof.add(0.5, 1.0, 1.0)
+    >>> prof.fit()
+    >>> prof.edge
+    array([0. , 0.5])
+    """
 
     def __init__(self, p: np.ndarray, linear_play: bool):
         self.levels = np.concatenate([[0.0], np.cumsum(p)])  # P_0 = 0, P_i = p_1 + ... + p_i
@@ -44,7 +86,27 @@ class BranchProfile:
         self.fitted = False
 
     def add(self, x0: float, x1: float, dy: float) -> None:
-        """Spread the branch piece [x0, x1] with output change dy over the bins it covers."""
+        """Spread the branch piece [x0, x1] with output change dy over the bins it covers.
+
+        Bins are merged in pairs (the width doubles) until ``x1`` fits in the 256 bins.
+
+        Parameters
+        ----------
+        x0 : float
+            Travel at the start of the piece (input unit, >= 0).
+        x1 : float
+            Travel at its end (input unit, > x0).
+        dy : float
+            Signed output change ``s (y[k] - y[k-1])`` along the piece (output unit).
+
+        Examples
+        --------
+        >>> prof = BranchProfile(np.array([1.0]), False)
+        >>> prof.width = 0.1
+        >>> prof.add(0.0, 0.2, 0.4)
+        >>> prof.S[:3], prof.C[:3]
+        (array([0.2, 0.2, 0. ]), array([0.1, 0.1, 0. ]))
+        """
         while x1 >= BINS * self.width:  # merge bins in pairs
             self.S[: BINS // 2] = self.S[0::2] + self.S[1::2]
             self.C[: BINS // 2] = self.C[0::2] + self.C[1::2]
@@ -63,7 +125,20 @@ class BranchProfile:
         self.top = max(self.top, b1)
 
     def fit(self) -> None:
-        """Non-decreasing count per bin minimising sum C_b (S_b/C_b - P_i)^2; edges from it."""
+        """Non-decreasing count per bin minimising sum C_b (S_b/C_b - P_i)^2; edges from it.
+
+        An exact dynamic programme over the bins filled so far; sets ``edge[j]``, the travel
+        at which play j + 1 reaches its envelope (-1 when it does not within the profile).
+
+        Examples
+        --------
+        >>> prof = BranchProfile(np.array([1.0, 1.0]), False)
+        >>> prof.width = 0.01
+        >>> prof.add(0.0, 1.0, 1.0)           # slope 1 throughout: play 2 never on
+        >>> prof.fit()
+        >>> prof.edge
+        array([ 0., -1.])
+        """
         if self.top < 0:
             return
         P, n1 = self.levels, self.levels.size
@@ -94,7 +169,70 @@ class BranchProfile:
 def estimate_radii_reference(v, y, weights, *, dt, gains, initial_radii, linear_play=False,
                              threshold=0.0, max_step=None, anneal_time=None, guard=0.0,
                              slope_window=8, slope_tol=0.5, initial_state=0.0, law="data"):
-    """Returns ``(history, yhat, e, e_delta, used, final radii)`` as in the C batch loop."""
+    """Returns ``(history, yhat, e, e_delta, used, final radii)`` as in the C batch loop.
+
+    One Python step per sample (slow); the arguments are those of
+    :class:`pimodel.estimator.RadiusEstimator` with ``v``, ``y`` as in
+    :meth:`pimodel.estimator.RadiusEstimator.run` (no argument checks here).
+
+    Parameters
+    ----------
+    v : array_like of float, shape (N,)
+        Input samples ``v[k]`` (input unit).
+    y : array_like of float, shape (N,)
+        Measured output ``y[k]`` (output unit).
+    weights : array_like of float, shape (n,)
+        Play weights ``p_j > 0``.
+    dt : float
+        Sample time [s].
+    gains : float or array_like of float
+        Adaptation gains (scalar or per play).
+    initial_radii : array_like of float, shape (n,)
+        Start of the estimate (projected onto the ordered set).
+    linear_play : bool, optional
+        Hold ``rhat_1 = 0``.
+    threshold : float, optional
+        Reversal threshold (input unit).
+    max_step : float, optional
+        Per-sample clip of the update (input unit).
+    anneal_time : float, optional
+        Gain annealing time constant [s].
+    guard : float, optional
+        Breakpoint guard band (input unit).
+    slope_window : int, optional
+        Samples of the slope check (``law="paper"``).
+    slope_tol : float, optional
+        Slope check tolerance in units of the smallest weight.
+    initial_state : float, optional
+        Model play state before the first sample.
+    law : {"data", "paper"}, optional
+        The regime law (module docstring of :mod:`pimodel.estimator`).
+
+    Returns
+    -------
+    history : numpy.ndarray, shape (N, n)
+        Estimate used at each step.
+    yhat : numpy.ndarray, shape (N,)
+        Model output.
+    e : numpy.ndarray, shape (N,)
+        ``yhat[k] - y[k]``.
+    e_delta : numpy.ndarray, shape (N,)
+        Modified error (0 where unused).
+    used : numpy.ndarray of bool, shape (N,)
+        True where the sample adapted the radii.
+    radii : numpy.ndarray, shape (n,)
+        Final estimate.
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = np.sin(np.linspace(0, 20, 2000))
+    >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+    >>> out = estimate_radii_reference(v, y, [1.0, 1.0], dt=1e-3, gains=10.0,
+    ...                                initial_radii=[0.0, 0.0])
+    >>> out[-1].round(2)
+    array([0. , 0.3])
+    """
     p = np.asarray(weights, float)
     n = p.size
     g = np.broadcast_to(np.asarray(gains, float), (n,)).copy()

@@ -46,16 +46,23 @@ __all__ = ["OperatorFit", "fit_asymmetric", "fit_creep", "fit_generalized",
 class OperatorFit:
     """Result of an identification.
 
-    Attributes
+    Parameters
     ----------
     model : GeneralizedPI, RateDependentPI or CreepOperator
         The identified operator.
-    rms, max_error : float
-        Residual on the scored samples (output unit).
+    rms : float
+        RMS residual on the scored samples (output unit).
+    max_error : float
+        Largest absolute residual on the scored samples (output unit).
     y_range : float
         Peak-to-peak of the measured output over the scored samples.
     settings : dict
         Fit settings and by-products (grid, rate sensitivity, ...).
+
+    Examples
+    --------
+    >>> OperatorFit(model=None, rms=0.01, max_error=0.03, y_range=2.0).relative_rms
+    0.005
     """
 
     model: object

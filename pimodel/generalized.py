@@ -163,6 +163,14 @@ class GeneralizedPI:
         ------
         ValueError
             Non-finite input, or a sample outside an envelope's domain (named).
+
+        Examples
+        --------
+        >>> from pimodel.envelopes import Envelope
+        >>> op = GeneralizedPI([1.0, 0.5], [0.0, 0.2],
+        ...                    output_envelope=Envelope.poly2(0.0, 1.0, 0.5))
+        >>> op.simulate([0.0, 1.0, 0.5])
+        array([0.     , 2.38   , 1.21125])
         """
         x = as_signal(v, "v")
         z = self.initial_state.copy() if state is None else self._state(state)
@@ -179,11 +187,44 @@ class GeneralizedPI:
         self._z = self._state(value)
 
     def reset(self) -> None:
-        """Return the streaming state to :attr:`initial_state`."""
+        """Return the streaming state to :attr:`initial_state`.
+
+        Examples
+        --------
+        >>> op = GeneralizedPI([1.0, 0.5], [0.0, 0.2])
+        >>> _ = op.step(1.0)
+        >>> op.reset()
+        >>> op.state
+        array([0., 0.])
+        """
         self._z = self.initial_state.copy()
 
     def step(self, v: float) -> float:
-        """Advance one sample with input ``v[k]`` and return ``y[k]``."""
+        """Advance one sample with input ``v[k]`` and return ``y[k]``.
+
+        Parameters
+        ----------
+        v : float
+            Input sample ``v[k]`` (input unit).
+
+        Returns
+        -------
+        float
+            Output ``y[k]`` (output unit), from the updated play states ``z_i[k]``.
+
+        Raises
+        ------
+        ValueError
+            Non-finite input, or a sample outside an envelope's domain.
+
+        Examples
+        --------
+        >>> from pimodel.envelopes import Envelope
+        >>> op = GeneralizedPI([1.0, 0.5], [0.0, 0.2],
+        ...                    output_envelope=Envelope.poly2(0.0, 1.0, 0.5))
+        >>> op.step(1.0), op.state
+        (2.38, array([1. , 0.8]))
+        """
         z = self._z.copy()
         y = self._run(as_signal(v, "v"), z)
         self._z = z
@@ -211,6 +252,15 @@ class GeneralizedPI:
         ------
         ValueError
             When the PI part has no linear play (``r_1 > 0``).
+
+        Examples
+        --------
+        >>> from pimodel.envelopes import Envelope
+        >>> op = GeneralizedPI([1.0, 0.5], [0.0, 0.2],
+        ...                    output_envelope=Envelope.poly2(0.0, 1.0, 0.5))
+        >>> v = np.array([0.0, 1.0, 0.5])
+        >>> bool(np.allclose(op.inverse().simulate(op.simulate(v)), v))
+        True
         """
         inv = self._pi.inverse()
         out = GeneralizedPI(inv.weights, inv.radii,
@@ -221,7 +271,20 @@ class GeneralizedPI:
         return out
 
     def to_dict(self) -> dict:
-        """JSON-ready parameters (weights, radii, initial state, envelopes)."""
+        """JSON-ready parameters (weights, radii, initial state, envelopes).
+
+        Returns
+        -------
+        dict
+            ``type``, ``weights``, ``radii``, ``initial_state``, ``signed_weights``,
+            ``input_envelope`` and ``output_envelope`` (see :func:`pimodel.models.model_to_dict`).
+
+        Examples
+        --------
+        >>> d = GeneralizedPI([1.0], [0.0]).to_dict()
+        >>> d["type"], d["weights"], d["output_envelope"]
+        ('GeneralizedPI', [1.0], {'kind': 'poly2', 'coefficients': [0.0, 1.0, 0.0]})
+        """
         return {"type": "GeneralizedPI", "weights": self.weights.tolist(),
                 "radii": self.radii.tolist(), "initial_state": self.initial_state.tolist(),
                 "signed_weights": self._pi.signed_weights,

@@ -40,7 +40,23 @@ MIN_LOOP_R2 = 0.5               # below: "no hysteresis loop found" warning
 
 def max_passes(n_samples: int) -> int:
     """Largest ``passes`` for a record of ``n_samples``: ``MAX_REPEATED_SAMPLES // n_samples``
-    (the repeated record is held in memory, 16 bytes per sample)."""
+    (the repeated record is held in memory, 16 bytes per sample).
+
+    Parameters
+    ----------
+    n_samples : int
+        Length of the record.
+
+    Returns
+    -------
+    int
+        The bound on :func:`identify`'s ``passes`` (0 when the record alone exceeds it).
+
+    Examples
+    --------
+    >>> max_passes(600), max_passes(1_000_000)
+    (33333, 20)
+    """
     return MAX_REPEATED_SAMPLES // max(int(n_samples), 1)
 
 
@@ -55,7 +71,40 @@ def _warn_if_no_loop(slopes: SlopeIdentification) -> None:
 
 @dataclass
 class Identification:
-    """An identified model ``y = PI[v] + offset`` with its fit errors on the record."""
+    """An identified model ``y = PI[v] + offset`` with its fit errors on the record.
+
+    Parameters
+    ----------
+    operator : PIOperator
+        The identified operator (zero initial play states).
+    offset : float
+        Output offset (output unit), the mean of ``y - PI[v]``.
+    method : {"adaptive", "conventional", "joint"}
+        How it was identified.
+    rms_error : float
+        RMS of ``PI[v] + offset - y`` on the record (output unit).
+    max_error : float
+        Largest absolute error on the record (output unit).
+    output_range : float
+        Peak-to-peak of ``y`` (output unit).
+    excitation : ExcitationReport
+        Whether the record excites every play (:func:`pimodel.excitation.check_excitation`).
+    slopes : SlopeIdentification, optional
+        The loop-slope identification (None for the conventional method).
+    settings : dict, optional
+        Settings used (gains, passes, guard, ...).
+    health : EstimatorHealth, optional
+        Adaptive method: the radius estimate's health.
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = 2 * np.sin(np.linspace(0, 6 * np.pi, 600))     # three periods
+    >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+    >>> ident = identify(v, y, dt=1e-3, n_plays=2, passes=2)
+    >>> ident.method, ident.weights.round(3), ident.radii.round(3)
+    ('adaptive', array([1. , 0.5]), array([0. , 0.4]))
+    """
 
     operator: PIOperator
     offset: float
@@ -70,17 +119,62 @@ class Identification:
 
     @property
     def weights(self) -> np.ndarray:
+        """Weights ``p_i`` of the identified operator."""
         return self.operator.weights
 
     @property
     def radii(self) -> np.ndarray:
+        """Radii ``r_i`` of the identified operator (input unit), non-decreasing."""
         return self.operator.radii
 
     def predict(self, v) -> np.ndarray:
-        """Model output ``PI[v] + offset`` from zero initial state."""
+        """Model output ``PI[v] + offset`` from zero initial state.
+
+        Parameters
+        ----------
+        v : array_like of float, shape (N,)
+            Input samples ``v[k]`` (input unit).
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N,)
+            ``y[k] = PI[v][k] + offset`` (output unit).
+
+        Raises
+        ------
+        ValueError
+            If ``v`` is not a finite 1-D signal.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = 2 * np.sin(np.linspace(0, 6 * np.pi, 600))     # three periods
+        >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+        >>> ident = identify(v, y, dt=1e-3, n_plays=2, passes=2)
+        >>> bool(np.allclose(ident.predict([0.0, 1.0]), [0.0, 1.3]))
+        True
+        """
         return self.operator.simulate(v) + self.offset
 
     def to_json(self) -> dict:
+        """The model, its fit and the reports as a JSON-ready dict.
+
+        Returns
+        -------
+        dict
+            ``method``, ``n_plays``, ``weights``, ``radii``, ``offset``, ``fit`` (errors, also
+            in % of the output range), ``excitation``, ``slopes``, ``settings``, ``health``.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = 2 * np.sin(np.linspace(0, 6 * np.pi, 600))     # three periods
+        >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+        >>> ident = identify(v, y, dt=1e-3, n_plays=2, passes=2)
+        >>> d = ident.to_json()
+        >>> d["n_plays"], d["fit"]["rms_error_percent"] < 1e-3
+        (2, True)
+        """
         return {
             "method": self.method,
             "n_plays": self.operator.n,
@@ -101,6 +195,28 @@ class Identification:
         }
 
     def save_json(self, path) -> Path:
+        """Write :meth:`to_json` to ``path`` (parent directories created).
+
+        Parameters
+        ----------
+        path : str or Path
+            The JSON file (overwritten).
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> from pimodel import PIOperator
+        >>> v = 2 * np.sin(np.linspace(0, 6 * np.pi, 600))     # three periods
+        >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+        >>> ident = identify(v, y, dt=1e-3, n_plays=2, passes=2)
+        >>> ident.save_json(pathlib.Path(tempfile.mkdtemp()) / "model.json").name
+        'model.json'
+        """
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(self.to_json(), indent=2))
@@ -120,18 +236,67 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
              max_segments: int = 8) -> Identification:
     """Identify a PI model from a record ``(v[k], y[k])`` sampled every ``dt`` seconds.
 
-    ``n_plays``: fixed number of plays, an integer from 1 to 64 (adaptive: else chosen by BIC
-    on the slopes; conventional: default 10). ``gains``: estimator gains (default
-    ``20 / sum p_i^2``, a convergence rate of about 20/s whatever the units). ``passes``:
-    repetitions of the record, an integer from 1 to ``max_passes(len(v))`` (2e7 samples in all;
-    default: enough for 200 s of adaptation, at least 3, within that bound). ``guard``:
-    estimator breakpoint guard (default 0.2 % of the input range). The adaptive method reports
-    the health of its radius estimate (``health``, :mod:`pimodel.estimator_health`) and warns
-    when it fails.
+    The adaptive method reports the health of its radius estimate (``health``,
+    :mod:`pimodel.estimator_health`) and warns when it fails. The model is
+    ``y[k] = PI[v][k] + offset`` with zero initial play states.
 
-    Warns (RuntimeWarning) when the record shows no hysteresis loop (slope-fit R^2 < 0.5) and
-    when the joint fit has more plays than the data resolve (they are merged or dropped).
-    Raises ValueError naming the argument on bad input.
+    Parameters
+    ----------
+    v : array_like of float, shape (N,)
+        Input samples (input unit), N >= 10, not constant.
+    y : array_like of float, shape (N,)
+        Measured output (output unit).
+    dt : float
+        Sample time [s].
+    n_plays : int, optional
+        Fixed number of plays, from 1 to 64 (adaptive: else chosen by BIC on the slopes;
+        conventional: default 10).
+    method : {"adaptive", "conventional", "joint"}, optional
+        See the module docstring. Default ``"adaptive"``.
+    gains : float or array_like of float, optional
+        Estimator gains (default ``20 / sum p_i^2``, a convergence rate of about 20/s whatever
+        the units).
+    passes : int, optional
+        Repetitions of the record, from 1 to ``max_passes(len(v))`` (2e7 samples in all;
+        default: enough for 200 s of adaptation, at least 3, within that bound).
+    linear_play : bool, optional
+        Force (True) or forbid (False) a linear play ``r_1 = 0``; default: chosen from the
+        slopes.
+    guard : float, optional
+        Estimator breakpoint guard (input unit; default 0.2 % of the input range).
+    conventional_span : float, optional
+        Conventional method: the span of the preset radii (input unit; default from the
+        record).
+    max_segments : int, optional
+        Most loop-branch segments tried by the slope fit (1 to 65). Default 8.
+
+    Returns
+    -------
+    Identification
+        The model, its errors on the record and the reports.
+
+    Raises
+    ------
+    ValueError
+        Bad input (unequal lengths, a constant input, an unknown method, ``n_plays`` or
+        ``passes`` out of range, ``dt <= 0``); the message names the argument.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the record shows no hysteresis loop (slope-fit R^2 < 0.5) and when the joint fit
+        has more plays than the data resolve (they are merged or dropped).
+    UserWarning
+        When the adaptive radius estimate fails its health check.
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = 2 * np.sin(np.linspace(0, 6 * np.pi, 600))     # three periods
+    >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+    >>> ident = identify(v, y, dt=1e-3, n_plays=2, passes=2)
+    >>> ident.weights.round(3), ident.radii.round(3), ident.health.ok
+    (array([1. , 0.5]), array([0. , 0.4]), True)
     """
     v = as_signal(v, "v", min_length=10)
     y = as_signal(y, "y", min_length=10)

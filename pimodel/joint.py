@@ -54,11 +54,38 @@ FIRST_FIT_BRANCHES = 50
 class JointEstimate:
     """Result of :class:`JointEstimator` runs: the final estimate and its update history.
 
-    ``update_index[u]`` is the sample at which update u was made (the estimate
-    ``weight_history[u]``, ``radius_history[u]`` is in force from the next sample on).
-    ``fit_rms`` is the RMS of the samples of the branches added since the previous update about
-    the estimate in force when each ended, each branch with its own offset (output unit): a
-    prediction check, and an estimate of the output noise once the model fits.
+    Parameters
+    ----------
+    weights : numpy.ndarray of float, shape (n,)
+        The estimate of ``p_j`` in force after the last sample.
+    radii : numpy.ndarray of float, shape (n,)
+        The estimate of ``r_j`` (input unit), non-decreasing.
+    update_index : numpy.ndarray of int, shape (U,)
+        ``update_index[u]`` is the sample at which update u was made (the estimate
+        ``weight_history[u]``, ``radius_history[u]`` is in force from the next sample on).
+    weight_history : numpy.ndarray of float, shape (U, n)
+        Weights after each update.
+    radius_history : numpy.ndarray of float, shape (U, n)
+        Radii after each update.
+    fit_rms : float
+        RMS of the samples of the branches added since the previous update about the estimate
+        in force when each ended, each branch with its own offset (output unit): a prediction
+        check, and an estimate of the output noise once the model fits (NaN before).
+    branches_used : int
+        Branches added to the statistics.
+    samples_used : int
+        Samples of those branches.
+    samples_outside : int
+        Usable samples beyond ``travel_range`` (not used).
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = 2 * np.sin(np.linspace(0, 12 * np.pi, 1200))    # six periods
+    >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+    >>> res = estimate_jointly(v, y, 2, linear_play=True, refit_every=2)
+    >>> res.weights.round(3), res.radii.round(3), res.weight_history.shape[1]
+    (array([1. , 0.5]), array([0. , 0.4]), 2)
     """
 
     weights: np.ndarray
@@ -74,20 +101,72 @@ class JointEstimate:
 
 def branch_shape(x: np.ndarray, weights: np.ndarray, radii: np.ndarray) -> np.ndarray:
     """``g(x) = sum_j p_j max(0, x - 2 r_j)``: the output change along a branch after a travel
-    ``x`` (input unit) from a reversal, in the output unit."""
+    ``x`` (input unit) from a reversal, in the output unit.
+
+    Parameters
+    ----------
+    x : numpy.ndarray of float, shape (N,)
+        Travels from the reversal (input unit, >= 0).
+    weights : numpy.ndarray of float, shape (n,)
+        Play weights ``p_j``.
+    radii : numpy.ndarray of float, shape (n,)
+        Play radii ``r_j`` (input unit).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N,)
+        ``g(x)`` (output unit).
+
+    Examples
+    --------
+    >>> branch_shape(np.array([0.0, 0.5, 1.0]), np.array([1.0, 0.5]), np.array([0.0, 0.4]))
+    array([0. , 0.5, 1.1])
+    """
     return np.maximum(0.0, x[:, None] - 2.0 * radii[None, :]) @ weights
 
 
 class JointEstimator:
     """Streaming joint estimator of weights and radii (see the module docstring for the law).
 
-    ``n_plays``: number of plays (e.g. from :func:`pimodel.identify_slopes`); ``linear_play``:
-    whether ``r_1 = 0`` (the branch starts with slope ``p_1``); ``initial_weights``,
-    ``initial_radii``: the estimate reported before the first update (the law itself needs no
-    start); ``travel_range``: the x range of the bins (input unit, default: the travel of the
-    first usable branch; samples beyond it are counted in ``samples_outside``); ``bins``: number
-    of bins; ``refit_every``: branches between updates; ``forgetting``: per-branch factor in
-    (0, 1]; ``threshold``: reversal threshold (input unit).
+    Parameters
+    ----------
+    n_plays : int
+        Number of plays, 1 to 64 (e.g. from :func:`pimodel.identify_slopes`).
+    linear_play : bool, optional
+        Whether ``r_1 = 0`` (the branch starts with slope ``p_1``).
+    initial_weights : array_like of float, shape (n,), optional
+        The weights reported before the first update (the law itself needs no start);
+        default all 1.
+    initial_radii : array_like of float, shape (n,), optional
+        The radii reported before the first update; default ``0, 1, ..., n - 1``.
+    travel_range : float, optional
+        The x range of the bins (input unit); default the travel of the first usable branch.
+        Samples beyond it are counted in ``samples_outside``.
+    bins : int, optional
+        Number of bins (at least ``4 (n + 1)``). Default 2048.
+    refit_every : int, optional
+        Branches between updates (>= 1). Default 10.
+    forgetting : float, optional
+        Per-branch factor on the older statistics, in (0, 1]. Default 1 (no forgetting).
+    threshold : float, optional
+        Reversal threshold (input unit). Default 0.
+
+    Raises
+    ------
+    ValueError
+        A bad ``n_plays``, ``bins``, ``refit_every``, ``forgetting``, ``travel_range``, or a
+        negative or wrong-length start (the message names the argument).
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = 2 * np.sin(np.linspace(0, 12 * np.pi, 1200))    # six periods
+    >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+    >>> est = JointEstimator(2, linear_play=True, refit_every=2)
+    >>> _ = est.run(v, y)
+    >>> res = est.finish()
+    >>> res.weights.round(3), res.radii.round(3)
+    (array([1. , 0.5]), array([0. , 0.4]))
     """
 
     def __init__(self, n_plays: int, *, linear_play: bool = False, initial_weights=None,
@@ -136,12 +215,64 @@ class JointEstimator:
 
     # -- streaming -------------------------------------------------------------------------
     def step(self, v: float, y: float) -> tuple[np.ndarray, np.ndarray]:
-        """Process sample k; returns the estimate ``(weights, radii)`` in force after it."""
+        """Process sample k; returns the estimate ``(weights, radii)`` in force after it.
+
+        Parameters
+        ----------
+        v : float
+            Input sample ``v[k]`` (input unit).
+        y : float
+            Measured output ``y[k]`` (output unit).
+
+        Returns
+        -------
+        weights : numpy.ndarray of float, shape (n,)
+            Weights in force after sample k (copies).
+        radii : numpy.ndarray of float, shape (n,)
+            Radii in force after sample k (input unit).
+
+        Raises
+        ------
+        ValueError
+            If ``v`` or ``y`` is not finite.
+
+        Examples
+        --------
+        >>> JointEstimator(2, linear_play=True).step(0.0, 0.0)   # the start, before any update
+        (array([1., 1.]), array([0., 1.]))
+        """
         self._consume(as_signal([v], "v", min_length=1), as_signal([y], "y", min_length=1))
         return self.weights.copy(), self.radii.copy()
 
     def run(self, v, y) -> JointEstimate:
-        """Process the next samples (arrays, any length >= 1); returns everything so far."""
+        """Process the next samples (arrays, any length >= 1); returns everything so far.
+
+        Parameters
+        ----------
+        v : array_like of float, shape (N,)
+            Next input samples (input unit).
+        y : array_like of float, shape (N,)
+            Next measured outputs (output unit).
+
+        Returns
+        -------
+        JointEstimate
+            As :meth:`result` (the branch still running is not yet used).
+
+        Raises
+        ------
+        ValueError
+            Non-finite samples or unequal lengths.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = 2 * np.sin(np.linspace(0, 12 * np.pi, 1200))    # six periods
+        >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+        >>> est = JointEstimator(2, linear_play=True, refit_every=2)
+        >>> est.run(v, y).radii.round(3)
+        array([0. , 0.4])
+        """
         x = as_signal(v, "v", min_length=1)
         m = as_signal(y, "y", min_length=1)
         if x.size != m.size:
@@ -151,7 +282,29 @@ class JointEstimator:
 
     def finish(self) -> JointEstimate:
         """End of record: update with the branches completed since the last update (the branch
-        still running is left out: its end, hence its travel, is unknown)."""
+        still running is left out: its end, hence its travel, is unknown).
+
+        Returns
+        -------
+        JointEstimate
+            The final estimate and its history.
+
+        Warns
+        -----
+        RuntimeWarning
+            If the record held no usable branch (the estimate is then the start).
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = 2 * np.sin(np.linspace(0, 12 * np.pi, 1200))    # six periods
+        >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+        >>> est = JointEstimator(2, linear_play=True, refit_every=2)
+        >>> _ = est.run(v, y)
+        >>> res = est.finish()
+        >>> res.update_index.size >= 2, bool(res.fit_rms < 1e-6)
+        (True, True)
+        """
         if self._pending or self._since_update:
             self._update(self._k - 1)
         if not self._updates:
@@ -254,13 +407,46 @@ class JointEstimator:
 
     def binned(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The fit's data: mean travel ``x`` (input unit), mean centred signed output ``Y``
-        (output unit) and sample count of each occupied bin."""
+        (output unit) and sample count of each occupied bin.
+
+        Returns
+        -------
+        x : numpy.ndarray of float, shape (B,)
+            Mean travel per occupied bin (input unit).
+        Y : numpy.ndarray of float, shape (B,)
+            Mean centred signed output per bin (output unit).
+        count : numpy.ndarray of float, shape (B,)
+            (Forgetting-weighted) sample count per bin.
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = 2 * np.sin(np.linspace(0, 12 * np.pi, 1200))    # six periods
+        >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+        >>> est = JointEstimator(2, linear_play=True, refit_every=2)
+        >>> res = stream_jointly(est, [(v, y)])
+        >>> x, Y, count = est.binned()
+        >>> bool(np.allclose(Y, branch_shape(x, res.weights, res.radii), atol=1e-4))
+        True
+        """
         cnt, sx, sy = self._stats
         ok = cnt > 0
         return sx[ok] / cnt[ok], sy[ok] / cnt[ok], cnt[ok]
 
     def result(self) -> JointEstimate:
-        """Everything so far as a :class:`JointEstimate`."""
+        """Everything so far as a :class:`JointEstimate`.
+
+        Returns
+        -------
+        JointEstimate
+            The estimate in force, the update history and the usage counts.
+
+        Examples
+        --------
+        >>> res = JointEstimator(2).result()      # no sample yet: the start, no update
+        >>> res.weights, res.update_index.size
+        (array([1., 1.]), 0)
+        """
         idx = np.array([u[0] for u in self._updates], dtype=np.int64)
         n = self.n
         W = np.array([u[1] for u in self._updates]).reshape(-1, n)
@@ -271,7 +457,38 @@ class JointEstimator:
 
 def estimate_jointly(v, y, n_plays: int, **options) -> JointEstimate:
     """Joint weights and radii from a record ``(v[k], y[k])`` (see :class:`JointEstimator` for
-    the options)."""
+    the options).
+
+    Parameters
+    ----------
+    v : array_like of float, shape (N,)
+        Input samples (input unit).
+    y : array_like of float, shape (N,)
+        Measured output (output unit).
+    n_plays : int
+        Number of plays, 1 to 64.
+    **options
+        Keywords of :class:`JointEstimator` (``linear_play``, ``refit_every``, ...).
+
+    Returns
+    -------
+    JointEstimate
+        After :meth:`JointEstimator.finish`.
+
+    Raises
+    ------
+    ValueError
+        Bad samples or options (named).
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = 2 * np.sin(np.linspace(0, 12 * np.pi, 1200))    # six periods
+    >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+    >>> res = estimate_jointly(v, y, 2, linear_play=True, refit_every=2)
+    >>> res.weights.round(3), res.radii.round(3)
+    (array([1. , 0.5]), array([0. , 0.4]))
+    """
     est = JointEstimator(n_plays, **options)
     est.run(v, y)
     return est.finish()
@@ -279,7 +496,36 @@ def estimate_jointly(v, y, n_plays: int, **options) -> JointEstimate:
 
 def stream_jointly(estimator: JointEstimator, chunks: Iterable[tuple]) -> JointEstimate:
     """Run ``estimator`` over a record given as ``(v, y)`` chunks (bounded memory), then
-    :meth:`JointEstimator.finish`."""
+    :meth:`JointEstimator.finish`.
+
+    The result does not depend on how the record is cut into chunks.
+
+    Parameters
+    ----------
+    estimator : JointEstimator
+        Runs from its current state.
+    chunks : iterable of tuple of array_like
+        ``(v, y)`` pieces of the record, in order.
+
+    Returns
+    -------
+    JointEstimate
+        After :meth:`JointEstimator.finish`.
+
+    Raises
+    ------
+    ValueError
+        Bad samples in a chunk.
+
+    Examples
+    --------
+    >>> from pimodel import PIOperator
+    >>> v = 2 * np.sin(np.linspace(0, 12 * np.pi, 1200))    # six periods
+    >>> y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+    >>> est = JointEstimator(2, linear_play=True, refit_every=2)
+    >>> stream_jointly(est, [(v[:600], y[:600]), (v[600:], y[600:])]).radii.round(3)
+    array([0. , 0.4])
+    """
     for v, y in chunks:
         estimator.run(v, y)
     return estimator.finish()

@@ -80,19 +80,35 @@ class PIOperator:
 
     Parameters
     ----------
-    weights, radii:
-        ``p_i`` and ``r_i`` (same length n >= 1). Radii must be >= 0; they are **sorted
-        ascending together with their weights** (and with a per-play initial state) when given
-        unsorted, so ``op.radii`` is always non-decreasing.
-    initial_state:
+    weights : array_like of float, shape (n,)
+        Weights ``p_i`` (output per input unit), n >= 1.
+    radii : array_like of float, shape (n,)
+        Radii ``r_i`` (input units), each >= 0. They are **sorted ascending together with their
+        weights** (and with a per-play initial state) when given unsorted, so ``op.radii`` is
+        always non-decreasing.
+    initial_state : float or array_like of float, optional
         The plays' state before the first sample, ``z_i[-1]``: a scalar (the paper's initial
         condition x, same for all plays) or one value per play. Default 0.
-    signed_weights:
+    signed_weights : bool, optional
         Allow negative weights as long as every partial sum ``p_1 + ... + p_i`` is positive
         (the class of operators the exact inverse produces). Default False: all ``p_i > 0``.
 
+    Raises
+    ------
+    ValueError
+        If the lengths differ, a radius is negative, a weight (or, with ``signed_weights``, a
+        partial sum) is not positive, or ``initial_state`` has the wrong length.
+
+    Notes
+    -----
     :meth:`simulate` is pure (starts from ``initial_state`` each call); :meth:`step` streams,
     reading and updating :attr:`state`.
+
+    Examples
+    --------
+    >>> op = PIOperator([1.0, 0.5], [0.0, 0.3])
+    >>> op.simulate([0.0, 0.5, 1.0, 0.6])
+    array([0.  , 0.6 , 1.35, 0.95])
     """
 
     def __init__(self, weights, radii, *, initial_state=0.0, signed_weights: bool = False):
@@ -139,7 +155,36 @@ class PIOperator:
         """Output ``y[k]`` for the input samples ``v[k]``, k = 0..N-1.
 
         Starts from ``state`` (default :attr:`initial_state`) and leaves the streaming state
-        untouched. With ``return_state=True`` returns ``(y, z_final)``.
+        untouched.
+
+        Parameters
+        ----------
+        v : array_like of float, shape (N,)
+            Input samples ``v[0..N-1]`` (input units), finite.
+        state : float or array_like of float, optional
+            Play states before ``v[0]``, ``z_i[-1]``; default :attr:`initial_state`.
+        return_state : bool, optional
+            Also return the play states after the last sample.
+
+        Returns
+        -------
+        y : numpy.ndarray of float, shape (N,)
+            Output ``y[k]`` (output units); ``y[k]`` depends on ``v[0..k]``.
+        z_final : numpy.ndarray of float, shape (n,)
+            Play states ``z_i[N-1]``; only with ``return_state=True``.
+
+        Raises
+        ------
+        ValueError
+            If ``v`` is not a finite 1-D signal, ``state`` has the wrong length, or the output
+            overflows.
+
+        Examples
+        --------
+        >>> op = PIOperator([1.0, 0.5], [0.0, 0.3])
+        >>> y, z = op.simulate([0.0, 1.0, 0.6], return_state=True)
+        >>> y, z
+        (array([0.  , 1.35, 0.95]), array([0.6, 0.7]))
         """
         x = as_signal(v, "v")
         z = self._z0.copy() if state is None else _initial_state(state, self.n)
@@ -148,7 +193,32 @@ class PIOperator:
         return (y, z) if return_state else y
 
     def play_outputs(self, v, *, state=None) -> np.ndarray:
-        """Play outputs ``z[k, i] = Gamma_{r_i}[v][k]``, shape (N, n)."""
+        """Play outputs ``z[k, i] = Gamma_{r_i}[v][k]``, shape (N, n).
+
+        Parameters
+        ----------
+        v : array_like of float, shape (N,)
+            Input samples (input units).
+        state : float or array_like of float, optional
+            Play states before ``v[0]``; default :attr:`initial_state`.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (N, n)
+            Row k holds the play states ``z_i[k]`` after sample k (input units).
+
+        Raises
+        ------
+        ValueError
+            If ``v`` is not a finite 1-D signal or ``state`` has the wrong length.
+
+        Examples
+        --------
+        >>> PIOperator([1.0, 0.5], [0.0, 0.3]).play_outputs([0.0, 1.0, 0.6])
+        array([[0. , 0. ],
+               [1. , 0.7],
+               [0.6, 0.7]])
+        """
         x = as_signal(v, "v")
         z = self._z0.copy() if state is None else _initial_state(state, self.n)
         _, zhist = _native.pi_run(self._p, self._r, z, x, with_plays=True)
@@ -165,11 +235,42 @@ class PIOperator:
         self._z = _initial_state(value, self.n)
 
     def reset(self) -> None:
-        """Return the streaming state to :attr:`initial_state`."""
+        """Return the streaming state to :attr:`initial_state`.
+
+        Examples
+        --------
+        >>> op = PIOperator([1.0], [0.2])
+        >>> _ = op.step(1.0)
+        >>> op.reset()
+        >>> op.state
+        array([0.])
+        """
         self._z = self._z0.copy()
 
     def step(self, v: float) -> float:
-        """Advance one sample: update the state with input ``v[k]`` and return ``y[k]``."""
+        """Advance one sample: update the state with input ``v[k]`` and return ``y[k]``.
+
+        Parameters
+        ----------
+        v : float
+            Input sample ``v[k]`` (input units), finite.
+
+        Returns
+        -------
+        float
+            Output ``y[k]`` (output units), computed from the updated states ``z_i[k]``.
+
+        Raises
+        ------
+        ValueError
+            If ``v`` is not finite or the output overflows.
+
+        Examples
+        --------
+        >>> op = PIOperator([1.0, 0.5], [0.0, 0.3])
+        >>> op.step(0.5), op.step(1.0), op.state
+        (0.6, 1.35, array([1. , 0.7]))
+        """
         vk = float(v)
         if not np.isfinite(vk):
             raise ValueError(f"v: input sample is {v!r}; expected a finite number")
@@ -178,7 +279,28 @@ class PIOperator:
         return y
 
     def output(self, state=None) -> float:
-        """Output ``sum_i p_i z_i`` for a state (default: the current streaming state)."""
+        """Output ``sum_i p_i z_i`` for a state (default: the current streaming state).
+
+        Parameters
+        ----------
+        state : float or array_like of float, optional
+            Play states ``z_i``; default the current streaming :attr:`state`.
+
+        Returns
+        -------
+        float
+            ``sum_i p_i z_i`` (output units).
+
+        Raises
+        ------
+        ValueError
+            If ``state`` has the wrong length.
+
+        Examples
+        --------
+        >>> PIOperator([1.0, 0.5], [0.0, 0.3]).output([1.0, 0.7])
+        1.35
+        """
         z = self._z if state is None else _initial_state(state, self.n)
         return float(self._p @ z)
 
@@ -188,6 +310,18 @@ class PIOperator:
 
         With ``r_1 > 0``: the n + 1 values ``0, P_1, ..., P_n``; with ``r_1 = 0`` the n values
         ``P_1, ..., P_n``, where ``P_i = p_1 + ... + p_i``. Equal radii merge their slopes.
+
+        Returns
+        -------
+        numpy.ndarray of float
+            The branch slopes (output per input unit), ascending.
+
+        Examples
+        --------
+        >>> PIOperator([1.0, 0.5], [0.0, 0.3]).slopes()
+        array([1. , 1.5])
+        >>> PIOperator([1.0, 0.5], [0.1, 0.3]).slopes()
+        array([0. , 1. , 1.5])
         """
         P = np.cumsum(self._p)
         keep = np.append(self._r[1:] > self._r[:-1], True)  # last play of each radius group
@@ -195,7 +329,18 @@ class PIOperator:
         return s if self._r[0] == 0 else np.concatenate(([0.0], s))
 
     def loop_width(self) -> float:
-        """Lemma 2's loop width ``rho = 2 sum p_i r_i / sum p_i`` (input units)."""
+        """Lemma 2's loop width ``rho = 2 sum p_i r_i / sum p_i`` (input units).
+
+        Returns
+        -------
+        float
+            The loop width ``rho`` (input units).
+
+        Examples
+        --------
+        >>> round(PIOperator([1.0, 0.5], [0.0, 0.3]).loop_width(), 12)
+        0.2
+        """
         return float(2.0 * (self._p @ self._r) / self._p.sum())
 
     @property
@@ -209,6 +354,28 @@ class PIOperator:
         Requires ``r_1 = 0`` (a linear play) with ``p_1 > 0``; raises ValueError otherwise.
         The inverse's initial state is made consistent with this operator's initial state, so
         ``op.inverse().simulate(op.simulate(v))`` returns ``v``; its weights are signed.
+
+        Returns
+        -------
+        PIOperator
+            The inverse operator (signed weights, output units in, input units out).
+
+        Raises
+        ------
+        ValueError
+            If ``r_1 > 0``, a partial sum of weights is not positive, or the branch slopes range
+            over more than ``INVERSE_CONDITION_ERROR`` (a RuntimeWarning above
+            ``INVERSE_CONDITION_WARN``).
+
+        Examples
+        --------
+        >>> op = PIOperator([1.0, 0.5], [0.0, 0.3])
+        >>> inv = op.inverse()
+        >>> inv.weights.round(6), inv.radii
+        (array([ 1.      , -0.333333]), array([0. , 0.3]))
+        >>> v = np.array([0.0, 0.5, 1.0, 0.6])
+        >>> np.allclose(inv.simulate(op.simulate(v)), v)
+        True
         """
         if self._r[0] != 0.0:
             raise ValueError(
@@ -261,7 +428,29 @@ class PIOperator:
         return PIDescribingFunction(self)
 
     def inverse_state(self, state) -> np.ndarray:
-        """Inverse-operator state consistent with forward play states ``state``."""
+        """Inverse-operator state consistent with forward play states ``state``.
+
+        Parameters
+        ----------
+        state : float or array_like of float
+            Forward play states ``z_i`` (a scalar or n values, input units).
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (n,)
+            States of :meth:`inverse`'s plays (output units) such that the inverse continues
+            exactly from where this operator is.
+
+        Raises
+        ------
+        ValueError
+            If the operator is not invertible or ``state`` has the wrong length.
+
+        Examples
+        --------
+        >>> PIOperator([1.0, 0.5], [0.0, 0.3]).inverse_state(0.0)
+        array([0., 0.])
+        """
         z = _initial_state(state, self.n)
         res = _native.pi_inverse(self._p, self._r, z)
         if res is None:
@@ -274,6 +463,21 @@ class TimeDependentPI:
     """PI operator with radii given per sample (paper eq. 7), used by the radius estimator.
 
     ``z_i[k] = max(v[k] - R[k, i], min(v[k] + R[k, i], z_i[k-1]))``, ``y[k] = sum_i p_i z_i[k]``.
+
+    Parameters
+    ----------
+    weights : array_like of float, shape (n,)
+        Weights ``p_i`` (output per input unit).
+
+    Raises
+    ------
+    ValueError
+        If ``weights`` is not a finite non-empty vector.
+
+    Examples
+    --------
+    >>> TimeDependentPI([1.0]).simulate([0.0, 1.0, 1.0], [[0.0], [0.5], [0.2]])
+    array([0. , 0.5, 0.8])
     """
 
     weights: np.ndarray
@@ -283,7 +487,40 @@ class TimeDependentPI:
         object.__setattr__(self, "weights", p)
 
     def simulate(self, v, radii_per_sample, *, initial_state=0.0, return_plays: bool = False):
-        """Output for inputs ``v`` (N) and radii ``radii_per_sample`` (N, n), each >= 0."""
+        """Output for inputs ``v`` (N) and radii ``radii_per_sample`` (N, n), each >= 0.
+
+        Parameters
+        ----------
+        v : array_like of float, shape (N,)
+            Input samples ``v[k]`` (input units).
+        radii_per_sample : array_like of float, shape (N, n)
+            Radius ``R[k, i]`` of play i at sample k (input units), finite and >= 0.
+        initial_state : float or array_like of float, optional
+            Play states before the first sample, ``z_i[-1]``. Default 0.
+        return_plays : bool, optional
+            Also return the play states ``z_i[k]``.
+
+        Returns
+        -------
+        y : numpy.ndarray of float, shape (N,)
+            Output ``y[k] = sum_i p_i z_i[k]`` (output units).
+        z : numpy.ndarray of float, shape (N, n)
+            Play states per sample; only with ``return_plays=True``.
+
+        Raises
+        ------
+        ValueError
+            If ``radii_per_sample`` has the wrong shape or a negative/non-finite radius, or ``v``
+            is not a finite 1-D signal.
+
+        Examples
+        --------
+        >>> y, z = TimeDependentPI([1.0, 0.5]).simulate(
+        ...     [0.0, 1.0], [[0.0, 0.0], [0.0, 0.4]], return_plays=True)
+        >>> y, z
+        (array([0. , 1.3]), array([[0. , 0. ],
+               [1. , 0.6]]))
+        """
         x = as_signal(v, "v")
         n = self.weights.size
         R = np.ascontiguousarray(np.asarray(radii_per_sample, dtype=float))

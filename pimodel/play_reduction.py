@@ -29,9 +29,22 @@ REMOVED_PARAMETERS = 2  # a merge or a drop removes one weight and one radius
 class PlayReduction:
     """Result of :func:`reduce_plays`: the resolved plays and what was merged or dropped.
 
-    ``weights``, ``radii``: the plays kept (radii ascending, input unit). ``merged``: radius
-    pairs ``(r_a, r_b)`` merged into one play; ``dropped``: ``(radius, weight)`` of the plays
-    removed.
+    Parameters
+    ----------
+    weights : numpy.ndarray of float
+        Weights of the plays kept (output per input unit).
+    radii : numpy.ndarray of float
+        Radii of the plays kept, ascending (input unit).
+    merged : list of tuple of float
+        Radius pairs ``(r_a, r_b)`` merged into one play.
+    dropped : list of tuple of float
+        ``(radius, weight)`` of the plays removed.
+
+    Examples
+    --------
+    >>> red = PlayReduction(np.array([1.0]), np.array([0.5]), merged=[(0.499, 0.501)])
+    >>> red.changed
+    True
     """
 
     weights: np.ndarray
@@ -44,7 +57,18 @@ class PlayReduction:
         return bool(self.merged or self.dropped)
 
     def describe(self) -> str:
-        """One sentence listing the merges and drops (empty when nothing changed)."""
+        """One sentence listing the merges and drops (empty when nothing changed).
+
+        Returns
+        -------
+        str
+            The merges and drops, separated by ``"; "``.
+
+        Examples
+        --------
+        >>> PlayReduction(np.array([1.0]), np.array([0.5]), dropped=[(2.0, 0.01)]).describe()
+        'play at radius 2 with weight 0.01 dropped (no resolved slope change there)'
+        """
         parts = [f"plays at radii {a:.4g} and {b:.4g} merged (not resolved apart by the data)"
                  for a, b in self.merged]
         parts += [f"play at radius {r:.4g} with weight {w:.3g} dropped (no resolved slope "

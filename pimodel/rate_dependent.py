@@ -138,7 +138,24 @@ class RateDependentPI:
         return (1.0 - self.rate_decay) * self.rate_gain * ratio / self.dt
 
     def radii_at_rate(self, rate: float) -> np.ndarray:
-        """Radii ``alpha_i (1 + beta |rate|)`` at an input rate [input unit / s]."""
+        """Radii ``alpha_i (1 + beta |rate|)`` at an input rate [input unit / s].
+
+        Parameters
+        ----------
+        rate : float
+            Input rate [input unit / s]; its sign does not matter.
+
+        Returns
+        -------
+        numpy.ndarray of float, shape (n,)
+            The radii (input unit).
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> op.radii_at_rate(100.0)
+        array([0. , 0.4])
+        """
         return self.base_radii * (1.0 + self.rate_gain * abs(float(rate)))
 
     def __repr__(self) -> str:
@@ -165,7 +182,16 @@ class RateDependentPI:
         self._s = self._full_state(value)
 
     def reset(self) -> None:
-        """Return the streaming state to :attr:`initial_state`."""
+        """Return the streaming state to :attr:`initial_state`.
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> _ = op.step(1.0)
+        >>> op.reset()
+        >>> op.state
+        array([0., 0., 0., 0.])
+        """
         self._s = self.initial_state
 
     # -- simulation ---------------------------------------------------------------------
@@ -191,7 +217,18 @@ class RateDependentPI:
         Returns
         -------
         numpy.ndarray or tuple
-            ``y``, or ``(y, final_state)``.
+            ``y`` (output unit; ``y[k]`` depends on ``v[0..k]``), or ``(y, final_state)``.
+
+        Raises
+        ------
+        ValueError
+            Non-finite input, or a ``state`` of the wrong length.
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> op.simulate([0.0, 1.0, 0.5])
+        array([0. , 1.4, 0.9])
         """
         x = as_signal(v, "v")
         s = self.initial_state if state is None else self._full_state(state)
@@ -199,11 +236,46 @@ class RateDependentPI:
         return (y, s) if return_state else y
 
     def step(self, v: float) -> float:
-        """Advance one sample with ``v[k]`` and return ``y[k]``."""
+        """Advance one sample with ``v[k]`` and return ``y[k]``.
+
+        Parameters
+        ----------
+        v : float
+            Input sample ``v[k]`` (input unit).
+
+        Returns
+        -------
+        float
+            Output ``y[k]`` (output unit); the state (plays, ``v[k]``, rate) advances.
+
+        Raises
+        ------
+        ValueError
+            If ``v`` is not finite.
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> op.step(1e-3), op.state
+        (0.001, array([0.001, 0.   , 0.001, 1.   ]))
+        """
         return float(self._run(as_signal(v, "v"), self._s)[0])
 
     def to_dict(self) -> dict:
-        """JSON-ready parameters."""
+        """JSON-ready parameters.
+
+        Returns
+        -------
+        dict
+            ``type``, ``weights``, ``base_radii``, ``rate_gain``, ``dt``,
+            ``rate_time_constant``, ``initial_state`` and ``initial_input``.
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> op.to_dict()["rate_gain"]
+        0.01
+        """
         return {"type": "RateDependentPI", "weights": self.weights.tolist(),
                 "base_radii": self.base_radii.tolist(), "rate_gain": self.rate_gain,
                 "dt": self.dt, "rate_time_constant": self.rate_time_constant,
@@ -222,6 +294,13 @@ class RateDependentPI:
         ------
         ValueError
             When ``alpha_1 > 0`` (no linear play: the step map has flat stretches).
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> v = np.array([0.0, 1.0, 0.5])
+        >>> bool(np.allclose(op.inverse().simulate(op.simulate(v)), v))
+        True
         """
         if self.base_radii[0] != 0.0:
             raise ValueError("RateDependentPI.inverse: not invertible, the smallest base radius "
@@ -264,7 +343,17 @@ class RateDependentPIInverse:
         self._s = self.forward._full_state(value)
 
     def reset(self) -> None:
-        """Return to the forward operator's initial state."""
+        """Return to the forward operator's initial state.
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> inv = op.inverse()
+        >>> _ = inv.step(1.5)
+        >>> inv.reset()
+        >>> inv.state
+        array([0., 0., 0., 0.])
+        """
         self._s = self.forward.initial_state
 
     def _run(self, yd: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -290,7 +379,18 @@ class RateDependentPIInverse:
         Returns
         -------
         numpy.ndarray or tuple
-            ``v``, or ``(v, final_state)``.
+            ``v`` (input unit), or ``(v, final_state)``.
+
+        Raises
+        ------
+        ValueError
+            Non-finite ``y_d``, or a ``state`` of the wrong length.
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> op.inverse().simulate([0.0, 1.5])
+        array([0.        , 1.06666667])
         """
         x = as_signal(y_d, "y_d")
         s = self.forward.initial_state if state is None else self.forward._full_state(state)
@@ -298,5 +398,27 @@ class RateDependentPIInverse:
         return (v, s) if return_state else v
 
     def step(self, y_d: float) -> float:
-        """Advance one sample with ``y_d[k]`` and return ``v[k]``."""
+        """Advance one sample with ``y_d[k]`` and return ``v[k]``.
+
+        Parameters
+        ----------
+        y_d : float
+            Desired output ``y_d[k]`` (output unit).
+
+        Returns
+        -------
+        float
+            Input ``v[k]`` (input unit) with forward output ``y[k] = y_d[k]``.
+
+        Raises
+        ------
+        ValueError
+            If ``y_d`` is not finite.
+
+        Examples
+        --------
+        >>> op = RateDependentPI([1.0, 0.5], [0.0, 0.2], rate_gain=0.01, dt=1e-3)
+        >>> round(op.inverse().step(1.5), 12)
+        1.066666666667
+        """
         return float(self._run(as_signal(y_d, "y_d"), self._s)[0])

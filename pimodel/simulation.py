@@ -20,8 +20,22 @@ from .blocks import initial_state as _initial_state
 class Signals:
     """Time ``t`` [s] and named signal arrays: ``res["y"]``, ``res.names``.
 
-    ``aliases`` maps deprecated signal names (before 1-based state labels) to current ones;
-    looking one up works with a DeprecationWarning.
+    Parameters
+    ----------
+    t : numpy.ndarray of float, shape (N,)
+        Sample times [s].
+    signals : dict of str to numpy.ndarray
+        Signal name -> samples (one per time); ``res[name]`` looks one up (KeyError listing the
+        names when unknown).
+    aliases : dict of str to str, optional
+        Deprecated signal names (before 1-based state labels) -> current ones; looking one up
+        works with a DeprecationWarning.
+
+    Examples
+    --------
+    >>> res = Signals(np.arange(2) * 1e-3, {"y": np.array([0.0, 0.5])})
+    >>> res["y"], res.names
+    (array([0. , 0.5]), ['y'])
     """
 
     t: np.ndarray

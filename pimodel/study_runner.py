@@ -35,13 +35,47 @@ STUDIES_DIR = Path(__file__).resolve().parent.parent / "studies"
 
 @dataclass
 class Table:
-    """A results table: ``columns`` names and ``rows`` of values (numbers or text)."""
+    """A results table: ``columns`` names and ``rows`` of values (numbers or text).
+
+    Parameters
+    ----------
+    title : str
+        Caption (bold in Markdown).
+    columns : list of str
+        Column names.
+    rows : list of list
+        One list per row, one value (number or text) per column.
+
+    Examples
+    --------
+    >>> table = Table("Errors", ["model", "rms"], [["a", 0.123456], ["b", 2.0]])
+    >>> table.to_markdown(3).splitlines()[2:]
+    ['| model | rms |', '|---|---|', '| a | 0.123 |', '| b | 2 |']
+    """
 
     title: str
     columns: list[str]
     rows: list[list]
 
     def to_markdown(self, digits: int = 4) -> str:
+        """The table in Markdown: bold title, a blank line, then the pipe table.
+
+        Parameters
+        ----------
+        digits : int, optional
+            Significant digits of float values (``g`` format). Default 4.
+
+        Returns
+        -------
+        str
+            The Markdown lines joined by newlines (no final newline).
+
+        Examples
+        --------
+        >>> table = Table("Errors", ["model", "rms"], [["a", 0.123456], ["b", 2.0]])
+        >>> table.to_markdown().splitlines()[0], table.to_markdown().splitlines()[4]
+        ('**Errors**', '| a | 0.1235 |')
+        """
         def fmt(x):
             if isinstance(x, float | np.floating):
                 return f"{x:.{digits}g}"
@@ -55,7 +89,31 @@ class Table:
 
 @dataclass
 class StudyResult:
-    """What a study returns: tables, key numbers (checked by tests), figure paths, notes."""
+    """What a study returns: tables, key numbers (checked by tests), figure paths, notes.
+
+    Parameters
+    ----------
+    name : str
+        The study's name.
+    tables : list of Table, optional
+        Result tables.
+    numbers : dict, optional
+        Key numbers by name (checked by tests), JSON-convertible by
+        :func:`pimodel.sweep.plain`.
+    figures : list of Path, optional
+        Figure files (PNG) written into the output folder.
+    notes : list of str, optional
+        Sentences for the report.
+    quick : bool, optional
+        Whether the reduced (CI) size was run.
+
+    Examples
+    --------
+    >>> table = Table("Errors", ["model", "rms"], [["a", 0.123456], ["b", 2.0]])
+    >>> res = StudyResult("demo", tables=[table], numbers={"x": 1.5}, notes=["a note"])
+    >>> res.to_json()["numbers"], res.to_markdown().splitlines()[:3]
+    ({'x': 1.5}, ['# Study `demo`', '', '- a note'])
+    """
 
     name: str
     tables: list[Table] = field(default_factory=list)
@@ -65,6 +123,19 @@ class StudyResult:
     quick: bool = False
 
     def to_json(self) -> dict:
+        """The result as a JSON-ready dict (what ``results.json`` holds; no timings).
+
+        Returns
+        -------
+        dict
+            ``name``, ``quick``, ``numbers``, ``tables`` (title, columns, rows), ``figures``
+            (file names) and ``notes``.
+
+        Examples
+        --------
+        >>> StudyResult("demo", numbers={"x": np.float64(1.5)}).to_json()["numbers"]
+        {'x': 1.5}
+        """
         return {
             "name": self.name,
             "quick": self.quick,
@@ -76,6 +147,20 @@ class StudyResult:
         }
 
     def to_markdown(self) -> str:
+        """The report (what ``results.md`` holds): heading, notes, tables, figure links.
+
+        Returns
+        -------
+        str
+            Markdown text ending in a newline.
+
+        Examples
+        --------
+        >>> print(StudyResult("demo", notes=["a note"], quick=True).to_markdown(), end="")
+        # Study `demo` (quick size)
+        <BLANKLINE>
+        - a note
+        """
         parts = [f"# Study `{self.name}`" + (" (quick size)" if self.quick else ""), ""]
         parts += [f"- {n}" for n in self.notes]
         for t in self.tables:
@@ -86,14 +171,46 @@ class StudyResult:
 
 
 def available_studies() -> list[str]:
-    """Names of the study scripts in ``studies/`` (files not starting with ``_``)."""
+    """Names of the study scripts in ``studies/`` (files not starting with ``_``).
+
+    Returns
+    -------
+    list of str
+        Sorted study names (empty when ``studies/`` is absent, e.g. in an installed wheel).
+
+    Examples
+    --------
+    >>> "compensation" in available_studies()
+    True
+    """
     if not STUDIES_DIR.is_dir():
         return []
     return sorted(p.stem for p in STUDIES_DIR.glob("*.py") if not p.stem.startswith("_"))
 
 
 def load_study(name: str) -> ModuleType:
-    """Import ``studies/NAME.py`` as a module; ValueError naming the study when absent."""
+    """Import ``studies/NAME.py`` as a module; ValueError naming the study when absent.
+
+    Parameters
+    ----------
+    name : str
+        The study's name (file stem in ``studies/``).
+
+    Returns
+    -------
+    types.ModuleType
+        The executed study module.
+
+    Raises
+    ------
+    ValueError
+        No such study (the message lists the available ones).
+
+    Examples
+    --------
+    >>> load_study("compensation").__name__
+    'pimodel_study_compensation'
+    """
     path = STUDIES_DIR / f"{name}.py"
     if not path.exists():
         known = ", ".join(available_studies()) or f"none found in {STUDIES_DIR}"
@@ -105,7 +222,23 @@ def load_study(name: str) -> ModuleType:
 
 
 def is_sweep(module: ModuleType) -> bool:
-    """Whether a study module declares ``cases``, ``run_case`` and ``aggregate``."""
+    """Whether a study module declares ``cases``, ``run_case`` and ``aggregate``.
+
+    Parameters
+    ----------
+    module : types.ModuleType
+        A study module (:func:`load_study`).
+
+    Returns
+    -------
+    bool
+        True for a sweep, False for a single computation (``run``).
+
+    Examples
+    --------
+    >>> is_sweep(load_study("sim_to_real")), is_sweep(load_study("compensation"))
+    (True, False)
+    """
     return all(callable(getattr(module, f, None)) for f in ("cases", "run_case", "aggregate"))
 
 
@@ -169,7 +302,21 @@ def run_study(name: str, out_dir=None, *, quick: bool = False, workers: int | No
 
 def add_run_options(ap: argparse.ArgumentParser) -> None:
     """Options shared by ``pimodel study``, ``pimodel sweep`` and ``python studies/NAME.py``:
-    ``--workers``, ``--scheduler``, ``--memory-limit``, ``--fresh``."""
+    ``--workers``, ``--scheduler``, ``--memory-limit``, ``--fresh``.
+
+    Parameters
+    ----------
+    ap : argparse.ArgumentParser
+        The parser to add them to (``--workers`` and ``--scheduler`` exclude each other).
+
+    Examples
+    --------
+    >>> import argparse
+    >>> ap = argparse.ArgumentParser()
+    >>> add_run_options(ap)
+    >>> ap.parse_args(["--workers", "0"])
+    Namespace(workers=0, scheduler=None, memory_limit=None, fresh=False)
+    """
     where = ap.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, default=None, metavar="N",
                        help="local Dask worker processes (default: one per core); "
@@ -186,7 +333,35 @@ def add_run_options(ap: argparse.ArgumentParser) -> None:
 
 def study_main(name: str, argv: list[str] | None = None) -> int:
     """Command line of a study script: ``python studies/NAME.py [--quick] [--out DIR]
-    [--workers N | --scheduler ADDRESS] [--fresh]``."""
+    [--workers N | --scheduler ADDRESS] [--fresh]``.
+
+    Runs :func:`run_study`, prints the Markdown report and where the results are.
+
+    Parameters
+    ----------
+    name : str
+        The study's name.
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0, or 2 when the study or a case failed (the error is printed on
+        stderr).
+
+    Raises
+    ------
+    ValueError
+        If there is no study ``name``.
+
+    Examples
+    --------
+    A quick run of a study takes seconds to minutes, hence skipped here:
+
+    >>> study_main("compensation", ["--quick", "--workers", "0"])  # doctest: +SKIP
+    0
+    """
     ap = argparse.ArgumentParser(prog=f"studies/{name}.py",
                                  description=load_study(name).__doc__)
     ap.add_argument("--quick", action="store_true", help="reduced size (as run in CI)")

@@ -26,3 +26,15 @@ def real_record_path() -> Path:
         pytest.skip(f"shared real record not found at {REAL_RECORD} (needs ../shared beside "
                     "the repo)")
     return REAL_RECORD
+
+
+@pytest.fixture(scope="session")
+def built_fmus(tmp_path_factory) -> Path:
+    """Every FMU unit built once per session for FMI 2.0 and 3.0 into one folder (read only:
+    tests that change an FMU copy it first)."""
+    from pimodel.fmu import build_fmus
+
+    out = tmp_path_factory.mktemp("built_fmus")
+    build_fmus(out, fmi_version="2.0")
+    build_fmus(out, fmi_version="3.0")
+    return out

@@ -16,7 +16,7 @@ from fmpy.validation import validate_fmu
 
 from pimodel import PIOperator, RadiusEstimator, estimate_radii
 from pimodel.actuators import stage_dynamics
-from pimodel.fmu import MODELS, build_fmus
+from pimodel.fmu import MODELS
 from pimodel.fmu.block import fmu_block
 from pimodel.fmu.cosim import cosimulate_adaptive_loop
 from pimodel.fmu.unit import FMUUnit
@@ -34,10 +34,8 @@ def arr(prefix, values):
 
 
 @pytest.fixture(scope="session")
-def fmus(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("fmus")
-    build_fmus(out)
-    return out
+def fmus(built_fmus) -> Path:
+    return built_fmus
 
 
 @pytest.mark.parametrize("name", list(MODELS))

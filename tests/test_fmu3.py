@@ -31,11 +31,8 @@ TS = 1e-3
 
 
 @pytest.fixture(scope="module")
-def fmus(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("fmus3")
-    build_fmus(out, fmi_version="3.0")
-    build_fmus(out, fmi_version="2.0")
-    return out
+def fmus(built_fmus) -> Path:
+    return built_fmus
 
 
 def path(fmus, name):

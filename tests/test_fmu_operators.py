@@ -24,7 +24,6 @@ from pimodel.asymmetric import AsymmetricPI
 from pimodel.cascade import Cascade
 from pimodel.creep import CreepOperator
 from pimodel.envelopes import Envelope
-from pimodel.fmu import build_fmus
 from pimodel.fmu.build import NMAX
 from pimodel.fmu.model_fmu import build_model_fmus, cosimulate_chain
 from pimodel.fmu.operators import unit_parameters
@@ -62,11 +61,8 @@ def signal(n: int = 700) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def fmus(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("operator_fmus")
-    for fmi in ("2.0", "3.0"):
-        build_fmus(out, UNITS, fmi_version=fmi)
-    return out
+def fmus(built_fmus) -> Path:
+    return built_fmus
 
 
 def fmu_file(fmus: Path, name: str, fmi: str) -> Path:

@@ -72,11 +72,8 @@ def radius_message(name: str, i: int) -> str:
 
 
 @pytest.fixture(scope="module")
-def fmu_dir(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("fuzz_fmus")
-    build_fmus(out, fmi_version="2.0")
-    build_fmus(out, fmi_version="3.0")
-    return out
+def fmu_dir(built_fmus) -> Path:
+    return built_fmus
 
 
 def fmu_path(fmu_dir: Path, name: str, fmi: str) -> Path:

@@ -29,7 +29,32 @@ SUFFIX = {"2.0": "", "3.0": "_fmi3"}  # file NAME{suffix}.fmu per FMI version
 
 
 def check_fmi_version(fmi_version: str) -> str:
-    """``fmi_version`` if supported, else ValueError naming the supported ones."""
+    """``fmi_version`` if supported, else ValueError naming the supported ones.
+
+    Parameters
+    ----------
+    fmi_version : str
+        ``"2.0"`` or ``"3.0"``.
+
+    Returns
+    -------
+    str
+        ``fmi_version``.
+
+    Raises
+    ------
+    ValueError
+        If it is not one of :data:`FMI_VERSIONS`.
+
+    Examples
+    --------
+    >>> check_fmi_version("3.0")
+    '3.0'
+    >>> check_fmi_version("1.0")
+    Traceback (most recent call last):
+    ...
+    ValueError: fmi_version: expected one of ('2.0', '3.0'), got '1.0'
+    """
     if fmi_version not in GLUE:
         raise ValueError(f"fmi_version: expected one of {FMI_VERSIONS}, got {fmi_version!r}")
     return fmi_version
@@ -37,7 +62,30 @@ def check_fmi_version(fmi_version: str) -> str:
 
 def fmu_filename(name: str, fmi_version: str = "2.0") -> str:
     """File name of a unit's FMU as :func:`build_fmus` writes it (``NAME.fmu``,
-    ``NAME_fmi3.fmu``)."""
+    ``NAME_fmi3.fmu``).
+
+    Parameters
+    ----------
+    name : str
+        The unit (model identifier), e.g. ``"PIHysteresis"``.
+    fmi_version : {"2.0", "3.0"}, optional
+        The FMI version. Default ``"2.0"``.
+
+    Returns
+    -------
+    str
+        The file name.
+
+    Raises
+    ------
+    ValueError
+        An unsupported ``fmi_version``.
+
+    Examples
+    --------
+    >>> fmu_filename("PIHysteresis"), fmu_filename("PIHysteresis", "3.0")
+    ('PIHysteresis.fmu', 'PIHysteresis_fmi3.fmu')
+    """
     return f"{name}{SUFFIX[check_fmi_version(fmi_version)]}.fmu"
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-O2", "-fPIC",
           "-shared"]
@@ -49,6 +97,30 @@ SAMPLING = ("Internal sample k at time k*Ts; doStep(t, h) processes every sample
 
 @dataclass(frozen=True)
 class Var:
+    """One scalar variable of a unit's FMI interface (a row of its model description).
+
+    Parameters
+    ----------
+    name : str
+        Variable name; arrays are 1-based scalars ``p[1]..p[64]``.
+    vr : int
+        Value reference.
+    kind : {"Real", "Integer", "Boolean"}
+        FMI 2 type.
+    causality : {"parameter", "input", "output"}
+        FMI causality.
+    start : str
+        Start value as written in the XML.
+    description : str
+        Meaning and unit.
+
+    Examples
+    --------
+    >>> ts = spec_of("PIHysteresis")["vars"][0]
+    >>> ts.name, ts.causality, ts.start
+    ('Ts', 'parameter', '0.001')
+    """
+
     name: str
     vr: int
     kind: str  # Real, Integer, Boolean
@@ -187,13 +259,53 @@ MODEL_UNITS: dict[str, dict] = {}
 
 
 def spec_of(name: str) -> dict:
-    """The spec of a unit (``MODELS``) or of a model's operator FMU (``MODEL_UNITS``)."""
+    """The spec of a unit (``MODELS``) or of a model's operator FMU (``MODEL_UNITS``).
+
+    Parameters
+    ----------
+    name : str
+        The unit's model identifier.
+
+    Returns
+    -------
+    dict
+        ``id`` (unit code in the C glue), ``description`` and ``vars`` (list of :class:`Var`);
+        a model's operator FMU also has ``salt`` and ``defaults``.
+
+    Raises
+    ------
+    KeyError
+        An unknown unit.
+
+    Examples
+    --------
+    >>> spec = spec_of("PIHysteresis")
+    >>> spec["id"], [v.name for v in spec["vars"]][:4]
+    (1, ['Ts', 'n', 'z0', 'p[1]'])
+    """
     return MODEL_UNITS[name] if name in MODEL_UNITS else MODELS[name]
 
 
 def guid(name: str) -> str:
     """Fixed GUID of a unit (changes with the interface version: v2 has 64 plays, linear_play;
-    a model's operator FMU also with its parameter values)."""
+    a model's operator FMU also with its parameter values).
+
+    Parameters
+    ----------
+    name : str
+        The unit's model identifier.
+
+    Returns
+    -------
+    str
+        A braced name-based UUID (uuid5), the same on every build.
+
+    Examples
+    --------
+    >>> g = guid("PIHysteresis")
+    >>> g == guid("PIHysteresis"), g[0] + g[-1], len(g)
+    (True, '{}', 38)
+    """
     import uuid
 
     salt = MODEL_UNITS[name]["salt"] if name in MODEL_UNITS else ""
@@ -201,7 +313,23 @@ def guid(name: str) -> str:
 
 
 def source_dir() -> Path:
-    """The C sources: ``fmu/src`` beside the package (editable install) or packaged copy."""
+    """The C sources: ``fmu/src`` beside the package (editable install) or packaged copy.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder holding the FMI glue and the C core.
+
+    Raises
+    ------
+    FileNotFoundError
+        When neither location holds the sources.
+
+    Examples
+    --------
+    >>> (source_dir() / "pim_pi.c").is_file()
+    True
+    """
     here = Path(__file__).resolve()
     for cand in (here.parents[2] / "fmu" / "src", here.parent / "src"):
         if (cand / GLUE["2.0"]).exists():
@@ -211,6 +339,23 @@ def source_dir() -> Path:
 
 
 def fmi_headers() -> Path:
+    """The FMI headers shipped with the installed fmpy (``fmpy/c-code``).
+
+    Returns
+    -------
+    pathlib.Path
+        The folder holding ``fmi2Functions.h`` (and the FMI 3 headers).
+
+    Raises
+    ------
+    FileNotFoundError
+        When the fmpy installation has no FMI 2 headers.
+
+    Examples
+    --------
+    >>> (fmi_headers() / "fmi2Functions.h").is_file()
+    True
+    """
     import fmpy
 
     path = Path(fmpy.__file__).parent / "c-code"
@@ -220,7 +365,24 @@ def fmi_headers() -> Path:
 
 
 def find_compiler() -> str:
-    """A C compiler on PATH ($CC, cc, gcc or clang); RuntimeError naming them when none."""
+    """A C compiler on PATH ($CC, cc, gcc or clang); RuntimeError naming them when none.
+
+    Returns
+    -------
+    str
+        The first of ``$CC``, ``cc``, ``gcc``, ``clang`` found on PATH.
+
+    Raises
+    ------
+    RuntimeError
+        When none is found.
+
+    Examples
+    --------
+    >>> import os
+    >>> find_compiler() in (os.environ.get("CC"), "cc", "gcc", "clang")
+    True
+    """
     for cand in (os.environ.get("CC"), "cc", "gcc", "clang"):
         if cand and shutil.which(cand):
             return cand
@@ -228,6 +390,29 @@ def find_compiler() -> str:
 
 
 def model_description(name: str) -> str:
+    """The FMI 2.0 ``modelDescription.xml`` of a unit (Co-Simulation, scalar variables).
+
+    Parameters
+    ----------
+    name : str
+        The unit's model identifier.
+
+    Returns
+    -------
+    str
+        The XML text.
+
+    Raises
+    ------
+    KeyError
+        An unknown unit.
+
+    Examples
+    --------
+    >>> xml = model_description("PIHysteresis")
+    >>> 'fmiVersion="2.0" modelName="PIHysteresis"' in xml, 'name="r[64]"' in xml
+    (True, True)
+    """
     spec = spec_of(name)
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
@@ -265,6 +450,23 @@ def model_description(name: str) -> str:
 
 
 def build_description(name: str) -> str:
+    """``sources/buildDescription.xml``: the C files ``fmpy compile`` needs to rebuild the unit.
+
+    Parameters
+    ----------
+    name : str
+        The unit's model identifier.
+
+    Returns
+    -------
+    str
+        The XML text (FMI 3 build description, also read for FMI 2 by fmpy).
+
+    Examples
+    --------
+    >>> build_description("PIHysteresis").splitlines()[2]
+    '  <BuildConfiguration modelIdentifier="PIHysteresis">'
+    """
     files = "\n".join(f'        <SourceFile name="{s}"/>' for s in ("model.c", *CORE_SOURCES))
     return (
         '<?xml version="1.0" encoding="UTF-8"?>\n<fmiBuildDescription fmiVersion="3.0">\n'
@@ -308,8 +510,40 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
                fmi_version: str = "2.0") -> list[Path]:
     """Compile and package the FMUs named in ``which`` (default all) into ``out_dir``.
 
-    ``fmi_version``: ``"2.0"`` (files ``NAME.fmu``) or ``"3.0"`` (files ``NAME_fmi3.fmu``,
-    arrays as FMI 3 arrays); the model identifier is ``NAME`` in both."""
+    Parameters
+    ----------
+    out_dir : str or Path
+        Folder of the FMUs (created; existing files overwritten).
+    which : iterable of str, optional
+        Units to build (names of ``MODELS`` or ``MODEL_UNITS``); default all of ``MODELS``.
+    compiler : str, optional
+        C compiler; default :func:`find_compiler`.
+    fmi_version : {"2.0", "3.0"}, optional
+        ``"2.0"`` (files ``NAME.fmu``) or ``"3.0"`` (files ``NAME_fmi3.fmu``, arrays as FMI 3
+        arrays); the model identifier is ``NAME`` in both. Default ``"2.0"``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The FMU files, in the order of ``which``.
+
+    Raises
+    ------
+    ValueError
+        An unknown unit or FMI version.
+    RuntimeError
+        No compiler found, or compiling failed (the message holds the compiler's output).
+    FileNotFoundError
+        The C sources or the FMI headers are missing.
+
+    Examples
+    --------
+    Compiling takes about a second per unit, hence skipped here:
+
+    >>> import tempfile
+    >>> build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0].name  # doctest: +SKIP
+    'PIHysteresis.fmu'
+    """
     names = list(MODELS) if which is None else list(which)
     unknown = [n for n in names if n not in MODELS and n not in MODEL_UNITS]
     if unknown:

@@ -14,7 +14,26 @@ PLATFORM = "x86_64-linux"
 
 
 def token(name: str) -> str:
-    """Fixed instantiation token of a unit (changes with the interface version)."""
+    """Fixed instantiation token of a unit (changes with the interface version).
+
+    Parameters
+    ----------
+    name : str
+        The unit's model identifier.
+
+    Returns
+    -------
+    str
+        A braced name-based UUID (uuid5), the same on every build, different from the FMI 2
+        GUID.
+
+    Examples
+    --------
+    >>> from pimodel.fmu.build import guid
+    >>> t = token("PIHysteresis")
+    >>> t == token("PIHysteresis"), t != guid("PIHysteresis"), len(t)
+    (True, True, 38)
+    """
     salt = MODEL_UNITS[name]["salt"] if name in MODEL_UNITS else ""
     return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"pimodel/fmi3/{name}/v2{salt}")) + "}"
 
@@ -40,6 +59,29 @@ def _variables(name: str) -> list[tuple[str, int, str, str, str, str, bool]]:
 
 
 def model_description3(name: str) -> str:
+    """The FMI 3.0 ``modelDescription.xml`` of a unit (Co-Simulation, array variables).
+
+    Parameters
+    ----------
+    name : str
+        The unit's model identifier.
+
+    Returns
+    -------
+    str
+        The XML text.
+
+    Raises
+    ------
+    KeyError
+        An unknown unit.
+
+    Examples
+    --------
+    >>> xml = model_description3("PIHysteresis")
+    >>> 'fmiVersion="3.0" modelName="PIHysteresis"' in xml, '<Float64 name="p"' in xml
+    (True, True)
+    """
     spec = spec_of(name)
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',

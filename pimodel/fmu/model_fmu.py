@@ -148,7 +148,20 @@ def cosimulate_chain(paths, u, Ts: float) -> np.ndarray:
 
     Returns
     -------
-    numpy.ndarray
+    numpy.ndarray of float, shape (N,)
+        Output ``y[k]`` of the last stage after the step that took ``u[k]``.
+
+    Examples
+    --------
+    The FMUs must be built first (seconds), hence skipped here:
+
+    >>> from pimodel.creep import CreepOperator
+    >>> import tempfile
+    >>> op = CreepOperator([0.05], [0.1], dt=1e-3)
+    >>> paths = build_model_fmus(op, tempfile.mkdtemp())  # doctest: +SKIP
+    >>> y = cosimulate_chain(paths, np.ones(4), 1e-3)  # doctest: +SKIP
+    >>> bool(np.allclose(y, op.simulate(np.ones(4))))  # doctest: +SKIP
+    True
     """
     units = [FMUUnit(p, instance_name=f"stage{i}") for i, p in enumerate(paths, start=1)]
     ports = [(next(v.name for v in unit.md.modelVariables if v.causality == "input"),

@@ -29,10 +29,47 @@ RENAMED = {"known_linear": "linear_play"}
 class FMUUnit:
     """An instantiated, initialised co-simulation FMU.
 
-    ``start`` sets parameters and start values by variable name before initialisation
-    (``n``, ``Ts``, ``p[1]`` ...). :meth:`set` / :meth:`get` take variable names; :meth:`step`
-    calls ``doStep(t, h)`` and advances the unit's time. Errors from the FMU (fmi2Error) raise
-    fmpy's ``FMICallException``; the FMU's log lines are kept in :attr:`log`.
+    :meth:`set` / :meth:`get` take variable names; :meth:`step` calls ``doStep(t, h)`` and
+    advances the unit's time. Errors from the FMU (fmi2Error) raise fmpy's
+    ``FMICallException``; the FMU's log lines are kept in :attr:`log`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.fmu`` file (FMI 2.0 or 3.0, Co-Simulation).
+    start : dict, optional
+        Parameters and start values by variable name, set before initialisation (``n``,
+        ``Ts``, ``p[1]`` ..., or a whole FMI 3 array ``"p": [...]``).
+    instance_name : str, optional
+        The FMU instance's name (in its log). Default ``"unit"``.
+
+    Raises
+    ------
+    FileNotFoundError
+        No file at ``path``.
+    ValueError
+        Not a co-simulation FMU, or initialisation failed (the message holds the FMU's log).
+    KeyError
+        A ``start`` name that is no variable of the FMU.
+
+    Examples
+    --------
+    The examples of this class need a built FMU (a compile of about a second), hence are
+    skipped here; for PIHysteresis, ``doStep(0, Ts)`` processes the sample ``k = 0``:
+
+    >>> import tempfile
+    >>> from pimodel.fmu import build_fmus
+    >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+    >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+    >>> unit.set({"v": 1.0})  # doctest: +SKIP
+    >>> unit.step(1e-3)  # doctest: +SKIP
+    >>> unit.get(["y"])   # 1.0 * 1.0 + 0.5 * (1.0 - 0.3)  # doctest: +SKIP
+    array([1.35])
+    >>> unit.close()  # doctest: +SKIP
+    >>> FMUUnit("missing.fmu")
+    Traceback (most recent call last):
+    ...
+    FileNotFoundError: missing.fmu: no such FMU
     """
 
     def __init__(self, path, start: dict | None = None, *, instance_name: str = "unit"):
@@ -104,7 +141,35 @@ class FMUUnit:
         return np.array(self.fmu.getFloat64([v.valueReference], nValues=self._size(v)))
 
     def set(self, values: dict) -> None:
-        """Set variables by name (Real/Float64, Integer/Int32 or Boolean)."""
+        """Set variables by name (Real/Float64, Integer/Int32 or Boolean).
+
+        Parameters
+        ----------
+        values : dict
+            Variable name -> value; an FMI 3 array takes a sequence (shorter ones fill the first
+            elements) or element-wise names ``"p[2]"``. Old names in ``RENAMED`` work with a
+            DeprecationWarning.
+
+        Raises
+        ------
+        KeyError
+            An unknown variable name.
+        ValueError
+            Too many values for an FMI 3 array.
+        TypeError
+            A variable of a type other than Real, Integer or Boolean.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pimodel.fmu import build_fmus
+        >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+        >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+        >>> unit.set({"v": 1.0})  # doctest: +SKIP
+        >>> unit.step(1e-3)  # doctest: +SKIP
+        >>> unit.get(["y"])  # doctest: +SKIP
+        array([1.35])
+        """
         for name, value in values.items():
             v, i = self._var(name)
             vr = [v.valueReference]
@@ -128,7 +193,33 @@ class FMUUnit:
                 raise TypeError(f"{name}: unsupported type {v.type}")
 
     def get(self, names) -> np.ndarray:
-        """Real values of the named variables (FMI 3 array elements as ``base[i]``)."""
+        """Real values of the named variables (FMI 3 array elements as ``base[i]``).
+
+        Parameters
+        ----------
+        names : sequence of str
+            Variable names (1-based array elements ``"r_hat[1]"`` in both FMI versions; a
+            whole FMI 3 array by its base name).
+
+        Returns
+        -------
+        numpy.ndarray of float
+            The values, in the order of ``names`` (a whole array contributes all its elements).
+
+        Raises
+        ------
+        KeyError
+            An unknown variable name.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pimodel.fmu import build_fmus
+        >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+        >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+        >>> unit.get(["p[2]", "r[2]"])  # doctest: +SKIP
+        array([0.5, 0.3])
+        """
         if not self.fmi3:
             return np.array(self.fmu.getReal([self._var(n)[0].valueReference for n in names]))
         out, arrays = [], {}
@@ -143,7 +234,29 @@ class FMUUnit:
         return np.array(out)
 
     def step(self, h: float) -> None:
-        """One communication step of length ``h`` from the current time."""
+        """One communication step of length ``h`` from the current time.
+
+        Parameters
+        ----------
+        h : float
+            Communication step [s]; a pimodel unit processes every sample ``k`` with ``k Ts`` in
+            ``[t, t + h)``.
+
+        Raises
+        ------
+        ValueError
+            The FMU's ``doStep`` failed (the message holds its last log lines).
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pimodel.fmu import build_fmus
+        >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+        >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+        >>> unit.step(1e-3)  # doctest: +SKIP
+        >>> unit.time  # doctest: +SKIP
+        0.001
+        """
         try:
             self.fmu.doStep(currentCommunicationPoint=self.time, communicationStepSize=h)
         except Exception:
@@ -152,16 +265,88 @@ class FMUUnit:
         self.time += h
 
     def get_state(self):
+        """Save the FMU's state (``fmi2GetFMUstate``) together with the unit's time.
+
+        Returns
+        -------
+        tuple
+            ``(FMU state handle, time)``, for :meth:`set_state`; release it with
+            :meth:`free_state`.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pimodel.fmu import build_fmus
+        >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+        >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+        >>> unit.set({"v": 1.0})  # doctest: +SKIP
+        >>> unit.step(1e-3)  # doctest: +SKIP
+        >>> saved = unit.get_state()  # doctest: +SKIP
+        >>> unit.set({"v": 0.0})  # doctest: +SKIP
+        >>> unit.step(1e-3)  # doctest: +SKIP
+        >>> unit.get(["y"])  # doctest: +SKIP
+        array([0.15])
+        >>> unit.set_state(saved)  # doctest: +SKIP
+        >>> unit.set({"v": 0.0})  # doctest: +SKIP
+        >>> unit.step(1e-3)  # doctest: +SKIP
+        >>> unit.get(["y"])   # the same step again  # doctest: +SKIP
+        array([0.15])
+        >>> unit.free_state(saved)  # doctest: +SKIP
+        """
         return self.fmu.getFMUState(), self.time
 
     def set_state(self, state) -> None:
+        """Restore a state saved by :meth:`get_state` (the FMU's state, inputs and time).
+
+        Parameters
+        ----------
+        state : tuple
+            ``(FMU state handle, time)`` from :meth:`get_state`.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pimodel.fmu import build_fmus
+        >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+        >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+        >>> saved = unit.get_state()  # doctest: +SKIP
+        >>> unit.step(1e-3)  # doctest: +SKIP
+        >>> unit.set_state(saved)  # doctest: +SKIP
+        >>> unit.time  # doctest: +SKIP
+        0.0
+        """
         self.fmu.setFMUState(state[0])
         self.time = state[1]
 
     def free_state(self, state) -> None:
+        """Release a state saved by :meth:`get_state`.
+
+        Parameters
+        ----------
+        state : tuple
+            ``(FMU state handle, time)`` from :meth:`get_state`; not usable afterwards.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pimodel.fmu import build_fmus
+        >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+        >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+        >>> unit.free_state(unit.get_state())  # doctest: +SKIP
+        """
         self.fmu.freeFMUState(state[0])
 
     def close(self) -> None:
+        """Terminate and free the FMU instance and delete its extracted files.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pimodel.fmu import build_fmus
+        >>> path = build_fmus(tempfile.mkdtemp(), ["PIHysteresis"])[0]  # doctest: +SKIP
+        >>> unit = FMUUnit(path, {"n": 2, "p[2]": 0.5, "r[2]": 0.3})  # doctest: +SKIP
+        >>> unit.close()  # doctest: +SKIP
+        """
         try:
             self.fmu.terminate()
         finally:
