@@ -1,5 +1,5 @@
-"""Figures of a diagnosis: residual versus time and input, loops before and after, ranked
-regions."""
+"""Figures of a diagnosis (:func:`plot_diagnosis`): residual versus time and input, loops
+before and after the augmentation, ranked regions."""
 
 from __future__ import annotations
 
@@ -11,6 +11,49 @@ from ..plotting import new_figure, save_figure
 
 
 def plot_diagnosis(rep, out_dir, *, prefix: str = "", units=("V", "um")) -> list[Path]:
+    """Save the two figures of a diagnosis as PNG files.
+
+    ``residuals.png``: the validate residual ``y[k] - model[k]`` of the nominal PI model and of
+    the augmented model, against time and against the input. ``loops_and_regions.png``: the
+    measured and modelled loops of the first validate record, and the regions of the validate
+    records ranked by residual concentration (energy share over sample share; 1 is uniform).
+
+    Parameters
+    ----------
+    rep : DiagnosisReport
+        Result of :func:`pimodel.diagnosis.diagnose`; used are ``validate`` (records with
+        ``t``, ``v``, ``y``), ``before`` and ``after`` (nominal and augmented model outputs,
+        one array per validate record), ``verdict["effects"]`` and ``where["regions"]``.
+    out_dir : str or pathlib.Path
+        Directory of the figures (created if missing).
+    prefix : str
+        Prepended to each file name.
+    units : tuple of str
+        Units of the input and of the output, for the axis labels.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The two saved files.
+
+    Raises
+    ------
+    ValueError
+        If a figure fails the readability check of :func:`pimodel.plotting.save_figure`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from types import SimpleNamespace
+    >>> t = np.linspace(0.0, 0.01, 11)
+    >>> seg = SimpleNamespace(t=t, v=np.sin(600 * t), y=np.sin(600 * t))
+    >>> rep = SimpleNamespace(validate=[seg], before=[0.9 * seg.y], after=[seg.y],
+    ...                       verdict={"effects": ["creep"]},
+    ...                       where={"regions": [{"region": "late", "concentration": 1.5}]})
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     [p.name for p in plot_diagnosis(rep, tmp, prefix="stage_")]
+    ['stage_residuals.png', 'stage_loops_and_regions.png']
+    """
     uv, uy = units
     out = Path(out_dir)
     paths = []
