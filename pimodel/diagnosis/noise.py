@@ -34,7 +34,25 @@ MAX_PERIODS_TRIED = 6
 
 
 def robust_std(x: np.ndarray) -> float:
-    """1.4826 times the median absolute deviation: the standard deviation for Gaussian ``x``."""
+    """1.4826 times the median absolute deviation: the standard deviation for Gaussian ``x``.
+
+    Insensitive to a few outliers, unlike :func:`numpy.std`.
+
+    Parameters
+    ----------
+    x : array_like
+        Samples (any shape; flattened by the median).
+
+    Returns
+    -------
+    float
+        ``1.4826 * median(|x - median(x)|)``, in the units of ``x``.
+
+    Examples
+    --------
+    >>> robust_std([1.0, 2.0, 3.0, 4.0, 100.0])
+    1.4826
+    """
     x = np.asarray(x, float)
     return float(1.4826 * np.median(np.abs(x - np.median(x))))
 
