@@ -74,7 +74,42 @@ def _region_masks(t: np.ndarray, v: np.ndarray, fs: float) -> dict[str, np.ndarr
 
 
 def residual_breakdown(segments, residuals) -> dict:
-    """Ranked regions, spectrum bands and correlations of the validate residuals."""
+    """Ranked regions, spectrum bands and correlations of the validate residuals.
+
+    Each sample ``k`` of each record belongs to zero or more regions (ascending or descending
+    branches, near a reversal, input extremes, fast input, holds after a step, late in the
+    record, the start-up region of :func:`startup_length`). A region's concentration is its
+    share of the residual energy ``sum r[k]**2`` divided by its share of the samples; above 1
+    the residual lives there.
+
+    Parameters
+    ----------
+    segments : list of Segment
+        The validate records: ``t`` [s], input ``v[k]`` and sample time ``dt`` [s] each (see
+        :class:`pimodel.diagnosis.effects.Segment`).
+    residuals : list of numpy.ndarray
+        Residual ``r[k] = y[k] - model[k]`` of each record (output units), same lengths.
+
+    Returns
+    -------
+    dict
+        ``regions``: list of dicts (``region``, ``energy_share``, ``sample_share``,
+        ``concentration``), highest concentration first, empty regions left out;
+        ``spectrum``: share of the residual energy in the bands < 1 Hz, 1-10 Hz, 10-100 Hz,
+        100-1000 Hz, > 1 kHz (``band``, ``energy_share``); ``corr_input`` and
+        ``corr_input_rate``: correlation of ``r[k + lag]`` with ``v[k]`` and with
+        ``v[k] - v[k-1]`` (``lag_samples``, ``corr``), averaged over the records.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> t = np.arange(400) * 1e-3
+    >>> seg = SimpleNamespace(t=t, v=np.sin(2 * np.pi * 5 * t), dt=1e-3)
+    >>> r = np.where(t > 0.3, 0.01 * seg.v, 0.0)  # a gap that appears late in the record
+    >>> top = residual_breakdown([seg], [r])["regions"][0]
+    >>> top["region"], round(top["concentration"], 2)
+    ('late in the record (last third)', 3.01)
+    """
     regions: dict[str, list[float]] = {}
     total_e = sum(float(np.sum(r**2)) for r in residuals) or 1e-300
     total_n = sum(r.size for r in residuals)
