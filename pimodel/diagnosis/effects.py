@@ -32,16 +32,38 @@ STEP_SHARE = 0.05  # rate candidate: a one-sample jump above this share of the r
 
 @dataclass
 class Segment:
-    """One record: time [s] as given, input, measured output, play outputs ``Z`` of the radius
-    grid, and ``mask``: the samples that are fitted and scored (False in a start-up region
-    whose initial memory is unknown)."""
+    """One record prepared for the fits: samples ``k = 0..N-1`` at a constant sample time.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time ``t[k]`` [s] as given (a record's own clock or one shared by the records).
+    v : numpy.ndarray
+        Input ``v[k]``.
+    y : numpy.ndarray
+        Measured output ``y[k]``.
+    Z : numpy.ndarray
+        Play outputs ``z_i[k]`` of the radius grid, shape (N, n).
+    mask : numpy.ndarray or None
+        Boolean, the samples that are fitted and scored (False in a start-up region whose
+        initial memory is unknown); None: all.
+    rate_column : numpy.ndarray or None
+        The rate candidate's columns (:func:`rate_columns`), set by the diagnosis.
+
+    Examples
+    --------
+    >>> t = np.arange(4) * 1e-3
+    >>> seg = Segment(t, np.zeros(4), np.zeros(4), np.zeros((4, 1)))
+    >>> seg.dt, seg.used
+    (0.001, slice(None, None, None))
+    """
 
     t: np.ndarray
     v: np.ndarray
     y: np.ndarray
     Z: np.ndarray
     mask: np.ndarray | None = None
-    rate_column: np.ndarray | None = None  # see :func:`rate_column`, set by the diagnosis
+    rate_column: np.ndarray | None = None  # see rate_columns, set by the diagnosis
 
     @property
     def used(self) -> np.ndarray:
@@ -50,17 +72,66 @@ class Segment:
 
     @property
     def dt(self) -> float:
+        """Sample time ``t[1] - t[0]`` [s]."""
         return float(self.t[1] - self.t[0])
 
 
 def make_segment(t, v, y, radii, mask=None) -> Segment:
-    """Segment of one record with the play outputs of ``radii`` (play states start at 0)."""
+    """Segment of one record with the play outputs of ``radii`` (play states start at 0).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time ``t[k]`` [s].
+    v : numpy.ndarray
+        Input ``v[k]``.
+    y : numpy.ndarray
+        Measured output ``y[k]``.
+    radii : array_like
+        Play radii of the grid [input units], ``n`` of them.
+    mask : numpy.ndarray or None
+        Samples fitted and scored (see :class:`Segment`); None: all.
+
+    Returns
+    -------
+    Segment
+        With ``Z[k, i]`` the output of play ``i`` at sample ``k``, shape (N, n).
+
+    Examples
+    --------
+    >>> seg = make_segment(np.arange(4) * 1e-3, np.array([0.0, 1.0, 0.5, 0.0]), np.zeros(4),
+    ...                    [0.0, 0.5])
+    >>> seg.Z.tolist()
+    [[0.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5]]
+    """
     Z = PIOperator(np.ones(len(radii)), radii).play_outputs(v)
     return Segment(t, v, y, Z, mask)
 
 
 def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
-    """First-order lag (exact discretisation), at rest around x[0]; works column-wise."""
+    """First-order lag (exact discretisation), at rest around x[0]; works column-wise.
+
+    ``out[k] = a out[k-1] + (1 - a) x[k]`` with ``a = exp(-dt / tau)`` and ``out[-1] = x[0]``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Signal ``x[k]``, 1-D or (N, m) (each column filtered).
+    tau : float
+        Time constant [s].
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The lagged signal, shape of ``x``, units of ``x``.
+
+    Examples
+    --------
+    >>> np.round(lag(np.array([0.0, 1.0, 1.0, 1.0]), 1e-3, 1e-3), 4).tolist()
+    [0.0, 0.6321, 0.8647, 0.9502]
+    """
     a = np.exp(-dt / tau)
     zi = np.atleast_1d(a * x[0])[None, :] if x.ndim > 1 else [a * x[0]]
     out, _ = lfilter([1 - a], [1, -a], x, axis=0, zi=zi)
@@ -71,7 +142,29 @@ def mode_coefficients(fn: float, zeta: float, dt: float) -> tuple[np.ndarray, np
     """ZOH discretisation ``(b, a)`` of the unit-gain mode ``w^2 / (s^2 + 2 zeta w s + w^2)``.
 
     Underdamped modes use the closed form (the discrete step response equals the sampled
-    continuous one); others fall back to :func:`scipy.signal.cont2discrete`."""
+    continuous one); others fall back to :func:`scipy.signal.cont2discrete`.
+
+    Parameters
+    ----------
+    fn : float
+        Natural frequency [Hz].
+    zeta : float
+        Damping ratio [-].
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    b, a : numpy.ndarray
+        Numerator and denominator in powers of ``z^-1`` (``a[0] = 1``), for
+        :func:`scipy.signal.lfilter`.
+
+    Examples
+    --------
+    >>> b, a = mode_coefficients(100.0, 0.1, 1e-3)
+    >>> round(float(b.sum() / a.sum()), 6)  # unit static gain
+    1.0
+    """
     w = 2 * np.pi * fn
     if zeta >= 1.0:
         num, den, _ = cont2discrete(([w * w], [1.0, 2 * zeta * w, w * w]), dt, method="zoh")
@@ -89,7 +182,30 @@ def mode_coefficients(fn: float, zeta: float, dt: float) -> tuple[np.ndarray, np
 
 def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
     """Unit-gain second-order mode (zero-order-hold discretisation, as a DAC drives the stage),
-    at rest around x[0]; works column-wise: ``out[k]`` depends on ``x[0..k-1]``."""
+    at rest around x[0]; works column-wise: ``out[k]`` depends on ``x[0..k-1]``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Signal ``x[k]``, 1-D or (N, m) (each column filtered).
+    fn : float
+        Natural frequency [Hz].
+    zeta : float
+        Damping ratio [-].
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The filtered signal, shape and units of ``x``.
+
+    Examples
+    --------
+    >>> y = mode(np.r_[0.0, np.ones(300)], 50.0, 0.7, 1e-3)  # a unit step
+    >>> round(float(y[1]), 6), round(float(y[-1]), 3)
+    (0.0, 1.0)
+    """
     b, a = mode_coefficients(fn, zeta, dt)
     zi = lfilter_zi(b, a)
     if x.ndim == 1:
@@ -98,7 +214,30 @@ def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
 
 
 def mode_rows(xt: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
-    """:func:`mode` applied to each row of ``xt`` (signals as rows, C-contiguous)."""
+    """:func:`mode` applied to each row of ``xt`` (signals as rows, C-contiguous).
+
+    Parameters
+    ----------
+    xt : numpy.ndarray
+        Signals as rows, shape (m, N).
+    fn : float
+        Natural frequency [Hz].
+    zeta : float
+        Damping ratio [-].
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The filtered rows, shape (m, N).
+
+    Examples
+    --------
+    >>> x = np.r_[0.0, np.ones(20)]
+    >>> bool(np.allclose(mode_rows(x[None, :], 50.0, 0.7, 1e-3)[0], mode(x, 50.0, 0.7, 1e-3)))
+    True
+    """
     b, a = mode_coefficients(fn, zeta, dt)
     out, _ = lfilter(b, a, xt, axis=-1, zi=lfilter_zi(b, a)[None, :] * xt[:, :1])
     return out
@@ -106,7 +245,25 @@ def mode_rows(xt: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
 
 def shift(x: np.ndarray, d: float) -> np.ndarray:
     """``x`` delayed by ``d >= 0`` samples (rows; held at ``x[0]`` before the start); a
-    fractional part interpolates linearly between the two neighbouring whole delays."""
+    fractional part interpolates linearly between the two neighbouring whole delays.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Signal ``x[k]``, 1-D or (N, m) (rows are samples).
+    d : float
+        Delay [samples], ``d >= 0``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``x[k - d]``, shape of ``x``.
+
+    Examples
+    --------
+    >>> shift(np.arange(4.0), 1).tolist(), shift(np.arange(4.0), 0.5).tolist()
+    ([0.0, 0.0, 1.0, 2.0], [0.0, 0.5, 1.5, 2.5])
+    """
     n = int(np.floor(d))
     f = float(d) - n
     if f > 1e-12:
@@ -119,7 +276,29 @@ def shift(x: np.ndarray, d: float) -> np.ndarray:
 
 @dataclass
 class Model:
-    """A fitted (nominal or augmented) model: ``features(seg) @ coef``."""
+    """A fitted (nominal or augmented) model: ``features(seg) @ coef``.
+
+    Parameters
+    ----------
+    name : str
+        ``"nominal"`` or the effects joined by ``+`` (``"creep+delay"``).
+    k : int
+        Parameters added to the nominal model.
+    features : callable
+        ``features(seg)``: the regressor matrix of a :class:`Segment`, shape (N, p).
+    coef : numpy.ndarray
+        Fitted coefficients, shape (p,).
+    params : dict
+        Fitted physical parameters (``mode_hz``, ``delay_samples``, ...).
+    grid : dict
+        The grid parameters the model was built with.
+
+    Examples
+    --------
+    >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.0]), np.zeros(3), [0.0])
+    >>> Model("nominal", 0, base_features, np.array([2.0, 0.5])).predict(seg).tolist()
+    [0.5, 2.5, 0.5]
+    """
 
     name: str
     k: int
@@ -129,6 +308,24 @@ class Model:
     grid: dict = field(default_factory=dict)
 
     def predict(self, seg: Segment) -> np.ndarray:
+        """Model output of a record.
+
+        Parameters
+        ----------
+        seg : Segment
+            The record.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``features(seg) @ coef``: the model output at each sample, output units.
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(2) * 1e-3, np.array([0.0, 1.0]), np.zeros(2), [0.0])
+        >>> Model("nominal", 0, base_features, np.array([3.0, 0.0])).predict(seg).tolist()
+        [0.0, 3.0]
+        """
         return self.features(seg) @ self.coef
 
 
@@ -153,10 +350,53 @@ def _ones(s: Segment) -> np.ndarray:
 
 
 def base_features(s: Segment) -> np.ndarray:
+    """Regressors of the nominal model: the play outputs and a constant offset.
+
+    Parameters
+    ----------
+    s : Segment
+        The record.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``[Z, 1]``, shape (N, n + 1).
+
+    Examples
+    --------
+    >>> seg = make_segment(np.arange(2) * 1e-3, np.array([0.0, 1.0]), np.zeros(2), [0.0, 0.5])
+    >>> base_features(seg).tolist()
+    [[0.0, 0.0, 1.0], [1.0, 0.5, 1.0]]
+    """
     return np.hstack((s.Z, _ones(s)))
 
 
 def fit_nominal(train) -> Model:
+    """The nominal PI model: play weights and an offset by least squares on the train records.
+
+    Parameters
+    ----------
+    train : list of Segment
+        The train records (their masked samples are fitted).
+
+    Returns
+    -------
+    Model
+        Named ``"nominal"``, ``k = 0``; ``params`` holds the ``center`` and ``half_range`` of
+        its output, ``slope_sum`` (sum of the play weights) and ``rate_scale`` (95th
+        percentile of the moving input rate [input units / s]).
+
+    Examples
+    --------
+    >>> v = np.sin(np.linspace(0.0, 6 * np.pi, 300))
+    >>> y = 2.0 * v + 0.1  # a linear stage with an offset
+    >>> seg = make_segment(np.arange(300) * 1e-3, v, y, [0.0, 0.3])
+    >>> m = fit_nominal([seg])
+    >>> round(float(m.coef[0]), 6), round(float(m.coef[-1]), 6)  # slope, offset
+    (2.0, 0.1)
+    >>> round(float(np.max(np.abs(m.predict(seg) - y))), 6)
+    0.0
+    """
     model = _fit("nominal", 0, base_features, train)[0]
     h = np.concatenate([model.predict(s) for s in train])
     rate = np.concatenate([np.abs(np.diff(s.v)) / s.dt for s in train])
@@ -170,12 +410,58 @@ def fit_nominal(train) -> Model:
 def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None = None,
                nominal: Model | None = None) -> Model:
     """Fit the nominal model augmented with the effects ``combo + (name,)`` jointly; the grid
-    parameters of the effects in ``combo`` are held at ``fixed`` (from earlier rounds)."""
+    parameters of the effects in ``combo`` are held at ``fixed`` (from earlier rounds).
+
+    Parameters
+    ----------
+    name : str
+        The effect added, one of ``EFFECTS``.
+    train : list of Segment
+        The train records (``rate_column`` set when ``"rate"`` is among the effects).
+    combo : tuple of str
+        Effects chosen in earlier rounds.
+    fixed : dict or None
+        Their grid parameters (``fn``, ``zeta``, ``d``, ``clock``).
+    nominal : Model or None
+        The nominal model (:func:`fit_nominal` of ``train`` when None).
+
+    Returns
+    -------
+    Model
+        Named by the effects joined by ``+``, with ``k`` added parameters, the grid optimum in
+        ``grid`` and the fitted physical parameters in ``params``.
+
+    Examples
+    --------
+    >>> v = np.sin(np.linspace(0.0, 6 * np.pi, 300))
+    >>> seg = make_segment(np.arange(300) * 1e-3, v, 2.0 * v, [0.0, 0.3])
+    >>> m = fit_effect("creep", [seg])
+    >>> m.name, m.k, len(m.params["creep_lag_gains"])
+    ('creep', 4, 4)
+    """
     return _fit_combo((*combo, name), train, dict(fixed or {}), nominal or fit_nominal(train))
 
 
 def delay_grid(dt: float) -> np.ndarray:
-    """Coarse delay grid [samples]: every sample up to 12, then geometric up to MAX_DELAY_S."""
+    """Coarse delay grid [samples]: every sample up to 12, then geometric up to MAX_DELAY_S.
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Sorted whole delays [samples], from 0 to ``round(MAX_DELAY_S / dt)`` (at least 1).
+
+    Examples
+    --------
+    >>> delay_grid(5e-3).tolist()
+    [0, 1, 2, 3, 4]
+    >>> int(delay_grid(1e-4)[-1])
+    200
+    """
     dmax = max(int(round(MAX_DELAY_S / dt)), 1)
     coarse = np.concatenate((np.arange(min(dmax, 12) + 1), np.geomspace(12, dmax, 24)))
     return np.unique(np.round(coarse).astype(int)[coarse <= dmax])
