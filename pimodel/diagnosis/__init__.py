@@ -1,4 +1,27 @@
-"""Sim-to-real gap diagnosis (see :mod:`pimodel.diagnosis.diagnose`)."""
+"""Sim-to-real gap diagnosis: why measured records differ from the nominal PI model.
+
+:func:`diagnose` fits the nominal PI model on train records, measures the noise floor, ranks
+where the validate residual lies, and adds candidate effects (creep, dynamics, delay,
+asymmetry, drift, rate) while each lowers the Bayesian information criterion (BIC) on the
+validate records by a clear margin;
+it returns a :class:`DiagnosisReport`. The submodules:
+
+- :mod:`pimodel.diagnosis.diagnose`: :func:`diagnose` and :class:`DiagnosisReport`;
+- :mod:`pimodel.diagnosis.effects`: the records as segments, the nominal model and the
+  candidate effects, each fitted jointly with the hysteresis weights;
+- :mod:`pimodel.diagnosis.noise`: the measurement-noise floor of the records;
+- :mod:`pimodel.diagnosis.where`: the regions, bands and correlations of the residual;
+- :mod:`pimodel.diagnosis.plots`: the figures of a report.
+
+Examples
+--------
+>>> import pimodel.diagnosis as diagnosis
+>>> diagnosis.__all__
+['DiagnosisReport', 'diagnose']
+>>> from pimodel.diagnosis.effects import EFFECTS
+>>> EFFECTS
+('creep', 'dynamics', 'delay', 'asymmetry', 'drift', 'rate')
+"""
 
 from .diagnose import DiagnosisReport, diagnose
 
