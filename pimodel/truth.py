@@ -29,7 +29,40 @@ STEP_SHARE = 0.05  # a one-sample jump above this share of the input range is a 
 
 @dataclass
 class Truth:
-    """A simulated stage. ``None`` switches an effect off."""
+    """A simulated stage (input in V, output in um). ``None`` switches an effect off.
+
+    Parameters
+    ----------
+    weights : tuple of float
+        PI play weights [um/V].
+    radii : tuple of float
+        PI play radii [V], ascending, the first 0 (a linear play).
+    creep_percent_per_decade : float or None
+        Creep: percent of the last move added per decade of time.
+    mode_hz : float or None
+        First mechanical mode: natural frequency [Hz] (unit static gain).
+    mode_damping : float
+        Its damping ratio [-].
+    delay_s : float or None
+        Output delay [s], rounded to whole samples.
+    asymmetry : float or None
+        Quadratic output term ``asymmetry h**2 / half``, ``half`` the half range of ``h``.
+    drift_um_per_s : float or None
+        Linear drift [um/s].
+    drift_clock : str
+        ``"record"``: drift on ``t - t[0]`` of each record; ``"absolute"``: on ``t`` as given.
+    rate_gain : float or None
+        Play radii grow with the input rate (:func:`rate_dependent_pi`).
+    noise_um : float
+        Standard deviation of the white output noise [um].
+    extra : dict
+        Free annotations (not used by the simulation).
+
+    Examples
+    --------
+    >>> Truth(creep_percent_per_decade=1.5, delay_s=2e-4).effects
+    ['creep', 'delay']
+    """
 
     weights: tuple = STAGE_WEIGHTS
     radii: tuple = STAGE_RADII
@@ -52,7 +85,33 @@ class Truth:
         return [k for k, v in on.items() if v is not None]
 
     def simulate(self, t: np.ndarray, v: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t`` [s]."""
+        """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t`` [s].
+
+        The path ``v -> PI -> asymmetry -> creep -> mode -> delay -> + drift + noise``, plays
+        and filters starting at rest (plays at 0, filters around the first sample).
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Sample times [s], constant step.
+        v : numpy.ndarray
+            Input ``v[k]`` [V].
+        rng : numpy.random.Generator
+            Source of the noise.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``y[k]`` [um], same length as ``v``.
+
+        Examples
+        --------
+        >>> t = np.arange(4) * 1e-3
+        >>> y = Truth(weights=(2.0,), radii=(0.0,), noise_um=0.0).simulate(
+        ...     t, np.array([0.0, 0.5, 1.0, 0.5]), np.random.default_rng(0))
+        >>> y.tolist()
+        [0.0, 1.0, 2.0, 1.0]
+        """
         dt = float(t[1] - t[0])
         if self.rate_gain is None:
             y = PIOperator(self.weights, self.radii).simulate(v)
@@ -74,6 +133,31 @@ class Truth:
         return y + rng.normal(0.0, self.noise_um, y.size)
 
     def record(self, t, v, seed: int, name: str = "truth") -> Record:
+        """A :class:`pimodel.data.Record` of the simulated stage.
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Sample times [s].
+        v : numpy.ndarray
+            Input [V].
+        seed : int
+            Seed of the noise.
+        name : str
+            The record's ``source``.
+
+        Returns
+        -------
+        Record
+            ``t``, ``v`` and the output of :meth:`simulate` [um].
+
+        Examples
+        --------
+        >>> t = np.arange(3) * 1e-3
+        >>> rec = Truth(weights=(2.0,), radii=(0.0,), noise_um=0.0).record(t, np.ones(3), seed=0)
+        >>> rec.y.tolist()
+        [2.0, 2.0, 2.0]
+        """
         return Record(t, v, self.simulate(t, v, np.random.default_rng(seed)), source=name)
 
 
@@ -81,7 +165,34 @@ def rate_dependent_pi(weights, radii, v: np.ndarray, dt: float, gain: float) -> 
     """PI output ``y[k] = sum_i w_i z_i[k]`` with play radii that grow with the input rate,
     ``r_i[k] = r_i (1 + gain |v[k] - v[k-1]| / (dt RATE_REFERENCE))``; plays start at 0. A
     sampled step (a jump of more than ``STEP_SHARE`` of the input range in one sample) is no
-    rate the stage follows: its rate counts as 0."""
+    rate the stage follows: its rate counts as 0.
+
+    Parameters
+    ----------
+    weights : array_like
+        Play weights ``w_i`` [output units / input units].
+    radii : array_like
+        Play radii ``r_i`` at rest [input units].
+    v : numpy.ndarray
+        Input ``v[k]``.
+    dt : float
+        Sample time [s].
+    gain : float
+        Relative radius growth at the input rate ``RATE_REFERENCE`` [V/s].
+
+    Returns
+    -------
+    numpy.ndarray
+        ``y[k]``, same length as ``v``.
+
+    Examples
+    --------
+    >>> v = np.linspace(0.0, 1.0, 41)  # a ramp at 250 V/s with dt = 0.1 ms
+    >>> round(float(rate_dependent_pi([1.0], [0.1], v, 1e-4, 0.0)[-1]), 6)
+    0.9
+    >>> round(float(rate_dependent_pi([1.0], [0.1], v, 1e-4, 1.0)[-1]), 6)  # radius 0.2
+    0.8
+    """
     w, r = np.asarray(weights, float), np.asarray(radii, float)
     z = np.zeros(r.size)
     y = np.empty(v.size)
@@ -107,7 +218,33 @@ def _filter(G, x: np.ndarray, dt: float) -> np.ndarray:
 def excitation(kind: str, *, fs: float = 10_000.0, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Standard excitations (input in V, peak 1 V): ``train`` (triangles at 2 and 20 Hz, minor
     loops, steps with 0.2 s holds) and ``validate`` (sines at 5 and 40 Hz, minor loops, steps
-    with holds), each about 2.5 s."""
+    with holds); ``train`` lasts 3.0 s, ``validate`` 2.4 s.
+
+    Parameters
+    ----------
+    kind : str
+        ``"train"`` or ``"validate"``.
+    fs : float
+        Sample rate [Hz].
+    seed : int
+        Seed of the step levels.
+
+    Returns
+    -------
+    t, v : numpy.ndarray
+        Sample times from 0 [s] and input [V].
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is neither ``"train"`` nor ``"validate"``.
+
+    Examples
+    --------
+    >>> t, v = excitation("train", fs=1000.0)
+    >>> round(float(t[-1]), 1), round(float(np.max(np.abs(v))), 3)
+    (3.0, 1.0)
+    """
     rng = np.random.default_rng(seed)
     dt = 1.0 / fs
     parts = []
@@ -138,7 +275,34 @@ def excitation(kind: str, *, fs: float = 10_000.0, seed: int = 0) -> tuple[np.nd
 
 def random_truth(effects, seed: int, drift_clock: str = "record") -> Truth:
     """A truth with the named effects at random realistic magnitudes (seeded); a drift runs on
-    ``drift_clock`` (``"record"``: each record's own clock, ``"absolute"``: ``t`` as given)."""
+    ``drift_clock`` (``"record"``: each record's own clock, ``"absolute"``: ``t`` as given).
+
+    Parameters
+    ----------
+    effects : iterable of str
+        Names from ``EFFECTS``.
+    seed : int
+        Seed of the magnitudes.
+    drift_clock : str
+        Clock of a drift.
+
+    Returns
+    -------
+    Truth
+        The nominal stage (``STAGE_WEIGHTS``, ``STAGE_RADII``) with those effects and a noise
+        of 3-10 nm.
+
+    Raises
+    ------
+    ValueError
+        If an effect is not in ``EFFECTS``.
+
+    Examples
+    --------
+    >>> truth = random_truth(["dynamics", "delay"], seed=1)
+    >>> truth.effects, 500 <= truth.mode_hz <= 3000
+    (['dynamics', 'delay'], True)
+    """
     rng = np.random.default_rng(1000 + seed)
     unknown = set(effects) - set(EFFECTS)
     if unknown:
