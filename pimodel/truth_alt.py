@@ -42,7 +42,53 @@ OUTSIDE = ("dead_zone", "second_input", "bouc_wen")
 
 @dataclass
 class AltTruth:
-    """A Bouc-Wen stage; ``None`` switches an effect off (see the module docstring)."""
+    """A stage with Preisach (or Bouc-Wen) hysteresis and optional unmodelled effects;
+    ``None`` switches an effect off (see the module docstring). Input in V, output in um.
+
+    Parameters
+    ----------
+    k_lin : float
+        Linear part ``k`` [um/V].
+    preisach_c : float
+        Preisach density scale ``c`` [um/V^2].
+    preisach_h0 : float
+        Decay ``h0`` of the density in ``a - b`` [V].
+    bouc_wen : bool
+        Bouc-Wen instead of Preisach hysteresis.
+    bw_a : float
+        Bouc-Wen ``A`` [um/V].
+    bw_beta : float
+        Bouc-Wen ``beta`` [1/V].
+    bw_gamma : float
+        Bouc-Wen ``gamma`` [1/V].
+    rate : float or None
+        Relative growth of the Preisach part per ``RATE_REF`` of (low-passed) input rate.
+    asymmetry : float or None
+        Exponent ``a`` of the static map ``u -> (exp(a u) - 1) / a``.
+    creep : float or None
+        Fraction of a move added per decade of time (log law).
+    modes : tuple or None
+        ``((f1, zeta1, gain1), (f2, zeta2, gain2))``: modes in parallel [Hz, -, -].
+    delay_s : float or None
+        Fractional output delay [s].
+    drift : float or None
+        Linear drift [um/s].
+    drift_clock : str
+        ``"absolute"``: on ``t`` as given; ``"record"``: on ``t - t[0]`` of each record.
+    dead_zone : float or None
+        Half width of a dead zone on the input [V].
+    second_input : float or None
+        Amplitude of a slow random disturbance the model does not see [um].
+    noise : float
+        Standard deviation of the white noise [um]; the AR(1) part has the same size.
+    noise_ar : float
+        Pole of the AR(1) noise.
+
+    Examples
+    --------
+    >>> AltTruth(creep=0.01, dead_zone=0.2).effects  # the dead zone is outside the vocabulary
+    ['creep']
+    """
 
     k_lin: float = 6.0  # um/V
     preisach_c: float = 8.0  # um/V^2, density scale
@@ -70,13 +116,49 @@ class AltTruth:
         return [k for k, v in on.items() if v is not None]
 
     def everett(self, a: float, b: float) -> float:
-        """Preisach weight of the triangle ``b <= beta <= alpha <= a`` (``a >= b``)."""
+        """Preisach weight of the triangle ``b <= beta <= alpha <= a`` (``a >= b``).
+
+        Parameters
+        ----------
+        a : float
+            Upper switching value [V].
+        b : float
+            Lower switching value [V].
+
+        Returns
+        -------
+        float
+            The Everett function ``E(a, b)`` [um].
+
+        Examples
+        --------
+        >>> truth = AltTruth()
+        >>> float(truth.everett(0.5, 0.5)), round(float(truth.everett(1.0, 0.0)), 4)
+        (0.0, 1.7057)
+        """
         d, h0 = a - b, self.preisach_h0
         return self.preisach_c * h0 * (d - h0 * (1.0 - np.exp(-d / h0)))
 
     def preisach(self, v: np.ndarray) -> np.ndarray:
         """Preisach output ``P[v][k]`` from negative saturation: ``-E(U, -U) + 2 sum_k
-        (E(M_k, m_{k-1}) - E(M_k, m_k))`` over the alternating dominant extrema."""
+        (E(M_k, m_{k-1}) - E(M_k, m_k))`` over the alternating dominant extrema.
+
+        Parameters
+        ----------
+        v : numpy.ndarray
+            Input ``v[k]`` [V], clipped to ``+-U_SAT``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``P[v][k]`` [um]; ``y[k]`` depends on ``v[0..k]``.
+
+        Examples
+        --------
+        >>> p = AltTruth().preisach(np.array([-1.2, 1.2, 0.0, 1.2]))
+        >>> bool(np.isclose(p[0], -p[1])), bool(np.isclose(p[3], p[1]))  # saturations
+        (True, True)
+        """
         ext = [-U_SAT]  # m0, M1, m1, M2, ...: even index a minimum, odd a maximum; last = input
         out = np.empty(v.size)
         e_sat = self.everett(U_SAT, -U_SAT)
@@ -105,7 +187,25 @@ class AltTruth:
     def hysteresis(self, v: np.ndarray, dt: float) -> np.ndarray:
         """``k v[k] + P[v][k]`` (Preisach, rate-dependent width) or, with ``bouc_wen``, the
         Bouc-Wen output ``k v[k] + z[k]`` (explicit sub-stepped integration, ``z = 0`` at the
-        start)."""
+        start).
+
+        Parameters
+        ----------
+        v : numpy.ndarray
+            Input ``v[k]`` [V].
+        dt : float
+            Sample time [s] (for the rate dependence).
+
+        Returns
+        -------
+        numpy.ndarray
+            The hysteresis output [um].
+
+        Examples
+        --------
+        >>> AltTruth(preisach_c=0.0).hysteresis(np.array([0.0, 0.5]), 2e-4).tolist()
+        [0.0, 3.0]
+        """
         if not self.bouc_wen:
             p = self.preisach(v)
             if self.rate is not None:
@@ -127,7 +227,29 @@ class AltTruth:
         return out
 
     def simulate(self, t: np.ndarray, v: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t[k]`` [s]."""
+        """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t[k]`` [s].
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Sample times [s], constant step.
+        v : numpy.ndarray
+            Input ``v[k]`` [V].
+        rng : numpy.random.Generator
+            Source of the noise and of the second input.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``y[k]`` [um], same length as ``v``.
+
+        Examples
+        --------
+        >>> t = np.arange(3) * 2e-4
+        >>> AltTruth(preisach_c=0.0, noise=0.0).simulate(t, np.array([0.0, 0.5, 1.0]),
+        ...                                              np.random.default_rng(0)).tolist()
+        [0.0, 3.0, 6.0]
+        """
         dt = float(t[1] - t[0])
         x = v
         if self.dead_zone is not None:
@@ -165,7 +287,24 @@ class AltTruth:
 def excitations(seed: int) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
     """Train and validate inputs ``(t, v)`` [s, V] at 5 kHz on one clock (validate starts 1 s
     after train ends). Train: three 8 Hz sine cycles, a 25 Hz sine with decaying amplitude,
-    holds; validate: three 12.5 Hz triangle cycles, nested decaying 5 Hz minor loops, holds."""
+    holds; validate: three 12.5 Hz triangle cycles, nested decaying 5 Hz minor loops, holds.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the hold levels.
+
+    Returns
+    -------
+    tuple
+        ``((t_train, v_train), (t_validate, v_validate))``, arrays [s] and [V].
+
+    Examples
+    --------
+    >>> (t_tr, v_tr), (t_va, v_va) = excitations(seed=0)
+    >>> round(float(t_va[0] - t_tr[-1]), 6), t_tr.size, t_va.size
+    (1.0, 8275, 9200)
+    """
     rng = np.random.default_rng(seed)
     dt = 1.0 / FS
 
@@ -192,7 +331,33 @@ def excitations(seed: int) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndar
 def random_alt_truth(effects, seed: int, drift_clock: str = "absolute") -> AltTruth:
     """An :class:`AltTruth` with the named effects (from ``EFFECTS`` and ``OUTSIDE``) at random
     realistic magnitudes (seeded); a drift runs on ``drift_clock`` (``"absolute"``: the clock
-    the records share, ``"record"``: each record's own)."""
+    the records share, ``"record"``: each record's own).
+
+    Parameters
+    ----------
+    effects : iterable of str
+        Names from ``EFFECTS`` and ``OUTSIDE``.
+    seed : int
+        Seed of the magnitudes.
+    drift_clock : str
+        Clock of a drift.
+
+    Returns
+    -------
+    AltTruth
+        The stage (its hysteresis parameters are also drawn at random).
+
+    Raises
+    ------
+    ValueError
+        If an effect is in neither ``EFFECTS`` nor ``OUTSIDE``.
+
+    Examples
+    --------
+    >>> truth = random_alt_truth(["creep", "dead_zone"], seed=0)
+    >>> truth.effects, 0.15 <= truth.dead_zone <= 0.25
+    (['creep'], True)
+    """
     unknown = set(effects) - set(EFFECTS) - set(OUTSIDE)
     if unknown:
         raise ValueError(f"effects: unknown {sorted(unknown)}; known: {EFFECTS + OUTSIDE}")
