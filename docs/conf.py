@@ -93,6 +93,13 @@ STRICT_MODULES = [
     "pimodel.fmu.unit",
     "pimodel.fmu.cosim",
     "pimodel.fmu.compare",
+    "pimodel.diagnosis",  # the package docstring
+    "pimodel.diagnosis.effects",
+    "pimodel.diagnosis.where",
+    "pimodel.diagnosis.noise",
+    "pimodel.diagnosis.plots",
+    "pimodel.truth",
+    "pimodel.truth_alt",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the
