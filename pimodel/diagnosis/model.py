@@ -230,6 +230,35 @@ class DiagnosedModel:
         path.write_text(json.dumps(self.to_dict(), indent=1) + "\n")
         return path
 
+    def operator_form(self):
+        """The model as an operator that ``pimodel fmu build --model`` accepts.
+
+        Only the nominal model (no effects) has one: a
+        :class:`~pimodel.generalized.GeneralizedPI` with the weights (signed, positive partial
+        sums) and the offset as an affine output envelope, equal to :meth:`simulate`. The
+        diagnosis fits the effects in parallel to the hysteresis (module docstring), which no
+        chain of the operator FMUs reproduces.
+
+        Returns
+        -------
+        pimodel.generalized.GeneralizedPI
+
+        Raises
+        ------
+        ValueError
+            A model with effects (named), or weights the PI operator refuses.
+        """
+        from ..envelopes import Envelope
+        from ..generalized import GeneralizedPI
+
+        if self.effects:
+            raise ValueError(f"model: the effects {list(self.effects)} are fitted in parallel "
+                             "to the hysteresis; no operator chain (and so no FMU) reproduces "
+                             "them; only the nominal model has an operator form")
+        return GeneralizedPI(self.weights, self.radii,
+                             signed_weights=bool(np.any(self.weights <= 0)),
+                             output_envelope=Envelope.affine(1.0, self.offset))
+
     def static_part(self) -> DiagnosedModel:
         """The model without its dynamics and delay (what the inverse solves exactly)."""
         return replace(self, effects=tuple(e for e in self.effects
@@ -394,7 +423,7 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
             rho = dv / m.dt / p["rate_scale"] if dv <= step else 0.0
             dz = z_new - z
             memory = np.where(dz != 0, -np.sign(dz) * rho, memory)
-        guess = vk if first else 2 * vk - v_prev  # the root nearest the extrapolated input
+        guess = vk  # the next sample takes the root nearest this one (the input's branch)
         z, v_prev = z_new, vk
     return out
 
