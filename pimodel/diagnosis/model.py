@@ -423,7 +423,9 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
             rho = dv / m.dt / p["rate_scale"] if dv <= step else 0.0
             dz = z_new - z
             memory = np.where(dz != 0, -np.sign(dz) * rho, memory)
-        guess = vk  # the next sample takes the root nearest this one (the input's branch)
+        # the next sample takes the root nearest the extrapolated input (a smooth input's
+        # branch), or nearest this one after a jump (a step)
+        guess = vk if first or abs(vk - v_prev) > 0.01 * span else 2 * vk - v_prev
         z, v_prev = z_new, vk
     return out
 
