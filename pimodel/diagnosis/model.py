@@ -20,11 +20,15 @@ diagnosis' own prediction.
 
 The inverse solves, sample by sample, ``F_k(v[k]) = y_d[k]``: with the play states, the lags
 and the rate memory of sample k - 1 fixed, ``F_k`` is a polynomial of degree at most 3 in
-``v[k]`` between the play breakpoints ``z_i[k-1] -+ r_i`` (and ``v[k-1]``, where the rate term
-bends), so the root is exact to rounding. Exact (round trip to 1e-9) for the nominal model and
-for creep, asymmetry and rate, alone or together, while ``F_k`` is monotone on the operating
-range. Approximations, by choice:
+``v[k]`` between the play breakpoints ``z_i[k-1] -+ r_i`` (and ``v[k-1]``), so the root is
+exact to rounding. Exact (round trip to 1e-9) for the nominal model and
+for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input.
+Approximations, by choice:
 
+* **rate**: the rate term of sample k is taken from sample k - 1 (each play's last push up to
+  k - 1). Solved exactly, the term ``-r g |v[k] - v[k-1]| / (dt rate_scale)`` makes ``F_k``
+  steep and non-monotone, and the feedforward follows wrong roots (measured: open-loop errors
+  6 to 9 times the nominal's).
 * **delay**: not inverted; the feedforward is advanced by the delay (``y_d[k + d]``, linear
   interpolation): it needs the reference ``d`` samples ahead (a known trajectory).
 * **dynamics**: the mode is replaced by a stable approximate inverse, ``M(s)^-1`` times the
@@ -396,12 +400,8 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
             if asym:
                 u = (h0 - p["center"]) / p["half_range"]
                 y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-            if rate and not first:
-                dz = Zc - z[None, :]
-                dv = np.abs(vs - v_prev)
-                rho = np.where(dv <= step, dv / m.dt / p["rate_scale"], 0.0)
-                per = np.where(dz != 0, -np.sign(dz) * rho[:, None], memory[None, :])
-                y = y + per @ rg
+            if rate and not first:  # held from sample k - 1 (see the module docstring)
+                y = y + memory @ rg
             return y
 
         b = np.concatenate((z - r, z + r, [v_prev]))
