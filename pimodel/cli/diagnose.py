@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
 from ..data import load_record
 from .common import add_columns_option, refuse_overwrite
+
+EXPORT_FILES = ("augmented.json", "nominal.json", "nominal.model.json",
+                "nominal_1_GeneralizedPI.fmu")
 
 
 def register(sub) -> None:
@@ -29,6 +33,14 @@ def register(sub) -> None:
     p.add_argument("--initial-state", choices=("rest", "unknown"), default="rest",
                    help="'unknown': leave each record's start-up region (until the input first "
                    "spans 90 %% of its range) out of fitting and scoring (default: rest)")
+    p.add_argument("--export", default=None, metavar="DIR",
+                   help="write the augmented and the nominal model as JSON (augmented.json, "
+                   "nominal.json: pimodel.diagnosis.model.load_diagnosed_model) and the "
+                   "nominal model's FMU (FMI 2; nominal.model.json is its operator JSON for "
+                   "'pimodel fmu build --model'); the augmented model has no FMU (its effects "
+                   "are fitted in parallel to the hysteresis: the reason is printed)")
+    p.add_argument("--no-fmu", action="store_true",
+                   help="with --export: write the JSON files only (no C compiler needed)")
     add_columns_option(p)
     p.set_defaults(func=run)
 
@@ -36,8 +48,11 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..diagnosis import diagnose
 
+    exported = {f"--export {name}": str(Path(args.export) / name) for name in EXPORT_FILES} \
+        if args.export else {}
     refuse_overwrite({"--train": args.train, "--validate": args.validate},
-                     {"--json": args.json}, {"--plots": args.plots})
+                     {"--json": args.json, **exported}, {"--plots": args.plots,
+                                                         "--export": args.export})
     train = [load_record(f, columns=args.columns) for f in args.train]
     validate = [load_record(f, columns=args.columns) for f in args.validate]
     rep = diagnose(train, validate, initial_state=args.initial_state)
@@ -51,4 +66,37 @@ def run(args: argparse.Namespace) -> int:
     print(json.dumps({k: v[k] for k in ("effects", "gap_before", "gap_after", "shrink",
                                         "noise_floor", "noise_floor_method")}, indent=1))
     print(f"wrote {args.json}")
+    if args.export:
+        for path in export_models(rep, args.export, fmu=not args.no_fmu):
+            print(f"wrote {path}")
     return 0
+
+
+def export_models(rep, out_dir, *, fmu: bool = True) -> list:
+    """Write ``augmented.json``, ``nominal.json``, ``nominal.model.json`` (operator JSON) and,
+    with ``fmu``, the nominal model's FMU into ``out_dir``; returns the paths written."""
+    from ..models import save_model
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    aug, nom = rep.model(augmented=True), rep.model(augmented=False)
+    paths = [aug.save(out / "augmented.json"), nom.save(out / "nominal.json")]
+    try:
+        op = nom.operator_form()
+    except ValueError as err:
+        print(f"no operator form of the nominal model: {err}")
+        return paths
+    paths.append(save_model(op, out / "nominal.model.json"))
+    if aug.effects:
+        try:
+            aug.operator_form()
+        except ValueError as err:
+            print(f"augmented model: no FMU ({err})")
+    if fmu:
+        from ..fmu.model_fmu import build_model_fmus
+
+        try:
+            paths += build_model_fmus(op, out, Ts=nom.dt, stem="nominal")
+        except ValueError as err:
+            print(f"nominal model: no FMU ({err})")
+    return paths

@@ -77,6 +77,43 @@ class DiagnosisReport:
     validate: list
     before: list
     after: list
+    fitted: dict | None = None  # internals for :meth:`model` (radii, projection, models, dt)
+
+    def model(self, augmented: bool = True):
+        """The nominal or the augmented model the verdict chose, as one object.
+
+        Parameters
+        ----------
+        augmented : bool
+            True: the model with the effects of ``verdict["effects"]`` (as fitted, jointly with
+            the hysteresis weights); False: the nominal PI (+ offset).
+
+        Returns
+        -------
+        pimodel.diagnosis.model.DiagnosedModel
+            With ``simulate(v, t=None)``, ``inverse()``, ``to_dict()``.
+
+        Raises
+        ------
+        ValueError
+            A report without the fitted internals (e.g. rebuilt from JSON).
+
+        Examples
+        --------
+        >>> from pimodel.truth import excitation, random_truth
+        >>> truth = random_truth(["creep"], 0)
+        >>> tt, vt = excitation("train", seed=1)
+        >>> tv, vv = excitation("validate", seed=2)
+        >>> rep = diagnose([truth.record(tt, vt, 1)], [truth.record(tv, vv, 2)])
+        >>> rep.model().effects
+        ('creep',)
+        """
+        from .model import DiagnosedModel
+
+        if self.fitted is None:
+            raise ValueError("report: no fitted model kept (only reports from diagnose() have "
+                             "one)")
+        return DiagnosedModel.from_fit(self.fitted, augmented=augmented)
 
     def to_json(self) -> dict:
         return {"nominal": self.nominal, "where": self.where, "candidates": self.candidates,
@@ -213,8 +250,8 @@ def _compressed(tr, va, nominal: Model):
     """Segments whose play columns are replaced by a few combinations (the nominal's own
     weights, then the leading principal directions of the train play outputs), as few as keep
     the nominal train RSS within 1 %; the candidates' grid searches filter these columns only.
-    Returns the new segments and the nominal refitted on them (with the full model's
-    ``params``)."""
+    Returns the new segments, the nominal refitted on them (with the full model's
+    ``params``) and the projection ``V`` (play columns = ``Z @ V``; None: not compressed)."""
     n = tr[0].Z.shape[1]
     G = sum(s.Z[s.used].T @ s.Z[s.used] for s in tr)
     _, vecs = np.linalg.eigh(G)
@@ -222,15 +259,16 @@ def _compressed(tr, va, nominal: Model):
     rss_full = sum(float(np.sum((nominal.predict(s) - s.y)[s.used] ** 2)) for s in tr)
     for q in (32, n):
         if q >= n:
-            return tr, va, nominal
+            return tr, va, nominal, None
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :q]))
         ctr = [Segment(s.t, s.v, s.y, s.Z @ V, s.mask, s.rate_column) for s in tr]
         m = fit_nominal(ctr)
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
         if rss <= 1.01 * rss_full:
             m.params = dict(nominal.params)
-            return ctr, [Segment(s.t, s.v, s.y, s.Z @ V, s.mask, s.rate_column) for s in va], m
-    return tr, va, nominal
+            return (ctr, [Segment(s.t, s.v, s.y, s.Z @ V, s.mask, s.rate_column) for s in va],
+                    m, V)
+    return tr, va, nominal, None
 
 
 def _variants(name: str) -> list[dict]:
@@ -262,7 +300,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     for s in tr + va:
         s.rate_column = rate_columns(s.Z, radii, s.v, s.dt, nominal.params["rate_scale"],
                                      RATE_BANDS)
-    tr, va, nominal = _compressed(tr, va, nominal)
+    full_nominal = nominal
+    tr, va, nominal, proj = _compressed(tr, va, nominal)
     segs = tr + va
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
@@ -360,7 +399,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
                "unexplained": unexplained, "alternatives": alternatives,
                "model": current.params, "evidence": evidence}
-    return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out)
+    fitted = {"radii": radii, "projection": proj, "nominal": full_nominal, "reference": nominal,
+              "chosen": chosen,
+              "model": current, "dt": dt}
+    return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
+                           fitted)
 
 
 def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float) -> dict:

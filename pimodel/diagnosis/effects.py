@@ -585,7 +585,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
-                 bands: int = 4) -> np.ndarray:
+                 bands: int = 4, *, input_range: float | None = None) -> np.ndarray:
     """Output change per unit weight and unit ``c`` when the play radii grow with the input rate,
     ``r_i[k] = r_i (1 + c rho[k])``, ``rho = |v[k] - v[k-1]| / dt / rate_scale`` (0 at a
     sampled step, a one-sample jump of more than ``STEP_SHARE`` of the input range: no rate a
@@ -609,6 +609,8 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
         Input rate [input units / s] that makes ``rho = 1``.
     bands : int
         Groups of plays.
+    input_range : float, optional
+        The range of the step rule (default ``ptp(v)``).
 
     Returns
     -------
@@ -623,7 +625,8 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
     [0.0, 0.0, -0.5, -0.5]
     """
     dv = np.abs(np.diff(v, prepend=v[0]))
-    rho = np.where(dv <= STEP_SHARE * float(np.ptp(v)), dv / dt / rate_scale, 0.0)
+    span = float(np.ptp(v)) if input_range is None else float(input_range)
+    rho = np.where(dv <= STEP_SHARE * span, dv / dt / rate_scale, 0.0)
     dz = np.diff(Z, axis=0, prepend=Z[:1])
     pushed = dz != 0
     k = np.arange(Z.shape[0])[:, None]

@@ -1,0 +1,87 @@
+"""DiagnosisReport.model(): the nominal and augmented models as objects, their forward
+simulation (equal to the diagnosis' own predictions), inverse feedforward and JSON form."""
+
+import numpy as np
+import pytest
+
+from pimodel.diagnosis import diagnose
+from pimodel.diagnosis.model import DiagnosedModel, load_diagnosed_model
+from pimodel.truth import excitation, random_truth
+
+N_ROUND_TRIP = 3000  # samples of the validate input in the round trips (the solve is per sample)
+
+
+def _report(effect: str, seed: int = 0):
+    truth = random_truth([effect], seed)
+    tt, vt = excitation("train", seed=1)
+    tv, vv = excitation("validate", seed=2)
+    rec = truth.record(tv, vv, 2)
+    return diagnose([truth.record(tt, vt, 1)], [rec]), rec
+
+
+@pytest.fixture(scope="module", params=["creep", "asymmetry"])
+def invertible(request):
+    return request.param, *_report(request.param)
+
+
+def test_model_equals_the_diagnosis_prediction(invertible):
+    effect, rep, rec = invertible
+    assert rep.verdict["effects"] == [effect]
+    aug, nom = rep.model(), rep.model(augmented=False)
+    assert aug.effects == (effect,) and nom.effects == ()
+    scale = float(np.ptp(rec.y))
+    assert np.max(np.abs(aug.simulate(rec.v, rec.t) - rep.after[0])) < 1e-10 * scale
+    assert np.max(np.abs(nom.simulate(rec.v, rec.t) - rep.before[0])) < 1e-10 * scale
+
+
+def test_inverse_round_trip_is_exact(invertible):
+    effect, rep, rec = invertible
+    for model in (rep.model(), rep.model(augmented=False)):
+        v = rec.v[:N_ROUND_TRIP]
+        y = model.simulate(v)
+        assert np.max(np.abs(model.inverse().simulate(y) - v)) < 1e-9
+
+
+def test_json_round_trip(invertible, tmp_path):
+    _, rep, rec = invertible
+    model = rep.model()
+    again = load_diagnosed_model(model.save(tmp_path / "m.json"))
+    v = rec.v[:N_ROUND_TRIP]
+    assert np.array_equal(again.simulate(v), model.simulate(v))
+    assert again.effects == model.effects
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("effect", ["delay", "dynamics", "drift", "rate"])
+def test_other_effects_equal_the_diagnosis_prediction(effect):
+    rep, rec = _report(effect)
+    if rep.verdict["effects"] != [effect]:
+        pytest.skip(f"verdict {rep.verdict['effects']} (not this test's subject)")
+    aug = rep.model()
+    assert np.max(np.abs(aug.simulate(rec.v, rec.t) - rep.after[0])) < 1e-9 * np.ptp(rec.y)
+    v_ff = aug.inverse().simulate(aug.simulate(rec.v[:N_ROUND_TRIP]))
+    assert v_ff.shape == (N_ROUND_TRIP,) and np.all(np.isfinite(v_ff))
+
+
+def test_synthetic_creep_asymmetry_round_trip():
+    params = {"creep_lag_gains": [0.04, -0.01], "creep_time_constants_s": [0.01, 0.2],
+              "asymmetry_quadratic": 0.05, "asymmetry_cubic": -0.01, "center": 0.8,
+              "half_range": 1.0}
+    m = DiagnosedModel([0.0, 0.2, 0.5], [1.0, 0.4, 0.3], 0.2, dt=1e-3,
+                       effects=("creep", "asymmetry"), reference_weights=[0.9, 0.45, 0.3],
+                       reference_offset=0.1, params=params)
+    t = np.arange(4000) * 1e-3
+    v = np.sin(2 * np.pi * 1.3 * t) * (1 + 0.5 * np.sin(2 * np.pi * 0.2 * t))
+    assert np.max(np.abs(m.inverse().simulate(m.simulate(v)) - v)) < 1e-9
+
+
+def test_bad_input():
+    m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)
+    with pytest.raises(ValueError, match="y_d"):
+        m.inverse().simulate([1.0, np.nan, 2.0])
+    with pytest.raises(ValueError, match="weights"):
+        DiagnosedModel([0.0, 0.5], [1.0], 0.0, dt=1e-3)
+    with pytest.raises(ValueError, match="effects"):
+        DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3, effects=("wobble",))
+    with pytest.raises(ValueError, match="missing key 'weights'"):
+        DiagnosedModel.from_dict({"type": "DiagnosedModel", "radii": [0.0]})
