@@ -30,15 +30,16 @@ def _case(generator: str, effect: str, seed: int):
                                          "augmented": rep.model()})
 
 
-# measured figures: docs/notes/i19c.md; two truth_alt creep seeds miss the target (strict
-# xfail, so a fix shows)
+# measured figures: docs/notes/i19c.md; two truth_alt creep seeds miss the target (xfail;
+# strict where the miss is clear, so a fix shows)
 @pytest.mark.slow
 @pytest.mark.parametrize("generator,effect,seed", [
     ("truth", "creep", 0), ("truth", "creep", 1), ("truth", "asymmetry", 0),
     ("truth", "asymmetry", 1), ("truth_alt", "asymmetry", 0), ("truth_alt", "asymmetry", 1),
     ("truth_alt", "creep", 2),
+    # 1.95x is too close to the target for a strict xfail: another machine may land above 2x
     pytest.param("truth_alt", "creep", 0, marks=pytest.mark.xfail(
-        strict=True, reason="measured 1.95x (creep + drift verdict)")),
+        strict=False, reason="measured 1.95x (creep + drift verdict)")),
     pytest.param("truth_alt", "creep", 1, marks=pytest.mark.xfail(
         strict=True, reason="measured 1.38x: the log-law creep beyond the four lags")),
 ])
