@@ -11,7 +11,11 @@ it returns a :class:`DiagnosisReport`. The submodules:
   candidate effects, each fitted jointly with the hysteresis weights;
 - :mod:`pimodel.diagnosis.noise`: the measurement-noise floor of the records;
 - :mod:`pimodel.diagnosis.where`: the regions, bands and correlations of the residual;
-- :mod:`pimodel.diagnosis.plots`: the figures of a report.
+- :mod:`pimodel.diagnosis.plots`: the figures of a report;
+- :mod:`pimodel.diagnosis.model`: :class:`~pimodel.diagnosis.model.DiagnosedModel`, the model a
+  report chose (:meth:`DiagnosisReport.model`), with its causal feedforward inverse;
+- :mod:`pimodel.diagnosis.feedforward`: open-loop feedforward with such a model, tried on a
+  simulated true stage.
 
 Examples
 --------
