@@ -79,6 +79,8 @@ def stability_bound(weights, dt: float) -> float:
     1801.8
     """
     p = as_vector(weights, "weights")
+    if np.any(p <= 0):
+        raise ValueError(f"weights: every weight must be > 0, got {p.tolist()}")
     return 2.0 / (positive_scalar(dt, "dt") * float(p @ p))
 
 
@@ -149,6 +151,8 @@ def default_settings(v, y, weights, *, dt: float) -> dict:
     x = as_signal(v, "v", min_length=3)
     m = as_signal(y, "y", min_length=3)
     p = as_vector(weights, "weights")
+    if np.any(p <= 0):
+        raise ValueError(f"weights: every weight must be > 0, got {p.tolist()}")
     dt = positive_scalar(dt, "dt")
     pp = float(p @ p)
     span_v = float(np.ptp(x))

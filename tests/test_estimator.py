@@ -286,3 +286,14 @@ def test_known_linear_play_is_a_deprecated_name_of_linear_play():
     with pytest.warns(DeprecationWarning, match="known_linear_play is deprecated"):
         res = estimate_radii(v, y, [1.0, 0.5], dt=1e-3, known_linear_play=True)
     assert res.radii[0] == 0.0
+
+
+@pytest.mark.parametrize("weights", [[0.0], [1.0, 0.0], [-1.0]])
+def test_settings_from_the_record_reject_non_positive_weights(weights):
+    """Found by the API fuzz: weights [0] reached the default-settings formula (a division by
+    |p|^2) before the weights were checked."""
+    v = np.sin(np.linspace(0, 20, 500))
+    with pytest.raises(ValueError, match="weights: every weight must be > 0"):
+        estimate_radii(v, v, weights, dt=1e-3, slope_window=2)
+    with pytest.raises(ValueError, match="weights: every weight must be > 0"):
+        default_settings(v, v, weights, dt=1e-3)
