@@ -93,6 +93,9 @@ STRICT_MODULES = [
     "pimodel.fmu.unit",
     "pimodel.fmu.cosim",
     "pimodel.fmu.compare",
+    "pimodel.diagnosis.diagnose",
+    "pimodel.diagnosis.model",
+    "pimodel.diagnosis.feedforward",
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",
     "pimodel.diagnosis.where",

@@ -68,7 +68,33 @@ EFFECT_SIGNATURES = {
 
 @dataclass
 class DiagnosisReport:
-    """Result of :func:`diagnose`; ``to_json()`` gives nominal, where, candidates, verdict."""
+    """Result of :func:`diagnose`; ``to_json()`` gives nominal, where, candidates, verdict.
+
+    Parameters
+    ----------
+    nominal : dict
+        The nominal PI model: its grid, parameters and train/validate errors.
+    where : dict
+        Where the nominal's validate residual lies (:mod:`.where`).
+    candidates : list of dict
+        Every effect tried, with its fit and scores.
+    verdict : dict
+        ``effects``, ``gap_before``/``gap_after``, ``shrink``, ``noise_floor``,
+        ``unexplained`` (see :func:`diagnose`).
+    validate : list of Record
+        The validate records.
+    before, after : list of numpy.ndarray
+        Validate predictions of the nominal and of the chosen model, one per record.
+    fitted : dict, optional
+        Internals for :meth:`model` (radii, projection, models, dt); None in a report
+        rebuilt from JSON.
+
+    Examples
+    --------
+    >>> rep = DiagnosisReport({"bic": 1.0}, {}, [], {"effects": ["none"]}, [], [], [])
+    >>> rep.to_json()["verdict"]
+    {'effects': ['none']}
+    """
 
     nominal: dict
     where: dict
@@ -116,10 +142,45 @@ class DiagnosisReport:
         return DiagnosedModel.from_fit(self.fitted, augmented=augmented)
 
     def to_json(self) -> dict:
+        """The report as plain data: nominal, where, candidates and verdict.
+
+        Returns
+        -------
+        dict
+            Keys ``nominal``, ``where``, ``candidates``, ``verdict`` (the validate records and
+            predictions are left out).
+
+        Examples
+        --------
+        >>> rep = DiagnosisReport({"bic": 1.0}, {}, [], {"effects": ["none"]}, [], [], [])
+        >>> sorted(rep.to_json())
+        ['candidates', 'nominal', 'verdict', 'where']
+        """
         return {"nominal": self.nominal, "where": self.where, "candidates": self.candidates,
                 "verdict": self.verdict}
 
     def save_json(self, path) -> Path:
+        """Write :meth:`to_json` as JSON to ``path`` (parent folders are created).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file to write.
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+
+        Examples
+        --------
+        >>> import json, tempfile
+        >>> from pathlib import Path
+        >>> rep = DiagnosisReport({"bic": 1.0}, {}, [], {"effects": ["none"]}, [], [], [])
+        >>> with tempfile.TemporaryDirectory() as d:
+        ...     json.loads(rep.save_json(Path(d) / "r.json").read_text())["verdict"]
+        {'effects': ['none']}
+        """
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(self.to_json(), indent=2, default=_plain))

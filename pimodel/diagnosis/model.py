@@ -172,6 +172,12 @@ class DiagnosedModel:
         ------
         ValueError
             ``v`` not a finite 1-D signal, ``t`` of another length.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+        >>> m.simulate([0.0, 1.0, 0.0]).round(3).tolist()
+        [0.1, 1.35, 0.35]
         """
         v = _signal(v, "v")
         tk = self._clock(v, t)
@@ -199,7 +205,19 @@ class DiagnosedModel:
         return y
 
     def inverse(self) -> DiagnosedInverse:
-        """The causal feedforward inverse (module docstring: exact or approximate per effect)."""
+        """The causal feedforward inverse (module docstring: exact or approximate per effect).
+
+        Returns
+        -------
+        DiagnosedInverse
+            Its ``simulate(y_d)`` gives the input that makes this model follow ``y_d``.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+        >>> m.inverse().simulate([0.1, 1.35, 0.35]).round(6).tolist()
+        [0.0, 1.0, 0.0]
+        """
         return DiagnosedInverse(self)
 
     @property
@@ -209,7 +227,23 @@ class DiagnosedModel:
 
     # -- JSON ---------------------------------------------------------------------------
     def to_dict(self) -> dict:
-        """JSON form ``{"type": "DiagnosedModel", ...}`` (:func:`load_diagnosed_model`)."""
+        """JSON form ``{"type": "DiagnosedModel", ...}`` (:func:`load_diagnosed_model`).
+
+        Returns
+        -------
+        dict
+            ``type``, ``radii``, ``weights``, ``offset``, ``dt``, ``effects``,
+            ``reference_weights``, ``reference_offset``, ``params`` (plain JSON values).
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+        >>> d = m.to_dict()
+        >>> d["type"], d["weights"]
+        ('DiagnosedModel', [1.0, 0.5])
+        >>> DiagnosedModel.from_dict(d).to_dict() == d
+        True
+        """
         return {"type": KIND, "radii": self.radii.tolist(), "weights": self.weights.tolist(),
                 "offset": self.offset, "dt": self.dt, "effects": list(self.effects),
                 "reference_weights": self.reference_weights.tolist(),
@@ -229,7 +263,27 @@ class DiagnosedModel:
             raise ValueError(f"model: missing key {err.args[0]!r}") from None
 
     def save(self, path) -> Path:
-        """Write :meth:`to_dict` as JSON to ``path``."""
+        """Write :meth:`to_dict` as JSON to ``path``.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file to write (its folder must exist).
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+        >>> with tempfile.TemporaryDirectory() as d:
+        ...     load_diagnosed_model(m.save(Path(d) / "m.json")).to_dict() == m.to_dict()
+        True
+        """
         path = Path(path)
         path.write_text(json.dumps(self.to_dict(), indent=1) + "\n")
         return path
@@ -251,6 +305,14 @@ class DiagnosedModel:
         ------
         ValueError
             A model with effects (named), or weights the PI operator refuses.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+        >>> op = m.operator_form()
+        >>> v = np.array([0.0, 1.0, 0.0])
+        >>> bool(np.allclose(op.simulate(v), m.simulate(v)))
+        True
         """
         from ..envelopes import Envelope
         from ..generalized import GeneralizedPI
@@ -264,13 +326,50 @@ class DiagnosedModel:
                              output_envelope=Envelope.affine(1.0, self.offset))
 
     def static_part(self) -> DiagnosedModel:
-        """The model without its dynamics and delay (what the inverse solves exactly)."""
+        """The model without its dynamics and delay (what the inverse solves exactly).
+
+        Returns
+        -------
+        DiagnosedModel
+            The same model with ``"dynamics"`` and ``"delay"`` removed from ``effects``.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3, effects=("delay",),
+        ...                    params={"delay_samples": 2})
+        >>> m.static_part().effects
+        ()
+        """
         return replace(self, effects=tuple(e for e in self.effects
                                            if e not in ("dynamics", "delay")))
 
 
 def load_diagnosed_model(path) -> DiagnosedModel:
-    """Read a model written by :meth:`DiagnosedModel.save` (ValueError naming the file)."""
+    """Read a model written by :meth:`DiagnosedModel.save` (ValueError naming the file).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A JSON file written by :meth:`DiagnosedModel.save`.
+
+    Returns
+    -------
+    DiagnosedModel
+
+    Raises
+    ------
+    ValueError
+        The file is not valid JSON or not a DiagnosedModel (a missing key is named).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     load_diagnosed_model(m.save(Path(d) / "m.json")).weights.tolist()
+    [1.0, 0.5]
+    """
     p = Path(path)
     try:
         return DiagnosedModel.from_dict(json.loads(p.read_text()))
@@ -288,6 +387,11 @@ def _signal(x, name: str) -> np.ndarray:
 class DiagnosedInverse:
     """Causal feedforward inverse of a :class:`DiagnosedModel` (module docstring).
 
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model to invert.
+
     Examples
     --------
     >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3, effects=("creep",),
@@ -301,7 +405,26 @@ class DiagnosedInverse:
         self.model = model
 
     def prefilter(self, y_d: np.ndarray) -> np.ndarray:
-        """The reference after the approximate inverses of the dynamics and the delay."""
+        """The reference after the approximate inverses of the dynamics and the delay.
+
+        Parameters
+        ----------
+        y_d : numpy.ndarray
+            Desired output, every ``dt``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``y_d`` advanced by the delay and filtered by the mode's approximate inverse;
+            ``y_d`` itself for a model with neither.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3, effects=("delay",),
+        ...                    params={"delay_samples": 1})
+        >>> m.inverse().prefilter(np.array([0.0, 1.0, 2.0, 3.0])).round(3).tolist()
+        [1.0, 2.0, 3.0, 3.0]
+        """
         m, p = self.model, self.model.params
         x = y_d
         if "dynamics" in m.effects:
@@ -333,6 +456,13 @@ class DiagnosedInverse:
         ------
         ValueError
             ``y_d`` not a finite 1-D signal.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+        >>> v = m.inverse().simulate([0.1, 0.6, 1.1])
+        >>> bool(np.allclose(m.simulate(v), [0.1, 0.6, 1.1]))
+        True
         """
         yd = _signal(y_d, "y_d")
         self.model._clock(yd, t)
