@@ -44,7 +44,27 @@ def _md_table(header: list[str], rows: list[list]) -> str:
 
 
 def step_identify(out: Path) -> tuple[dict, str]:
-    """Identify adaptive (n by BIC) and conventional (n = 4, 10) models; held-out errors."""
+    """Identify adaptive (n by BIC) and conventional (n = 4, 10) models; held-out errors.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output directory for the figures.
+
+    Returns
+    -------
+    results : dict
+        ``{"identify": numbers, "models": {name: operator}}``.
+    text : str
+        The report section (Markdown).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> FS_ID  # identification sample rate [Hz]
+    1000.0
+    >>> r, text = step_identify(Path("pimodel-demo"))  # doctest: +SKIP
+    """
     rng = np.random.default_rng(0)
     t, v = triangle(1.0, 1, fs=FS_ID, duration=3)
     y = STAGE.simulate(v) + rng.normal(0, NOISE_UM, v.size)
@@ -93,7 +113,30 @@ def step_identify(out: Path) -> tuple[dict, str]:
 
 
 def step_compensate(out: Path, models: dict) -> tuple[dict, str]:
-    """Feedforward with each identified model's inverse, on the stage with a 1 kHz mode."""
+    """Feedforward with each identified model's inverse, on the stage with a 1 kHz mode.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output directory for the figures.
+    models : dict
+        The identified operators, ``step_identify(out)[0]["models"]``.
+
+    Returns
+    -------
+    results : dict
+        ``{"compensate": numbers}``.
+    text : str
+        The report section (Markdown).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> FS_LOOP  # compensation loop sample rate [Hz]
+    10000.0
+    >>> r, _ = step_identify(Path("pimodel-demo"))  # doctest: +SKIP
+    >>> r2, text = step_compensate(Path("pimodel-demo"), r["models"])  # doctest: +SKIP
+    """
     dt = 1 / FS_LOOP
     t, vr = major_minor_loops(1.0, 1, fs=FS_LOOP, minor_fractions=(0.6, 0.3, 0.15))
     yd = STAGE.simulate(vr) - STAGE.simulate(vr).mean()
@@ -136,7 +179,29 @@ def step_compensate(out: Path, models: dict) -> tuple[dict, str]:
 
 
 def step_fmu(out: Path, weights) -> tuple[dict, str]:
-    """Build the FMUs and co-simulate the adaptive compensation loop; compare with native."""
+    """Build the FMUs and co-simulate the adaptive compensation loop; compare with native.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output directory (the FMUs go to ``out / "fmus"``).
+    weights : array_like
+        Play weights of the adaptive model (from step 1).
+
+    Returns
+    -------
+    results : dict
+        ``{"fmu": numbers}``.
+    text : str
+        The report section (Markdown).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> GAIN  # estimator gain in the co-simulated loop
+    50.0
+    >>> r, text = step_fmu(Path("pimodel-demo"), [1.0, 0.5, 0.3, 0.2])  # doctest: +SKIP
+    """
     from .fmu import build_fmus
     from .fmu.compare import compare_with_native, plot_comparison
     from .fmu.cosim import LOOP_UNITS
@@ -171,7 +236,27 @@ def step_fmu(out: Path, weights) -> tuple[dict, str]:
 
 
 def step_diagnose(out: Path) -> tuple[dict, str]:
-    """A stage with creep (1.5 %/decade) the PI model lacks: where, which effect, how far."""
+    """A stage with creep (1.5 %/decade) the PI model lacks: where, which effect, how far.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output directory for the figures.
+
+    Returns
+    -------
+    results : dict
+        ``{"diagnose": verdict}``.
+    text : str
+        The report section (Markdown).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> NOISE_UM  # sensor noise of the identification record [um]
+    0.005
+    >>> r, text = step_diagnose(Path("pimodel-demo"))  # doctest: +SKIP
+    """
     from .diagnosis import diagnose
     from .diagnosis.plots import plot_diagnosis
     from .truth import Truth, excitation
@@ -203,7 +288,26 @@ def step_diagnose(out: Path) -> tuple[dict, str]:
 
 
 def run_demo(out_dir="pimodel-demo") -> Path:
-    """Run the chain; write ``report.md``, ``results.json`` and figures into ``out_dir``."""
+    """Run the chain; write ``report.md``, ``results.json`` and figures into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path, optional
+        Output directory (created if missing).
+
+    Returns
+    -------
+    pathlib.Path
+        The path of ``report.md``.
+
+    Examples
+    --------
+    >>> import inspect
+    >>> inspect.signature(run_demo).parameters["out_dir"].default
+    'pimodel-demo'
+    >>> run_demo("pimodel-demo")  # doctest: +SKIP
+    PosixPath('.../pimodel-demo/report.md')
+    """
     out = Path(out_dir).resolve()
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()

@@ -1,4 +1,13 @@
-"""FMI 2.0 Co-Simulation FMUs of the pimodel units (real C, the shared core) and FMU helpers."""
+"""FMI 2.0 Co-Simulation FMUs of the pimodel units (real C, the shared core) and FMU helpers.
+
+``MODELS`` maps each unit name to its model description; ``build_fmus`` builds them.
+
+Examples
+--------
+>>> from pimodel.fmu import MODELS
+>>> sorted(MODELS)[:3]
+['AsymmetricPI', 'CreepOperator', 'GeneralizedPI']
+"""
 
 from .build import MODELS, build_fmus
 
