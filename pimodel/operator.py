@@ -363,9 +363,9 @@ class PIOperator:
         Raises
         ------
         ValueError
-            If ``r_1 > 0``, a partial sum of weights is not positive, or the branch slopes range
+            If ``r_1 > 0``, a partial sum of weights is not positive, the branch slopes range
             over more than ``INVERSE_CONDITION_ERROR`` (a RuntimeWarning above
-            ``INVERSE_CONDITION_WARN``).
+            ``INVERSE_CONDITION_WARN``), or the inverse's parameters overflow float64.
 
         Examples
         --------
@@ -404,6 +404,13 @@ class PIOperator:
                 f"{cond:.3g} times (well-conditioned below {INVERSE_CONDITION_WARN:.0e})",
                 RuntimeWarning, stacklevel=2)
         pinv, rinv, zinv = res
+        if not (np.all(np.isfinite(pinv)) and np.all(np.isfinite(rinv))
+                and np.all(np.isfinite(zinv))):
+            raise ValueError(
+                "PIOperator.inverse: not representable in float64, the inverse's weights "
+                f"(1/p_1 = 1/{float(self._p[0]):.3g}, -p_i / (P_i P_(i-1))) or radii overflow; "
+                "expected weights well inside the float64 range: rescale the output units"
+            )
         return PIOperator(pinv, rinv, initial_state=zinv, signed_weights=True)
 
     def describing_function(self) -> PIDescribingFunction:

@@ -72,3 +72,13 @@ def test_time_dependent_errors():
         tdpi.simulate([0, 1, 2], np.zeros((3, 3)))
     with pytest.raises(ValueError, match="radii_per_sample: every radius must be finite"):
         tdpi.simulate([0, 1, 2], -np.ones((3, 2)))
+
+
+def test_inverse_whose_weights_overflow_float64_is_refused():
+    """Found by the API fuzz in CI: weights of 1e-300 give inverse weights -p_i / (P_i P_(i-1))
+    beyond float64; the inverse must say so instead of carrying -inf."""
+    op = PIOperator([1e-300] * 4, [0.0, 0.1, 0.2, 0.3])
+    with pytest.raises(ValueError, match="PIOperator.inverse: not representable in float64"):
+        op.inverse()
+    with pytest.raises(ValueError, match="PIOperator.inverse: not representable in float64"):
+        PIOperator([1e-300] * 4, [0.0] * 4).inverse()
