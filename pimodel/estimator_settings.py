@@ -57,6 +57,19 @@ def noise_level(x) -> float:
     return float(1.4826 * np.median(np.abs(np.diff(s, 2))) / np.sqrt(6.0))
 
 
+def _norm2(weights) -> float:
+    """``|p|^2`` of positive weights; ValueError naming ``weights`` when a weight is not > 0
+    or ``|p|^2`` leaves the float64 range."""
+    p = as_vector(weights, "weights")
+    if np.any(p <= 0):
+        raise ValueError(f"weights: every weight must be > 0, got {p.tolist()}")
+    pp = float(p @ p)
+    if not 0.0 < pp < np.inf:
+        raise ValueError(f"weights: |p|^2 = {pp!r} is outside the float64 range; expected "
+                         "weights between about 1e-150 and 1e150 (rescale the output units)")
+    return pp
+
+
 def stability_bound(weights, dt: float) -> float:
     """Largest stable gain ``2 / (dt * |p|^2)`` of the discrete law (a gain per play above it
     makes ``rhat`` diverge: each step overshoots the fixed point).
@@ -78,10 +91,7 @@ def stability_bound(weights, dt: float) -> float:
     >>> round(stability_bound([0.3, 0.5, 0.8, 0.3, 0.2], 1e-3), 1)
     1801.8
     """
-    p = as_vector(weights, "weights")
-    if np.any(p <= 0):
-        raise ValueError(f"weights: every weight must be > 0, got {p.tolist()}")
-    return 2.0 / (positive_scalar(dt, "dt") * float(p @ p))
+    return 2.0 / (positive_scalar(dt, "dt") * _norm2(weights))
 
 
 def check_gains(gains, weights, dt: float) -> None:
@@ -150,11 +160,8 @@ def default_settings(v, y, weights, *, dt: float) -> dict:
     """
     x = as_signal(v, "v", min_length=3)
     m = as_signal(y, "y", min_length=3)
-    p = as_vector(weights, "weights")
-    if np.any(p <= 0):
-        raise ValueError(f"weights: every weight must be > 0, got {p.tolist()}")
+    pp = _norm2(weights)
     dt = positive_scalar(dt, "dt")
-    pp = float(p @ p)
     span_v = float(np.ptp(x))
     sig_y, sig_v = noise_level(m), noise_level(x)
     noisy = sig_y > 1e-4 * float(np.ptp(m))

@@ -297,3 +297,10 @@ def test_settings_from_the_record_reject_non_positive_weights(weights):
         estimate_radii(v, v, weights, dt=1e-3, slope_window=2)
     with pytest.raises(ValueError, match="weights: every weight must be > 0"):
         default_settings(v, v, weights, dt=1e-3)
+
+
+def test_settings_from_the_record_reject_weights_whose_norm_underflows():
+    """Found by the API fuzz: weights [5e-324] give |p|^2 = 0 (a division by zero before)."""
+    v = np.sin(np.linspace(0, 20, 500))
+    with pytest.raises(ValueError, match="weights: \\|p\\|\\^2 = 0.0 is outside the float64"):
+        estimate_radii(v, v, [5e-324], dt=1e-3, slope_window=2)
