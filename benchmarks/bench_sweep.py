@@ -2,7 +2,7 @@
 
 Run: ``.venv/bin/python benchmarks/bench_sweep.py [--study sim_to_real] [--quick] [--workers 2]
 [--repeat 1]``.
-Goal (issue 17): the full ``sim_to_real`` (80 cases) at least 1.7x faster on 2 workers than
+Goal (issue 17): the full ``sim_to_real`` (250 cases) at least 1.7x faster on 2 workers than
 serially, on a 2-core machine. Both runs start from an empty case folder (``fresh``) and include
 everything ``pimodel study`` does: cluster start-up and shut-down, the cases, the aggregate step
 (the real-record diagnosis) and the figures. The runs alternate (serial, cluster, serial, ...)

@@ -40,10 +40,13 @@ import numpy as np
 DEFAULT_MEMORY_LIMIT = "2GiB"
 
 # Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which also switches off glibc's
-# dynamic mmap threshold: every array above 128 KiB is then mmap'd and unmapped afresh, and a
-# case of the diagnosis or identification spends ~50 % more CPU (measured on the identify
-# sweep). Larger thresholds keep the case's working arrays (up to 16 MiB) on the heap; memory
-# still returns to the system above 64 MiB of free heap top.
+# dynamic mmap threshold: every array above 128 KiB is then mmap'd and unmapped afresh. A
+# sim_to_real case then spends about as much CPU in the kernel (page faults) as in user code:
+# 71 M minor faults and stime/utime = 0.8 in a worker, measured. Larger thresholds keep the
+# case's working arrays (up to 16 MiB) on the heap; memory still returns to the system above
+# 64 MiB of free heap top. glibc reads them once, at process start, so they must go into the
+# nanny's *pre-spawn* environment (``distributed.nanny.pre-spawn-environ``); LocalCluster's
+# ``env=`` is applied after the worker started and has no effect on them.
 WORKER_ENV = {"MALLOC_MMAP_THRESHOLD_": str(16 * 2**20), "MALLOC_TRIM_THRESHOLD_": str(64 * 2**20)}
 
 __all__ = ["CaseFailed", "DEFAULT_MEMORY_LIMIT", "WORKER_ENV", "available_cores", "case_key",
@@ -332,14 +335,17 @@ def _run_serial(func, cases, todo, results, cache, bar) -> None:
 def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory_limit) -> None:
     import logging
 
+    import dask
     from dask.distributed import Client, LocalCluster, as_completed
 
     cluster = None
     if scheduler is None:
         # processes, one thread each: the Python glue of a case holds the GIL
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               memory_limit=memory_limit, dashboard_address=None,
-                               silence_logs=logging.ERROR, env=WORKER_ENV)
+        spawn_env = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), **WORKER_ENV}
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn_env}):
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   memory_limit=memory_limit, dashboard_address=None,
+                                   silence_logs=logging.ERROR)
     client = Client(cluster if cluster is not None else scheduler)
     try:
         run = partial(_call_case, func)

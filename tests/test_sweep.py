@@ -17,6 +17,7 @@ import pytest
 
 from pimodel.cli import main
 from pimodel.sweep import (
+    WORKER_ENV,
     CaseFailed,
     case_key,
     grid,
@@ -291,3 +292,24 @@ def test_cluster_failure_names_the_case_and_keeps_the_finished(tmp_path, schedul
                     progress=False)
     assert got == [{"y": x * x} for x in range(5)]
     assert sorted(_computed(log)) == sorted(set(range(5)) - kept)
+
+
+def _start_environment(params: dict) -> dict:
+    """The environment the worker process was started with (Linux: /proc/self/environ), which
+    is what glibc read its malloc settings from; ``os.environ`` may have changed since."""
+    raw = Path("/proc/self/environ").read_bytes().split(b"\0")
+    env = dict(item.decode().split("=", 1) for item in raw if b"=" in item)
+    return {k: env.get(k) for k in WORKER_ENV}
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs Linux /proc")
+def test_local_workers_start_with_the_malloc_settings(tmp_path):
+    """Dask's default MALLOC_TRIM_THRESHOLD_=65536 switches off glibc's dynamic mmap threshold
+    (a case spent as much CPU in page faults as in its own code); the local cluster's workers
+    must be *started* with WORKER_ENV, not get it after start."""
+    import cloudpickle
+
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    got = run_cases(_start_environment, [{"i": 0}, {"i": 1}], workers=2, progress=False)
+    assert got == [WORKER_ENV, WORKER_ENV]
