@@ -1,9 +1,9 @@
 """What the operator classes share, written once (private module).
 
 :class:`~pimodel.PIOperator`, :class:`~pimodel.generalized.GeneralizedPI`,
-:class:`~pimodel.asymmetric.AsymmetricPI`, :class:`~pimodel.rate_dependent.RateDependentPI`,
-:class:`~pimodel.creep.CreepOperator` and the inverse classes keep their parameters in
-read-only arrays and a streaming state ``self._z`` that ``step`` advances and ``simulate``
+:class:`~pimodel.asymmetric.AsymmetricPI`, :class:`~pimodel.rate_dependent.RateDependentPI` and
+:class:`~pimodel.creep.CreepOperator` keep their parameters in read-only arrays; they and the
+inverse classes keep a streaming state ``self._z`` that ``step`` advances and ``simulate``
 leaves alone:
 
 - :func:`read_only` and :func:`size_of` make the parameter properties (``weights``, ``radii``,
@@ -12,7 +12,8 @@ leaves alone:
 - :func:`operator_repr` writes ``Name(args, key=value)`` with the arrays rounded to 6 digits;
 - :class:`Streaming` holds the streaming-state bookkeeping: the start state of ``simulate``,
   ``reset`` and one ``step`` on a copy of the state (the state changes only when the step
-  succeeds); :func:`streaming_state` makes the ``state`` property with the class's docstring;
+  succeeds; ``PIOperator.step`` updates it in place through the C core's step instead);
+  :func:`streaming_state` makes the ``state`` property with the class's docstring;
   :class:`InverseStreaming` is the same for an inverse that runs its forward operator's state.
 
 A class using :class:`Streaming` defines ``_check_state(value)`` (the state's form and its
