@@ -30,13 +30,22 @@ from __future__ import annotations
 import numpy as np
 
 from . import _native
-from .checks import as_signal, as_vector, positive_scalar
+from ._operator_base import (
+    InverseStreaming,
+    Streaming,
+    freeze,
+    operator_repr,
+    read_only,
+    size_of,
+    streaming_state,
+)
+from .checks import as_signal, as_vector, positive_scalar, scalar_or_vector
 from .envelopes import Envelope
 
 __all__ = ["AsymmetricPI", "AsymmetricPIInverse"]
 
 
-class AsymmetricPI:
+class AsymmetricPI(Streaming):
     """Generalized PI with distinct ascending/descending envelopes (module docstring).
 
     Parameters
@@ -86,15 +95,10 @@ class AsymmetricPI:
         if not isinstance(shape, Envelope):
             raise TypeError(f"shape: expected a pimodel.envelopes.Envelope, got "
                             f"{type(shape).__name__}")
-        z0 = as_vector(initial_state, "initial_state")
-        if z0.size not in (1, p.size):
-            raise ValueError(f"initial_state: expected a scalar or {p.size} values, got "
-                             f"{z0.size}")
+        z0 = scalar_or_vector(initial_state, "initial_state", p.size)
         order = np.argsort(r, kind="stable")
-        self._p, self._r = p[order].copy(), r[order].copy()
-        self._z0 = np.broadcast_to(z0, p.shape)[order].copy()
-        for arr in (self._p, self._r, self._z0):
-            arr.setflags(write=False)
+        self._p, self._r, self._z0 = p[order], r[order], z0[order]
+        freeze(self._p, self._r, self._z0)
         self.direct_weight = p0
         self.ascending = (float(al), float(dl))
         self.descending = (float(ar), float(dr))
@@ -104,45 +108,20 @@ class AsymmetricPI:
                                      shape.inverse().code)
         self.reset()
 
-    @property
-    def weights(self) -> np.ndarray:
-        """Play weights ``p_i`` (read-only), ordered by radius."""
-        return self._p
-
-    @property
-    def radii(self) -> np.ndarray:
-        """Radii ``r_i`` (read-only), non-decreasing."""
-        return self._r
-
-    @property
-    def n(self) -> int:
-        """Number of plays."""
-        return self._p.size
-
-    @property
-    def initial_state(self) -> np.ndarray:
-        """Play states before the first sample."""
-        return self._z0
+    weights = read_only("_p", "Play weights ``p_i`` (read-only), ordered by radius.")
+    radii = read_only("_r", "Radii ``r_i`` (read-only), non-decreasing.")
+    n = size_of("_p", "Number of plays.")
+    initial_state = read_only("_z0", "Play states before the first sample.")
 
     def __repr__(self) -> str:
-        return (f"AsymmetricPI({self.direct_weight!r}, {np.round(self._p, 6).tolist()}, "
-                f"{np.round(self._r, 6).tolist()}, ascending={self.ascending}, "
-                f"descending={self.descending}, shape={self.shape!r})")
+        return operator_repr("AsymmetricPI", self.direct_weight, self._p, self._r,
+                             ascending=self.ascending, descending=self.descending,
+                             shape=self.shape)
 
-    def _state(self, value) -> np.ndarray:
-        z = as_vector(value, "state")
-        if z.size not in (1, self.n):
-            raise ValueError(f"state: expected a scalar or {self.n} values, got {z.size}")
-        return np.broadcast_to(z, (self.n,)).copy()
+    def _check_state(self, value) -> np.ndarray:
+        return scalar_or_vector(value, "state", self.n)
 
-    @property
-    def state(self) -> np.ndarray:
-        """Streaming play states (a copy)."""
-        return self._z.copy()
-
-    @state.setter
-    def state(self, value) -> None:
-        self._z = self._state(value)
+    state = streaming_state("Streaming play states (a copy).")
 
     def reset(self) -> None:
         """Return the streaming state to :attr:`initial_state`.
@@ -155,7 +134,7 @@ class AsymmetricPI:
         >>> op.state
         array([0.])
         """
-        self._z = self._z0.copy()
+        self._restart()
 
     def _run(self, x: np.ndarray, z: np.ndarray, *, inverse: bool, name: str) -> np.ndarray:
         out, bad = _native.asym_run(self._c, self._p, self._r, z, x, inverse=inverse)
@@ -197,7 +176,7 @@ class AsymmetricPI:
         array([0. , 1.4, 0.8])
         """
         x = as_signal(v, "v")
-        z = self._z0.copy() if state is None else self._state(state)
+        z = self._start_state(state)
         y = self._run(x, z, inverse=False, name="v")
         return (y, z) if return_state else y
 
@@ -225,10 +204,7 @@ class AsymmetricPI:
         >>> op.step(1.0), op.state
         (1.4, array([0.8]))
         """
-        z = self._z.copy()
-        y = self._run(as_signal(v, "v"), z, inverse=False, name="v")
-        self._z = z
-        return float(y[0])
+        return self._advance(self._run, as_signal(v, "v"), inverse=False, name="v")
 
     def to_dict(self) -> dict:
         """JSON-ready parameters.
@@ -268,7 +244,7 @@ class AsymmetricPI:
         return AsymmetricPIInverse(self)
 
 
-class AsymmetricPIInverse:
+class AsymmetricPIInverse(InverseStreaming):
     """Exact inverse of an :class:`AsymmetricPI`: ``y_d[k]`` in, ``v[k]`` out; its state is the
     forward operator's play state, advanced with the ``v[k]`` it returns.
 
@@ -288,14 +264,7 @@ class AsymmetricPIInverse:
         self.forward = forward
         self.reset()
 
-    @property
-    def state(self) -> np.ndarray:
-        """Streaming (forward) play states (a copy)."""
-        return self._z.copy()
-
-    @state.setter
-    def state(self, value) -> None:
-        self._z = self.forward._state(value)
+    state = streaming_state("Streaming (forward) play states (a copy).")
 
     def reset(self) -> None:
         """Return to the forward operator's initial state.
@@ -309,7 +278,7 @@ class AsymmetricPIInverse:
         >>> inv.state
         array([0.])
         """
-        self._z = self.forward.initial_state.copy()
+        self._restart()
 
     def simulate(self, y_d, *, state=None, return_state: bool = False):
         """Input ``v[k]`` that makes the forward operator output ``y_d[k]``.
@@ -339,9 +308,8 @@ class AsymmetricPIInverse:
         array([0.        , 1.06666667, 0.56666667])
         """
         x = as_signal(y_d, "y_d")
-        f = self.forward
-        z = f.initial_state.copy() if state is None else f._state(state)
-        v = f._run(x, z, inverse=True, name="y_d")
+        z = self._start_state(state)
+        v = self.forward._run(x, z, inverse=True, name="y_d")
         return (v, z) if return_state else v
 
     def step(self, y_d: float) -> float:
@@ -369,7 +337,5 @@ class AsymmetricPIInverse:
         >>> round(inv.step(1.5), 12), inv.state
         (1.066666666667, array([0.86666667]))
         """
-        z = self._z.copy()
-        v = self.forward._run(as_signal(y_d, "y_d"), z, inverse=True, name="y_d")
-        self._z = z
-        return float(v[0])
+        return self._advance(self.forward._run, as_signal(y_d, "y_d"), inverse=True,
+                             name="y_d")

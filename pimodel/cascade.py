@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._operator_base import operator_repr
 from .checks import as_signal
 
 __all__ = ["Cascade"]
@@ -53,7 +54,7 @@ class Cascade:
         self.stages = tuple(stages)
 
     def __repr__(self) -> str:
-        return "Cascade(" + ", ".join(repr(s) for s in self.stages) + ")"
+        return operator_repr("Cascade", *self.stages)
 
     def simulate(self, v) -> np.ndarray:
         """Output of the chain for the samples ``v[k]`` (each stage from its initial state).

@@ -95,6 +95,48 @@ def as_vector(value, name: str, *, length: int | None = None) -> np.ndarray:
     return arr
 
 
+def scalar_or_vector(value, name: str, n: int, *, one_per: str | None = None) -> np.ndarray:
+    """Return ``value`` as ``n`` finite floats: a scalar repeated ``n`` times, or n values.
+
+    The form of an operator's (initial) state and of per-play settings such as gains.
+
+    Parameters
+    ----------
+    value : float or array_like
+        One value for all entries, or ``n`` values.
+    name : str
+        The argument's name, used in the error message.
+    n : int
+        Number of entries (plays, lags).
+    one_per : str, optional
+        What one entry belongs to (e.g. ``"play"``); the message then says ``(one per play)``.
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (n,)
+        A new array (never a view of ``value``).
+
+    Raises
+    ------
+    ValueError
+        As :func:`as_vector`, or if ``value`` holds neither 1 nor ``n`` values.
+
+    Examples
+    --------
+    >>> scalar_or_vector(0.5, "initial_state", 3)
+    array([0.5, 0.5, 0.5])
+    >>> scalar_or_vector([1.0, 2.0], "state", 3, one_per="play")
+    Traceback (most recent call last):
+    ...
+    ValueError: state: expected a scalar or 3 values (one per play), got 2
+    """
+    arr = as_vector(value, name)
+    if arr.size not in (1, n):
+        per = f" (one per {one_per})" if one_per else ""
+        raise ValueError(f"{name}: expected a scalar or {n} values{per}, got {arr.size}")
+    return np.broadcast_to(arr, (n,)).copy()
+
+
 def positive_scalar(value, name: str) -> float:
     """Return ``value`` as a finite float > 0, or raise ValueError naming ``name``.
 

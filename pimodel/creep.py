@@ -28,12 +28,13 @@ from __future__ import annotations
 import numpy as np
 
 from . import _native
-from .checks import as_signal, as_vector, positive_scalar
+from ._operator_base import Streaming, freeze, operator_repr, read_only, size_of, streaming_state
+from .checks import as_signal, as_vector, positive_scalar, scalar_or_vector
 
 __all__ = ["CreepOperator"]
 
 
-class CreepOperator:
+class CreepOperator(Streaming):
     """Sum-of-lags creep ``y = G[u]``, ``G(z) = 1 + sum_i c_i (1 - a_i) / (z - a_i)``.
 
     Parameters
@@ -72,14 +73,10 @@ class CreepOperator:
             i = int(np.flatnonzero(tau <= 0)[0])
             raise ValueError(f"time_constants: tau[{i + 1}] is {float(tau[i])!r}; expected > 0")
         self.dt = positive_scalar(dt, "dt")
-        self._c, self._tau = c, tau
+        self._c, self._tau = c.copy(), tau.copy()  # frozen below: not the caller's arrays
         self._a = np.exp(-self.dt / tau)
-        x0 = as_vector(initial_state, "initial_state")
-        if x0.size not in (1, c.size):
-            raise ValueError(f"initial_state: expected a scalar or {c.size} values, got {x0.size}")
-        self._x0 = np.broadcast_to(x0, c.shape).copy()
-        for arr in (self._c, self._tau, self._a, self._x0):
-            arr.setflags(write=False)
+        self._x0 = scalar_or_vector(initial_state, "initial_state", c.size)
+        freeze(self._c, self._tau, self._a, self._x0)
         self.inverted = bool(inverted)
         zmax = float(np.max(np.abs(self.zeros())))
         if zmax >= 1.0:
@@ -122,30 +119,11 @@ class CreepOperator:
         return cls(np.full(tau.size, gamma), tau, dt=dt, initial_state=initial_state)
 
     # -- parameters ---------------------------------------------------------------------
-    @property
-    def gains(self) -> np.ndarray:
-        """Lag gains ``c_i`` (read-only)."""
-        return self._c
-
-    @property
-    def time_constants(self) -> np.ndarray:
-        """Lag time constants ``tau_i`` [s] (read-only)."""
-        return self._tau
-
-    @property
-    def poles(self) -> np.ndarray:
-        """``a_i = exp(-dt / tau_i)``, the poles of ``G`` (read-only)."""
-        return self._a
-
-    @property
-    def m(self) -> int:
-        """Number of lags."""
-        return self._c.size
-
-    @property
-    def initial_state(self) -> np.ndarray:
-        """Lag states ``x_i[0]`` (read-only)."""
-        return self._x0
+    gains = read_only("_c", "Lag gains ``c_i`` (read-only).")
+    time_constants = read_only("_tau", "Lag time constants ``tau_i`` [s] (read-only).")
+    poles = read_only("_a", "``a_i = exp(-dt / tau_i)``, the poles of ``G`` (read-only).")
+    m = size_of("_c", "Number of lags.")
+    initial_state = read_only("_x0", "Lag states ``x_i[0]`` (read-only).")
 
     def zeros(self) -> np.ndarray:
         """Zeros of ``G`` (poles of the inverse): eigenvalues of ``diag(a) - (1 - a) c^T``.
@@ -206,8 +184,7 @@ class CreepOperator:
 
     def __repr__(self) -> str:
         name = "CreepOperator.inverse" if self.inverted else "CreepOperator"
-        return (f"{name}(gains={np.round(self._c, 6).tolist()}, "
-                f"time_constants={np.round(self._tau, 6).tolist()}, dt={self.dt!r})")
+        return operator_repr(name, gains=self._c, time_constants=self._tau, dt=self.dt)
 
     # -- simulation ---------------------------------------------------------------------
     def simulate(self, u, *, state=None, return_state: bool = False):
@@ -241,24 +218,17 @@ class CreepOperator:
         array([1.        , 1.31606028, 1.43233236])
         """
         x = as_signal(u, "u")
-        s = self._x0.copy() if state is None else self._check_state(state)
-        out = _native.creep_run(self._a, self._c, s, x, inverse=self.inverted)
+        s = self._start_state(state)
+        out = self._run(x, s)
         return (out, s) if return_state else out
 
+    def _run(self, x: np.ndarray, s: np.ndarray) -> np.ndarray:
+        return _native.creep_run(self._a, self._c, s, x, inverse=self.inverted)
+
     def _check_state(self, value) -> np.ndarray:
-        s = as_vector(value, "state")
-        if s.size not in (1, self.m):
-            raise ValueError(f"state: expected a scalar or {self.m} values, got {s.size}")
-        return np.broadcast_to(s, (self.m,)).copy()
+        return scalar_or_vector(value, "state", self.m)
 
-    @property
-    def state(self) -> np.ndarray:
-        """Streaming lag states (a copy)."""
-        return self._x.copy()
-
-    @state.setter
-    def state(self, value) -> None:
-        self._x = self._check_state(value)
+    state = streaming_state("Streaming lag states (a copy).")
 
     def reset(self) -> None:
         """Return the streaming state to :attr:`initial_state`.
@@ -271,7 +241,7 @@ class CreepOperator:
         >>> cr.step(1.0)
         1.0
         """
-        self._x = self._x0.copy()
+        self._restart()
 
     def step(self, u: float) -> float:
         """Advance one sample and return the output.
@@ -297,8 +267,7 @@ class CreepOperator:
         >>> cr.step(1.0), round(cr.step(1.0), 8)
         (1.0, 1.31606028)
         """
-        return float(_native.creep_run(self._a, self._c, self._x, as_signal(u, "u"),
-                                       inverse=self.inverted)[0])
+        return self._advance(self._run, as_signal(u, "u"))
 
     def inverse(self) -> CreepOperator:
         """The exact causal inverse ``u = G^-1[y]`` (same lags and state; module docstring).

@@ -62,9 +62,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _native
-from .checks import as_signal, as_vector, integer_in, positive_scalar
+from .checks import as_signal, as_vector, integer_in, positive_scalar, scalar_or_vector
 from .estimator_health import EstimatorHealth, estimator_health
-from .estimator_settings import check_gains, default_settings
+from .estimator_settings import check_gains, check_weights, default_settings
 
 _lib = _native.lib
 _F64 = _native.F64
@@ -293,12 +293,8 @@ class RadiusEstimator:
         n = p.size
         if n > MAX_PLAYS:
             raise ValueError(f"weights: at most {MAX_PLAYS} plays are supported, got {n}")
-        if np.any(p <= 0):
-            raise ValueError("weights: every weight must be > 0")
-        g = as_vector(gains, "gains")
-        g = np.full(n, g[0]) if g.size == 1 else g
-        if g.size != n:
-            raise ValueError(f"gains: expected a scalar or {n} values, got {g.size}")
+        check_weights(p)
+        g = scalar_or_vector(gains, "gains", n)
         if np.any(g < 0):
             raise ValueError("gains: every gain must be >= 0")
         if law not in LAWS:

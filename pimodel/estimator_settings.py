@@ -57,12 +57,43 @@ def noise_level(x) -> float:
     return float(1.4826 * np.median(np.abs(np.diff(s, 2))) / np.sqrt(6.0))
 
 
-def _norm2(weights) -> float:
-    """``|p|^2`` of positive weights; ValueError naming ``weights`` when a weight is not > 0
-    or ``|p|^2`` leaves the float64 range."""
+def check_weights(weights) -> np.ndarray:
+    """The play weights as the radius estimator accepts them: a finite vector, every ``p_j > 0``.
+
+    Parameters
+    ----------
+    weights : array_like
+        Play weights p_j (output per input unit).
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (n,)
+        The weights.
+
+    Raises
+    ------
+    ValueError
+        Naming ``weights``, if they are not a finite non-empty vector or a weight is not > 0.
+
+    Examples
+    --------
+    >>> check_weights([0.5, 1.0])
+    array([0.5, 1. ])
+    >>> check_weights([0.5, 0.0])
+    Traceback (most recent call last):
+    ...
+    ValueError: weights: every weight must be > 0, got [0.5, 0.0]
+    """
     p = as_vector(weights, "weights")
     if np.any(p <= 0):
         raise ValueError(f"weights: every weight must be > 0, got {p.tolist()}")
+    return p
+
+
+def _norm2(weights) -> float:
+    """``|p|^2`` of positive weights; ValueError naming ``weights`` when a weight is not > 0
+    (:func:`check_weights`) or ``|p|^2`` leaves the float64 range."""
+    p = check_weights(weights)
     pp = float(p @ p)
     if not 0.0 < pp < np.inf:
         raise ValueError(f"weights: |p|^2 = {pp!r} is outside the float64 range; expected "

@@ -36,7 +36,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import _native
-from .checks import as_signal
+from ._operator_base import Streaming, operator_repr, read_only, size_of, streaming_state
+from .checks import as_signal, scalar_or_vector
 from .envelopes import Envelope
 from .operator import PIOperator
 
@@ -52,7 +53,7 @@ def _envelope(value, name: str) -> Envelope:
     return value
 
 
-class GeneralizedPI:
+class GeneralizedPI(Streaming):
     """Generalized PI operator ``y[k] = g(sum_i p_i Gamma_{r_i}[h(v)][k])``.
 
     Parameters
@@ -93,7 +94,8 @@ class GeneralizedPI:
                               signed_weights=signed_weights)
         self.input_envelope = _envelope(input_envelope, "input_envelope")
         self.output_envelope = _envelope(output_envelope, "output_envelope")
-        self._z = self._pi.initial_state.copy()
+        self._p, self._r, self._z0 = self._pi.weights, self._pi.radii, self._pi.initial_state
+        self._restart()
 
     # -- parameters ---------------------------------------------------------------------
     @property
@@ -101,31 +103,15 @@ class GeneralizedPI:
         """The PI part (weights, radii, initial state in envelope units)."""
         return self._pi
 
-    @property
-    def weights(self) -> np.ndarray:
-        """Weights ``p_i`` (read-only), ordered by radius."""
-        return self._pi.weights
-
-    @property
-    def radii(self) -> np.ndarray:
-        """Radii ``r_i`` in envelope units (read-only), non-decreasing."""
-        return self._pi.radii
-
-    @property
-    def n(self) -> int:
-        """Number of plays."""
-        return self._pi.n
-
-    @property
-    def initial_state(self) -> np.ndarray:
-        """Play states before the first sample, ``z_i[-1]``."""
-        return self._pi.initial_state
+    weights = read_only("_p", "Weights ``p_i`` (read-only), ordered by radius.")
+    radii = read_only("_r", "Radii ``r_i`` in envelope units (read-only), non-decreasing.")
+    n = size_of("_p", "Number of plays.")
+    initial_state = read_only("_z0", "Play states before the first sample, ``z_i[-1]``.")
 
     def __repr__(self) -> str:
-        return (f"GeneralizedPI(weights={np.round(self.weights, 6).tolist()}, "
-                f"radii={np.round(self.radii, 6).tolist()}, "
-                f"input_envelope={self.input_envelope!r}, "
-                f"output_envelope={self.output_envelope!r})")
+        return operator_repr("GeneralizedPI", weights=self._p, radii=self._r,
+                             input_envelope=self.input_envelope,
+                             output_envelope=self.output_envelope)
 
     # -- simulation ---------------------------------------------------------------------
     def _run(self, x: np.ndarray, z: np.ndarray) -> np.ndarray:
@@ -139,8 +125,8 @@ class GeneralizedPI:
                              f"output envelope {self.output_envelope!r}")
         return y
 
-    def _state(self, value) -> np.ndarray:
-        return PIOperator(np.ones(self.n), self.radii, initial_state=value).initial_state.copy()
+    def _check_state(self, value) -> np.ndarray:
+        return scalar_or_vector(value, "initial_state", self.n, one_per="play")
 
     def simulate(self, v, *, state=None, return_state: bool = False):
         """Output ``y[k]`` for ``v[k]``, k = 0..N-1, from ``state`` (default the initial one).
@@ -173,18 +159,12 @@ class GeneralizedPI:
         array([0.     , 2.38   , 1.21125])
         """
         x = as_signal(v, "v")
-        z = self.initial_state.copy() if state is None else self._state(state)
+        z = self._start_state(state)
         y = self._run(x, z)
         return (y, z) if return_state else y
 
-    @property
-    def state(self) -> np.ndarray:
-        """Current streaming play states (a copy); settable with a scalar or n values."""
-        return self._z.copy()
-
-    @state.setter
-    def state(self, value) -> None:
-        self._z = self._state(value)
+    state = streaming_state(
+        "Current streaming play states (a copy); settable with a scalar or n values.")
 
     def reset(self) -> None:
         """Return the streaming state to :attr:`initial_state`.
@@ -197,7 +177,7 @@ class GeneralizedPI:
         >>> op.state
         array([0., 0.])
         """
-        self._z = self.initial_state.copy()
+        self._restart()
 
     def step(self, v: float) -> float:
         """Advance one sample with input ``v[k]`` and return ``y[k]``.
@@ -225,10 +205,7 @@ class GeneralizedPI:
         >>> op.step(1.0), op.state
         (2.38, array([1. , 0.8]))
         """
-        z = self._z.copy()
-        y = self._run(as_signal(v, "v"), z)
-        self._z = z
-        return float(y[0])
+        return self._advance(self._run, as_signal(v, "v"))
 
     # -- inverse ------------------------------------------------------------------------
     @property

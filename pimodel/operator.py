@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _native
-from .checks import as_signal, as_vector
+from ._operator_base import Streaming, freeze, operator_repr, read_only, size_of, streaming_state
+from .checks import as_signal, as_vector, scalar_or_vector
 
 if TYPE_CHECKING:
     from .describing import PIDescribingFunction
@@ -65,17 +66,10 @@ def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarr
 
 
 def _initial_state(value, n: int) -> np.ndarray:
-    z = as_vector(value, "initial_state")
-    if z.size == 1:
-        return np.full(n, z[0])
-    if z.size != n:
-        raise ValueError(
-            f"initial_state: expected a scalar or {n} values (one per play), got {z.size}"
-        )
-    return z.copy()
+    return scalar_or_vector(value, "initial_state", n, one_per="play")
 
 
-class PIOperator:
+class PIOperator(Streaming):
     """Weighted sum of play operators, ``y[k] = sum_i p_i Gamma_{r_i}[v][k]``.
 
     Parameters
@@ -118,37 +112,18 @@ class PIOperator:
         self._p = np.ascontiguousarray(p[order])
         self._r = np.ascontiguousarray(r[order])
         self._z0 = np.ascontiguousarray(z0[order])
-        self._z = self._z0.copy()
+        self._restart()
         self.signed_weights = bool(signed_weights)
-        for a in (self._p, self._r, self._z0):
-            a.setflags(write=False)
+        freeze(self._p, self._r, self._z0)
 
     # -- parameters ---------------------------------------------------------------------
-    @property
-    def weights(self) -> np.ndarray:
-        """Weights ``p_i`` (read-only view), ordered by radius."""
-        return self._p
-
-    @property
-    def radii(self) -> np.ndarray:
-        """Radii ``r_i`` (read-only view), non-decreasing."""
-        return self._r
-
-    @property
-    def n(self) -> int:
-        """Number of plays."""
-        return self._p.size
-
-    @property
-    def initial_state(self) -> np.ndarray:
-        """Play states before the first sample, ``z_i[-1]``."""
-        return self._z0
+    weights = read_only("_p", "Weights ``p_i`` (read-only view), ordered by radius.")
+    radii = read_only("_r", "Radii ``r_i`` (read-only view), non-decreasing.")
+    n = size_of("_p", "Number of plays.")
+    initial_state = read_only("_z0", "Play states before the first sample, ``z_i[-1]``.")
 
     def __repr__(self) -> str:
-        return (
-            f"PIOperator(weights={np.array2string(self._p, precision=6, separator=', ')}, "
-            f"radii={np.array2string(self._r, precision=6, separator=', ')})"
-        )
+        return operator_repr("PIOperator", weights=self._p, radii=self._r, numpy_arrays=True)
 
     # -- whole-array simulation ---------------------------------------------------------
     def simulate(self, v, *, state=None, return_state: bool = False):
@@ -187,7 +162,7 @@ class PIOperator:
         (array([0.  , 1.35, 0.95]), array([0.6, 0.7]))
         """
         x = as_signal(v, "v")
-        z = self._z0.copy() if state is None else _initial_state(state, self.n)
+        z = self._start_state(state)
         y, _ = _native.pi_run(self._p, self._r, z, x)
         _check_output(y, x)
         return (y, z) if return_state else y
@@ -220,19 +195,16 @@ class PIOperator:
                [0.6, 0.7]])
         """
         x = as_signal(v, "v")
-        z = self._z0.copy() if state is None else _initial_state(state, self.n)
+        z = self._start_state(state)
         _, zhist = _native.pi_run(self._p, self._r, z, x, with_plays=True)
         return zhist
 
     # -- streaming ----------------------------------------------------------------------
-    @property
-    def state(self) -> np.ndarray:
-        """Current play states ``z_i[k]`` (a copy); settable with a scalar or n values."""
-        return self._z.copy()
+    state = streaming_state(
+        "Current play states ``z_i[k]`` (a copy); settable with a scalar or n values.")
 
-    @state.setter
-    def state(self, value) -> None:
-        self._z = _initial_state(value, self.n)
+    def _check_state(self, value) -> np.ndarray:
+        return _initial_state(value, self.n)
 
     def reset(self) -> None:
         """Return the streaming state to :attr:`initial_state`.
@@ -245,7 +217,7 @@ class PIOperator:
         >>> op.state
         array([0.])
         """
-        self._z = self._z0.copy()
+        self._restart()
 
     def step(self, v: float) -> float:
         """Advance one sample: update the state with input ``v[k]`` and return ``y[k]``.
@@ -301,7 +273,7 @@ class PIOperator:
         >>> PIOperator([1.0, 0.5], [0.0, 0.3]).output([1.0, 0.7])
         1.35
         """
-        z = self._z if state is None else _initial_state(state, self.n)
+        z = self._z if state is None else self._check_state(state)
         return float(self._p @ z)
 
     # -- analysis -----------------------------------------------------------------------

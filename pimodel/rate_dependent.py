@@ -48,13 +48,21 @@ from __future__ import annotations
 import numpy as np
 
 from . import _native
+from ._operator_base import (
+    InverseStreaming,
+    Streaming,
+    operator_repr,
+    read_only,
+    size_of,
+    streaming_state,
+)
 from .checks import as_signal, positive_scalar
 from .operator import PIOperator
 
 __all__ = ["RateDependentPI", "RateDependentPIInverse"]
 
 
-class RateDependentPI:
+class RateDependentPI(Streaming):
     """Rate-dependent PI operator with radii ``r_i[k] = alpha_i (1 + beta rate[k])``.
 
     Parameters
@@ -91,6 +99,7 @@ class RateDependentPI:
     def __init__(self, weights, base_radii, *, rate_gain: float, dt: float,
                  rate_time_constant: float = 0.0, initial_state=0.0, initial_input: float = 0.0):
         self._pi = PIOperator(weights, base_radii, initial_state=initial_state)
+        self._p, self._r = self._pi.weights, self._pi.radii
         beta = float(rate_gain)
         if not np.isfinite(beta) or beta < 0:
             raise ValueError(f"rate_gain: expected a finite number >= 0, got {rate_gain!r}")
@@ -108,20 +117,9 @@ class RateDependentPI:
         self.initial_input = v0
         self.reset()
 
-    @property
-    def weights(self) -> np.ndarray:
-        """Weights ``p_i`` (read-only), ordered by base radius."""
-        return self._pi.weights
-
-    @property
-    def base_radii(self) -> np.ndarray:
-        """Radii at rate 0, ``alpha_i`` (read-only), non-decreasing."""
-        return self._pi.radii
-
-    @property
-    def n(self) -> int:
-        """Number of plays."""
-        return self._pi.n
+    weights = read_only("_p", "Weights ``p_i`` (read-only), ordered by base radius.")
+    base_radii = read_only("_r", "Radii at rate 0, ``alpha_i`` (read-only), non-decreasing.")
+    n = size_of("_p", "Number of plays.")
 
     @property
     def initial_state(self) -> np.ndarray:
@@ -159,27 +157,19 @@ class RateDependentPI:
         return self.base_radii * (1.0 + self.rate_gain * abs(float(rate)))
 
     def __repr__(self) -> str:
-        return (f"RateDependentPI(weights={np.round(self.weights, 6).tolist()}, "
-                f"base_radii={np.round(self.base_radii, 6).tolist()}, "
-                f"rate_gain={self.rate_gain!r}, dt={self.dt!r}, "
-                f"rate_time_constant={self.rate_time_constant!r})")
+        return operator_repr("RateDependentPI", weights=self._p, base_radii=self._r,
+                             rate_gain=self.rate_gain, dt=self.dt,
+                             rate_time_constant=self.rate_time_constant)
 
     # -- state --------------------------------------------------------------------------
-    def _full_state(self, value) -> np.ndarray:
+    def _check_state(self, value) -> np.ndarray:
         s = np.asarray(value, float).ravel()
         if s.size != self.n + 2 or not np.all(np.isfinite(s)):
             raise ValueError(f"state: expected {self.n + 2} finite values (z[1..{self.n}], "
                              f"v[k-1], rate[k]), got {s.size}")
         return s.copy()
 
-    @property
-    def state(self) -> np.ndarray:
-        """Streaming state (a copy): ``z[1..n]``, ``v[k-1]``, ``rate[k]``."""
-        return self._s.copy()
-
-    @state.setter
-    def state(self, value) -> None:
-        self._s = self._full_state(value)
+    state = streaming_state("Streaming state (a copy): ``z[1..n]``, ``v[k-1]``, ``rate[k]``.")
 
     def reset(self) -> None:
         """Return the streaming state to :attr:`initial_state`.
@@ -192,7 +182,7 @@ class RateDependentPI:
         >>> op.state
         array([0., 0., 0., 0.])
         """
-        self._s = self.initial_state
+        self._restart()
 
     # -- simulation ---------------------------------------------------------------------
     def _run(self, x: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -231,7 +221,7 @@ class RateDependentPI:
         array([0. , 1.4, 0.9])
         """
         x = as_signal(v, "v")
-        s = self.initial_state if state is None else self._full_state(state)
+        s = self._start_state(state)
         y = self._run(x, s)
         return (y, s) if return_state else y
 
@@ -259,7 +249,7 @@ class RateDependentPI:
         >>> op.step(1e-3), op.state
         (0.001, array([0.001, 0.   , 0.001, 1.   ]))
         """
-        return float(self._run(as_signal(v, "v"), self._s)[0])
+        return self._advance(self._run, as_signal(v, "v"))
 
     def to_dict(self) -> dict:
         """JSON-ready parameters.
@@ -309,7 +299,7 @@ class RateDependentPI:
         return RateDependentPIInverse(self)
 
 
-class RateDependentPIInverse:
+class RateDependentPIInverse(InverseStreaming):
     """Exact inverse of a :class:`RateDependentPI`: ``y_d[k]`` in, ``v[k]`` out.
 
     Its state is the forward operator's state (plays ``z[1..n]``, ``v[k-1]``, ``rate[k]``),
@@ -333,14 +323,7 @@ class RateDependentPIInverse:
         self.forward = forward
         self.reset()
 
-    @property
-    def state(self) -> np.ndarray:
-        """Streaming state (a copy), the forward layout."""
-        return self._s.copy()
-
-    @state.setter
-    def state(self, value) -> None:
-        self._s = self.forward._full_state(value)
+    state = streaming_state("Streaming state (a copy), the forward layout.")
 
     def reset(self) -> None:
         """Return to the forward operator's initial state.
@@ -354,7 +337,7 @@ class RateDependentPIInverse:
         >>> inv.state
         array([0., 0., 0., 0.])
         """
-        self._s = self.forward.initial_state
+        self._restart()
 
     def _run(self, yd: np.ndarray, s: np.ndarray) -> np.ndarray:
         f = self.forward
@@ -393,7 +376,7 @@ class RateDependentPIInverse:
         array([0.        , 1.06666667])
         """
         x = as_signal(y_d, "y_d")
-        s = self.forward.initial_state if state is None else self.forward._full_state(state)
+        s = self._start_state(state)
         v = self._run(x, s)
         return (v, s) if return_state else v
 
@@ -421,4 +404,4 @@ class RateDependentPIInverse:
         >>> round(op.inverse().step(1.5), 12)
         1.066666666667
         """
-        return float(self._run(as_signal(y_d, "y_d"), self._s)[0])
+        return self._advance(self._run, as_signal(y_d, "y_d"))
