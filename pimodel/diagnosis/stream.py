@@ -304,9 +304,6 @@ def state_labels(model) -> list[str]:
             + _labels("s", d.order) + _labels("x_delay", nbuf))
 
 
-SETTINGS = ("weights", "offset", "reference_weights", "reference_offset")
-
-
 def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
                     input: str = "v", output: str = "y",
                     input_range: float | None = None) -> control.NonlinearIOSystem:
