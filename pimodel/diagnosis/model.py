@@ -47,12 +47,16 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
 from ..operator import PIOperator
 from .effects import STEP_SHARE, lag, mode, rate_columns, shift
+
+if TYPE_CHECKING:
+    import control
 
 __all__ = ["DiagnosedModel", "DiagnosedInverse", "load_diagnosed_model"]
 
@@ -224,7 +228,8 @@ class DiagnosedModel:
         return DiagnosedInverse(self)
 
     def block(self, dt: float | None = None, *, name: str = "diagnosed", input: str = "v",
-              output: str = "y", input_range: float | None = None):
+              output: str = "y", input_range: float | None = None
+              ) -> control.NonlinearIOSystem:
         """The model as a discrete python-control block (C core step, :mod:`.stream`).
 
         Parameters
