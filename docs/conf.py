@@ -98,6 +98,7 @@ STRICT_MODULES = [
     "pimodel.fmu",
     "pimodel.diagnosis.diagnose",
     "pimodel.diagnosis.model",
+    "pimodel.diagnosis.stream",
     "pimodel.diagnosis.feedforward",
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",

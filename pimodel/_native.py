@@ -185,3 +185,58 @@ def asym_run(a: AsymParams, p: np.ndarray, r: np.ndarray, z: np.ndarray, x: np.n
     fn = lib.pim_asym_inverse_run if inverse else lib.pim_asym_run
     bad = fn(ctypes.byref(a), x.shape[0], p.shape[0], p, r, z, x, out)
     return out, int(bad)
+
+
+# -- the diagnosed model (fmu/src/pim_diagnosed.h) ---------------------------------------------
+
+_DP = ctypes.POINTER(ctypes.c_double)
+
+
+class DiagParams(ctypes.Structure):
+    """``pim_diag`` (fmu/src/pim_diagnosed.h): the model a diagnosis chose, for the C step."""
+
+    _fields_ = [("n", c_size), ("w", _DP), ("r", _DP), ("w0", _DP), ("c", c_double),
+                ("c0", c_double), ("m", c_size), ("lag_a", _DP), ("lag_g", _DP),
+                ("asym", c_int), ("q", c_double), ("c3", c_double), ("center", c_double),
+                ("half", c_double), ("rate_w", _DP), ("dt", c_double),
+                ("rate_scale", c_double), ("input_range", c_double), ("order", c_size),
+                ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
+                ("drift", c_double)]
+
+
+lib.pim_diag_state_size.restype = c_size
+lib.pim_diag_state_size.argtypes = [ctypes.POINTER(DiagParams)]
+lib.pim_diag_check.restype = ctypes.c_char_p
+lib.pim_diag_check.argtypes = [ctypes.POINTER(DiagParams)]
+lib.pim_diag_step.restype = c_double
+lib.pim_diag_step.argtypes = [ctypes.POINTER(DiagParams), F64, c_double, c_double]
+lib.pim_diag_run.restype = None
+lib.pim_diag_run.argtypes = [ctypes.POINTER(DiagParams), F64, c_size, F64, F64_OR_NULL, F64]
+
+
+def diag_pointer(a: np.ndarray | None):
+    """A ``double *`` into ``a`` (float64, C-contiguous, kept alive by the caller), or NULL."""
+    return None if a is None else a.ctypes.data_as(_DP)
+
+
+def diag_state_size(d: DiagParams) -> int:
+    """Length of the model's flat state."""
+    return int(lib.pim_diag_state_size(ctypes.byref(d)))
+
+
+def diag_check(d: DiagParams) -> str | None:
+    """Message naming the first bad parameter, or None."""
+    msg = lib.pim_diag_check(ctypes.byref(d))
+    return None if msg is None else msg.decode()
+
+
+def diag_step(d: DiagParams, x: np.ndarray, v: float, t: float) -> float:
+    """One sample ``y[k]``; the state ``x`` advances in place."""
+    return lib.pim_diag_step(ctypes.byref(d), x, float(v), float(t))
+
+
+def diag_run(d: DiagParams, x: np.ndarray, v: np.ndarray, t: np.ndarray | None) -> np.ndarray:
+    """``y[k]`` for ``v[0..N-1]`` at times ``t`` (None: ``k dt``); ``x`` advances in place."""
+    y = np.empty(v.shape[0])
+    lib.pim_diag_run(ctypes.byref(d), x, v.shape[0], v, t, y)
+    return y

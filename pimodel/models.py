@@ -16,6 +16,8 @@ Format: one JSON object with a ``"type"``; the other keys are the operator's ``t
     {"type": "PIOperator", "weights": [...], "radii": [...], "initial_state": [...]}
     {"type": "Inverse", "operator": {...}}          the exact inverse of the operator
     {"type": "Cascade", "stages": [{...}, ...]}     operators in series, first applied first
+    {"type": "DiagnosedModel", ...}                 a diagnosis' model (its ``to_dict()``;
+                                                    pimodel.diagnosis.model.DiagnosedModel)
 """
 
 from __future__ import annotations
@@ -74,11 +76,15 @@ def _build(kind: str, d: dict, where: str):
             raise ValueError(f"{where}.stages: expected a non-empty list of operators")
         return Cascade(*(model_from_dict(s, where=f"{where}.stages[{i}]")
                          for i, s in enumerate(stages)))
+    if kind == "DiagnosedModel":
+        from .diagnosis.model import DiagnosedModel
+
+        return DiagnosedModel.from_dict(d)
     raise ValueError(f"{where}.type: unknown model type {kind!r}; expected one of {TYPES}")
 
 
 TYPES = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator", "PIOperator",
-         "Inverse", "Cascade")
+         "Inverse", "Cascade", "DiagnosedModel")
 
 
 def model_from_dict(d: dict, *, where: str = "model"):

@@ -1,5 +1,6 @@
 """FMU robustness (issue 14), FMI 2 and FMI 3, all units (issue 19 added GeneralizedPI,
-AsymmetricPI, RateDependentPI and CreepOperator, each with its inverse flag), every call in a
+AsymmetricPI, RateDependentPI and CreepOperator, each with its inverse flag, and
+DiagnosedModel, signed weights, up to 128 plays), every call in a
 child process (tests/fmu_driver.py) so that a crash or a hang fails
 the test instead of killing pytest:
 
@@ -49,14 +50,28 @@ OK, ERROR = 0, 3
 VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "guard": 6,
       "slope_window": 7, "inverse": 8, "time": 9, "in1": 10, "out1": 11, "in2": 12, "out2": 13,
       "in_kind": 20, "in_c0": 21, "in_c1": 22, "in_c2": 23, "in_c3": 24, "rate_gain": 40,
-      "p": 100, "r": 200, "r_hat": 300}
+      "p": 100, "r": 200, "r_hat": 300, "n_lags": 52, "asymmetry_quadratic": 53,
+      "rate_scale": 57, "drift_clock": 60, "lti_order": 61, "delay_samples": 62,
+      "creep_gain": 500, "creep_tau": 600, "rate_band_gain": 700, "lti_b": 800, "lti_a": 900}
 OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
 TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
 CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
 
 
-def weight_message(name: str, i: int, value: float) -> str:
+def bad_weight(name: str):
+    """A weight value the unit refuses (DiagnosedModel: any sign is valid, NaN is not)."""
+    return "nan" if name == "DiagnosedModel" else -1.0
+
+
+def n_max(name: str) -> int:
+    """The largest number of plays of the unit."""
+    return 2 * NMAX if name == "DiagnosedModel" else NMAX
+
+
+def weight_message(name: str, i: int, value) -> str:
     """The logged reason for weight (creep: gain) i (1-based) of a bad value."""
+    if name == "DiagnosedModel":
+        return f"weight p[{i}] = {value} is not finite"
     if name == "CreepOperator":
         return f"gain c[{i}] = {value:g} is not positive"
     if name == "AsymmetricPI":
@@ -134,12 +149,12 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
     cases = {
         "corrupted serialized state": state + [
             *bad_state({**edit, "field": "n", "value": 10**6},
-                       "parameter n = 1000000 out of range: 1 <= n <= 64"),
+                       f"parameter n = 1000000 out of range: 1 <= n <= {n_max(name)}"),
             *bad_state({**edit, "field": "n", "value": -5}, "parameter n = -5 out of range"),
             *bad_state({**edit, "field": "r", "index": 0, "value": nan},
                        radius_message(name, 1)),
-            *bad_state({**edit, "field": "p", "index": 2, "value": -1.0},
-                       weight_message(name, 3, -1.0)),
+            *bad_state({**edit, "field": "p", "index": 2, "value": bad_weight(name)},
+                       weight_message(name, 3, bad_weight(name))),
             *bad_state({**edit, "field": "Ts", "value": 1e-300}, "parameter Ts = 1e-300"),
             *bad_state({**edit, "field": "time", "value": nan}, "time nan must be finite"),
             *bad_state({**edit, "field": "k_next", "value": 2**62}, "sample counter"),
@@ -226,10 +241,12 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
                 "the independent variable and cannot be set")] if fmi3 else []),
             (["enter_init", 0.0], ERROR, "EnterInitializationMode is not allowed now"),
             *step],
-        "indexed parameter messages": expect(init(name, fmi3, p=[1.0, 0.5, -1.0])[:-1]) + [
-            (["exit_init"], ERROR, weight_message(name, 3, -1.0))],
-        "n = 65": expect(init(name, fmi3, n=65)[:-1]) + [
-            (["exit_init"], ERROR, "parameter n = 65 out of range: 1 <= n <= 64")],
+        "indexed parameter messages": expect(init(name, fmi3, p=[1.0, 0.5, bad_weight(name)])
+                                             [:-1]) + [
+            (["exit_init"], ERROR, weight_message(name, 3, bad_weight(name)))],
+        "n = n_max + 1": expect(init(name, fmi3, n=n_max(name) + 1)[:-1]) + [
+            (["exit_init"], ERROR, f"parameter n = {n_max(name) + 1} out of range: 1 <= n <= "
+                                   f"{n_max(name)}")],
     }
     return cases
 
@@ -374,6 +391,25 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
     if name == "RateDependentPI":
         extra.append(["set_real", VR["rate_gain"], _pick_float(rng, rng.uniform(0, 1e-3),
                                                                0.1 * hostile)])
+    if name == "DiagnosedModel":  # effect terms: delay, creep, LTI, asymmetry, rate, drift
+        extra += [["set_real", VR["delay_samples"], rng.choice([0.0, 1.0, 2.5, 7.0]) if not
+                   hostile else rng.choice([0.0, 3.5, -1.0, 5000.0, "nan", "inf"])],
+                  ["set_int", VR["n_lags"], rng.choice([0, 1, 2]) if not hostile else
+                   rng.choice([0, 2, -1, 65])],
+                  *set_array(fmi3, VR["creep_gain"], [0.05, -0.02], 0.0),
+                  *set_array(fmi3, VR["creep_tau"], [_pick_float(rng, 0.01, 0.1 * hostile), 0.3],
+                             1.0),
+                  ["set_real", VR["asymmetry_quadratic"], _pick_float(rng, 0.1, 0.1 * hostile)],
+                  ["set_int", VR["drift_clock"], rng.choice([0, 1, 2]) if not hostile else
+                   rng.choice([0, 3, -1])]]
+        if rng.random() < 0.5:
+            extra += [["set_int", VR["lti_order"], 2 if not hostile else rng.choice([2, 64])],
+                      *set_array(fmi3, VR["lti_b"], [0.0, 0.15, 0.1], 0.0),
+                      *set_array(fmi3, VR["lti_a"], [_pick_float(rng, 1.0, 0.1 * hostile),
+                                                     -1.2, 0.45], 0.0)]
+        if rng.random() < 0.5:
+            extra += [*set_array(fmi3, VR["rate_band_gain"], [0.1] * m, 0.0),
+                      ["set_real", VR["rate_scale"], _pick_float(rng, 2.0, 0.1 * hostile)]]
     acts = init(name, fmi3, n=n, p=p, r=r, Ts=Ts, t0=t0, extra=extra)
     if hostile and rng.random() < 0.2:  # drop or repeat a life-cycle call
         acts.insert(rng.randrange(len(acts) + 1), rng.choice(
@@ -449,6 +485,9 @@ def must_reject(mutation: dict, blob_mode: int, name: str = "") -> bool:
         return True  # checksum, size or magic
     if name == "AsymmetricPI" and mutation["field"] == "p" and mutation["value"] == 0.0:
         return False  # a zero play weight is valid there
+    if name == "DiagnosedModel" and (mutation["field"], mutation["value"]) in (
+            ("p", 0.0), ("p", -1.0), ("n", 65)):
+        return False  # signed weights and up to 128 plays are valid there
     return mutation["field"] in ALWAYS_CHECKED or blob_mode >= 3
 
 

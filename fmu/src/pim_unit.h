@@ -2,12 +2,13 @@
  * The pimodel FMU units, independent of the FMI version: variables, modes, the parameter check,
  * one internal sample, the sub-stepping rule and the checked FMU state format.  Included (static
  * functions) by the FMI 2 and FMI 3 glue after PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
- * 3 InversePI, 4 GeneralizedPI, 5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator) is
- * defined.  Units 4-7 have a Boolean parameter `inverse`: false runs the operator (input u = v,
+ * 3 InversePI, 4 GeneralizedPI, 5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator,
+ * 8 DiagnosedModel) is defined.  Units 4-7 have a Boolean parameter `inverse`: false runs the operator (input u = v,
  * output y), true its exact inverse (input u = y_d, output y = v) with the same parameters,
  * started from the forward operator's initial state (as InversePI).  The numerics are the shared
  * C core (pim_pi.c, pim_estimator.c, pim_loops.c, pim_generalized.c, pim_asymmetric.c,
- * pim_rate_dependent.c, pim_creep.c).  An optional PIM_MODEL_DEFAULTS(u) (defined by a
+ * pim_rate_dependent.c, pim_creep.c, pim_diagnosed.c).  Unit 8 (DiagnosedModel) runs the model a
+ * diagnosis chose (pim_diagnosed.h): signed play weights and the effect terms in parallel.  An optional PIM_MODEL_DEFAULTS(u) (defined by a
  * model-specific model.c, `pimodel fmu build --model`) sets the parameters' start values.
  * Functions return 0 on success, or -1 with the reason in u->msg.
  *
@@ -17,7 +18,7 @@
  * between samples.  A step shorter than Ts that contains no sample instant changes nothing.
  *
  * Limits (each breach is an error with a logged reason, never a crash or a hang):
- *   n in 1..PIM_NMAX (64) plays; Ts finite and >= PIM_TS_MIN; start time finite and >= 0;
+ *   n in 1..PIM_NMAX (64) plays (DiagnosedModel: 1..128); Ts finite and >= PIM_TS_MIN; start time finite and >= 0;
  *   at most PIM_MAX_SUBSTEPS (10^7) samples per doStep; sample index (t+h)/Ts below
  *   PIM_MAX_SAMPLE_INDEX (2^52, where k*Ts is still exact in double); doStep needs
  *   t == the FMU's time (the end of the last step) within min(1e-9 max(1, |t|), 1e-3 Ts),
@@ -26,7 +27,10 @@
  * Value references: the enum ValueReference and, per unit, the table unit_vars (name, reference,
  * type, causality, size) are the one source of truth in C; tests/test_fmu3.py holds every
  * built modelDescription.xml (FMI 2 and 3) equal to unit_vars.  In FMI 2 array element
- * p[i+1] has reference 100 + i (r 200 + i, r_hat 300 + i); in FMI 3 an array is one variable.
+ * p[i+1] has reference 100 + i (r 200 + i, r_hat 300 + i; DiagnosedModel: w0 400 + i,
+ * creep_gain 500 + i, creep_tau 600 + i, rate_band_gain 700 + i, lti_b 800 + i,
+ * lti_a 900 + i, and for plays 65..128 p_hi 1000 + i, r_hi 1100 + i, w0_hi 1200 + i,
+ * rate_band_gain_hi 1300 + i); in FMI 3 an array is one variable.
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
@@ -42,19 +46,25 @@
 #include "pim_asymmetric.h"
 #include "pim_core.h"
 #include "pim_creep.h"
+#include "pim_diagnosed.h"
 #include "pim_estimator.h"
 #include "pim_generalized.h"
 #include "pim_loops.h"
 #include "pim_rate_dependent.h"
 
-#if !defined(PIM_MODEL) || PIM_MODEL < 1 || PIM_MODEL > 7
+#if !defined(PIM_MODEL) || PIM_MODEL < 1 || PIM_MODEL > 8
 #error "define PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator, 3 InversePI, 4 GeneralizedPI, \
-5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator)"
+5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator, 8 DiagnosedModel)"
 #endif
-#define PIM_HAS_INVERSE_FLAG (PIM_MODEL >= 4)
+#define PIM_HAS_INVERSE_FLAG (PIM_MODEL >= 4 && PIM_MODEL <= 7)
 
 #define PIM_NMAX PIM_MAX_PLAYS            /* declared array size: p[1..64], r[..], r_hat[..] */
 #define NMAX PIM_NMAX
+#if PIM_MODEL == 8
+#define PIM_UNIT_NMAX PIM_DIAG_MAX_PLAYS  /* plays 1..64 in p, r, ...; 65..128 in p_hi, r_hi, ... */
+#else
+#define PIM_UNIT_NMAX PIM_NMAX            /* largest n */
+#endif
 #define PIM_MAX_SUBSTEPS 10000000LL       /* samples per doStep */
 #define PIM_MAX_SAMPLE_INDEX 4503599627370496.0 /* 2^52 */
 #define PIM_TS_MIN 1e-12                  /* smallest sample time [s] */
@@ -93,9 +103,32 @@ typedef enum {
     vr_rate_gain = 40, /* RateDependentPI */
     vr_rate_time_constant = 41,
     vr_v0 = 42,
+    vr_offset = 50, /* DiagnosedModel */
+    vr_reference_offset = 51,
+    vr_n_lags = 52,
+    vr_asymmetry_quadratic = 53,
+    vr_asymmetry_cubic = 54,
+    vr_center = 55,
+    vr_half_range = 56,
+    vr_rate_scale = 57,
+    vr_input_range = 58,
+    vr_drift_per_s = 59,
+    vr_drift_clock = 60,
+    vr_lti_order = 61,
+    vr_delay_samples = 62,
     vr_p = 100,
     vr_r = 200,
-    vr_r_hat = 300
+    vr_r_hat = 300,
+    vr_w0 = 400, /* DiagnosedModel arrays */
+    vr_creep_gain = 500,
+    vr_creep_tau = 600,
+    vr_rate_band_gain = 700,
+    vr_lti_b = 800,
+    vr_lti_a = 900,
+    vr_p_hi = 1000, /* DiagnosedModel plays 65..128 */
+    vr_r_hi = 1100,
+    vr_w0_hi = 1200,
+    vr_rate_band_gain_hi = 1300
 } ValueReference;
 
 typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
@@ -141,6 +174,20 @@ typedef struct {
     pim_asym asym;
     /* rate-dependent state: v[k-1], rate[k] */
     double hist[2];
+#if PIM_MODEL == 8
+    /* DiagnosedModel parameters (pim_diagnosed.h; weights w of plays 1..64 in p, radii in r,
+     * plays 65..128 in p_hi, r_hi, w0_hi, rate_band_gain_hi; the creep poles exp(-Ts /
+     * creep_tau) derived into a), the plays' arrays joined (derived) and the flat state */
+    double w0[PIM_NMAX], creep_gain[PIM_NMAX], creep_tau[PIM_NMAX], rate_band_gain[PIM_NMAX];
+    double lti_b[PIM_NMAX], lti_a[PIM_NMAX];
+    double p_hi[PIM_NMAX], r_hi[PIM_NMAX], w0_hi[PIM_NMAX], rate_band_gain_hi[PIM_NMAX];
+    double dw[PIM_DIAG_MAX_PLAYS], dr[PIM_DIAG_MAX_PLAYS], dw0[PIM_DIAG_MAX_PLAYS],
+        drb[PIM_DIAG_MAX_PLAYS];
+    double offset, reference_offset, asym_q, asym_c3, center, half_range, rate_scale,
+        input_range, drift_per_s, delay_samples;
+    int n_lags, lti_order, drift_clock;
+    double dstate[PIM_DIAG_STATE_MAX];
+#endif
     char msg[256]; /* reason of the last failure */
 } pim_unit;
 
@@ -220,6 +267,34 @@ static const pim_var unit_vars[] = {
     {"tau", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
     {"c", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
     {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
+#elif PIM_MODEL == 8
+    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"w0", vr_w0, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0)},
+    {"offset", vr_offset, 'R', PIM_PARAMETER, 1, PIM_AT(offset)},
+    {"reference_offset", vr_reference_offset, 'R', PIM_PARAMETER, 1, PIM_AT(reference_offset)},
+    {"n_lags", vr_n_lags, 'I', PIM_PARAMETER, 1, PIM_AT(n_lags)},
+    {"creep_gain", vr_creep_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_gain)},
+    {"creep_tau", vr_creep_tau, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_tau)},
+    {"asymmetry_quadratic", vr_asymmetry_quadratic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_q)},
+    {"asymmetry_cubic", vr_asymmetry_cubic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_c3)},
+    {"center", vr_center, 'R', PIM_PARAMETER, 1, PIM_AT(center)},
+    {"half_range", vr_half_range, 'R', PIM_PARAMETER, 1, PIM_AT(half_range)},
+    {"rate_band_gain", vr_rate_band_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain)},
+    {"rate_scale", vr_rate_scale, 'R', PIM_PARAMETER, 1, PIM_AT(rate_scale)},
+    {"input_range", vr_input_range, 'R', PIM_PARAMETER, 1, PIM_AT(input_range)},
+    {"drift_per_s", vr_drift_per_s, 'R', PIM_PARAMETER, 1, PIM_AT(drift_per_s)},
+    {"drift_clock", vr_drift_clock, 'I', PIM_PARAMETER, 1, PIM_AT(drift_clock)},
+    {"lti_order", vr_lti_order, 'I', PIM_PARAMETER, 1, PIM_AT(lti_order)},
+    {"lti_b", vr_lti_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_b)},
+    {"lti_a", vr_lti_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_a)},
+    {"delay_samples", vr_delay_samples, 'R', PIM_PARAMETER, 1, PIM_AT(delay_samples)},
+    {"p_hi", vr_p_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p_hi)},
+    {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
+    {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
+    {"rate_band_gain_hi", vr_rate_band_gain_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain_hi)},
 #endif
     {"Ts", vr_Ts, 'R', PIM_PARAMETER, 1, PIM_AT(Ts)},
     {"n", vr_n, 'I', PIM_PARAMETER, 1, PIM_AT(n)},
@@ -277,6 +352,14 @@ static void unit_defaults(pim_unit *u)
         u->r[i] = 1.0;  /* time constant tau [s] */
     }
 #endif
+#if PIM_MODEL == 8
+    for (int i = 0; i < PIM_NMAX; ++i) {
+        u->w0[i] = u->w0_hi[i] = u->p_hi[i] = 1.0;
+        u->creep_tau[i] = 1.0;
+    }
+    u->lti_a[0] = 1.0; /* lti_order 0: no LTI */
+    u->half_range = u->rate_scale = u->input_range = 1.0;
+#endif
 #ifdef PIM_MODEL_DEFAULTS
     PIM_MODEL_DEFAULTS(u);
 #endif
@@ -333,6 +416,146 @@ static int unit_check_creep(pim_unit *u)
 }
 #endif
 
+#if PIM_MODEL == 8
+/* The model of the unit's parameters (pointers into u; built per sample, never stored, so that
+ * a restored FMU state holds no pointer).  The asymmetry and rate terms are on when a
+ * coefficient is non-zero; the state layout (pim_diagnosed.h) follows from the parameters. */
+static void unit_diag(const pim_unit *u, pim_diag *d)
+{
+    const size_t n = (size_t)u->n;
+    int rate = 0;
+    for (size_t i = 0; i < n; ++i) rate |= u->drb[i] != 0.0;
+    d->n = n;
+    d->w = u->dw;
+    d->r = u->dr;
+    d->w0 = u->dw0;
+    d->c = u->offset;
+    d->c0 = u->reference_offset;
+    d->m = (size_t)u->n_lags;
+    d->lag_a = u->a;
+    d->lag_g = u->creep_gain;
+    d->asym = u->asym_q != 0.0 || u->asym_c3 != 0.0;
+    d->q = u->asym_q;
+    d->c3 = u->asym_c3;
+    d->center = u->center;
+    d->half = u->half_range;
+    d->rate_w = rate ? u->drb : NULL;
+    d->dt = u->Ts;
+    d->rate_scale = u->rate_scale;
+    d->input_range = u->input_range;
+    d->order = (size_t)u->lti_order;
+    d->b = u->lti_b;
+    d->a = u->lti_a;
+    d->delay = u->delay_samples;
+    d->drift_clock = u->drift_clock;
+    d->drift = u->drift_per_s;
+}
+
+/* The plays' arrays joined: plays 1..64 from p, r, w0, rate_band_gain, 65..128 from the _hi
+ * arrays (derived, recomputed for every restored state). */
+static void unit_diag_join(pim_unit *u)
+{
+    for (int i = 0; i < PIM_DIAG_MAX_PLAYS; ++i) {
+        const int lo = i < PIM_NMAX, j = lo ? i : i - PIM_NMAX;
+        u->dw[i] = lo ? u->p[j] : u->p_hi[j];
+        u->dr[i] = lo ? u->r[j] : u->r_hi[j];
+        u->dw0[i] = lo ? u->w0[j] : u->w0_hi[j];
+        u->drb[i] = lo ? u->rate_band_gain[j] : u->rate_band_gain_hi[j];
+    }
+}
+
+/* "p[3]" or "p_hi[2]" for play i (0-based) of array `name`. */
+static const char *unit_play_name(const char *name, int i, char *buf, size_t size)
+{
+    if (i < PIM_NMAX)
+        snprintf(buf, size, "%s[%d]", name, i + 1);
+    else
+        snprintf(buf, size, "%s_hi[%d] (play %d)", name, i - PIM_NMAX + 1, i + 1);
+    return buf;
+}
+
+/* The DiagnosedModel parameter rules, with the variable, index and value in the message. */
+static int unit_check_diag(pim_unit *u)
+{
+    unit_diag_join(u);
+    char a[48], b[48];
+    for (int i = 0; i < u->n; ++i) {
+        if (!isfinite(u->dw[i]))
+            return unit_error(u, "weight %s = %g is not finite (weights may have any sign)",
+                              unit_play_name("p", i, a, sizeof a), u->dw[i]);
+        if (!isfinite(u->dw0[i]))
+            return unit_error(u, "reference weight %s = %g is not finite",
+                              unit_play_name("w0", i, a, sizeof a), u->dw0[i]);
+        if (!isfinite(u->dr[i]))
+            return unit_error(u, "radius %s = %g is not finite",
+                              unit_play_name("r", i, a, sizeof a), u->dr[i]);
+        if (u->dr[i] < 0.0)
+            return unit_error(u, "radius %s = %g is negative (radii must be >= 0)",
+                              unit_play_name("r", i, a, sizeof a), u->dr[i]);
+        if (i > 0 && u->dr[i] < u->dr[i - 1])
+            return unit_error(u, "radii not sorted: %s = %g < %s = %g (need r[1] <= ... <= "
+                                 "r[n])", unit_play_name("r", i, a, sizeof a), u->dr[i],
+                              unit_play_name("r", i - 1, b, sizeof b), u->dr[i - 1]);
+        if (!isfinite(u->drb[i]))
+            return unit_error(u, "rate gain %s = %g is not finite",
+                              unit_play_name("rate_band_gain", i, a, sizeof a), u->drb[i]);
+    }
+    if (!isfinite(u->offset) || !isfinite(u->reference_offset))
+        return unit_error(u, "parameters offset = %g, reference_offset = %g: must be finite",
+                          u->offset, u->reference_offset);
+    if (u->n_lags < 0 || u->n_lags > PIM_NMAX)
+        return unit_error(u, "parameter n_lags = %d out of range: 0 <= n_lags <= %d", u->n_lags,
+                          PIM_NMAX);
+    for (int j = 0; j < u->n_lags; ++j) {
+        if (!isfinite(u->creep_gain[j]))
+            return unit_error(u, "creep gain creep_gain[%d] = %g is not finite", j + 1,
+                              u->creep_gain[j]);
+        if (!isfinite(u->creep_tau[j]) || !(u->creep_tau[j] > 0.0))
+            return unit_error(u, "time constant creep_tau[%d] = %g is not positive (must be "
+                                 "finite and > 0 s)", j + 1, u->creep_tau[j]);
+        u->a[j] = exp(-u->Ts / u->creep_tau[j]); /* derived; checked below */
+    }
+    if (!isfinite(u->asym_q) || !isfinite(u->asym_c3) || !isfinite(u->center))
+        return unit_error(u, "parameters asymmetry_quadratic, asymmetry_cubic, center = (%g, %g, "
+                             "%g): must be finite", u->asym_q, u->asym_c3, u->center);
+    if (!isfinite(u->half_range) || !(u->half_range > 0.0))
+        return unit_error(u, "parameter half_range = %g: must be finite and > 0", u->half_range);
+    if (!isfinite(u->rate_scale) || !(u->rate_scale > 0.0))
+        return unit_error(u, "parameter rate_scale = %g: must be finite and > 0", u->rate_scale);
+    if (!isfinite(u->input_range) || !(u->input_range > 0.0))
+        return unit_error(u, "parameter input_range = %g: must be finite and > 0",
+                          u->input_range);
+    if (!isfinite(u->drift_per_s))
+        return unit_error(u, "parameter drift_per_s = %g: must be finite", u->drift_per_s);
+    if (u->drift_clock < 0 || u->drift_clock > 2)
+        return unit_error(u, "parameter drift_clock = %d out of range: 0 none, 1 record, "
+                             "2 absolute", u->drift_clock);
+    if (u->lti_order < 0 || u->lti_order > PIM_DIAG_MAX_ORDER)
+        return unit_error(u, "parameter lti_order = %d out of range: 0 <= lti_order <= %d",
+                          u->lti_order, PIM_DIAG_MAX_ORDER);
+    for (int j = 0; j <= u->lti_order && u->lti_order > 0; ++j) {
+        if (!isfinite(u->lti_b[j]))
+            return unit_error(u, "LTI coefficient lti_b[%d] = %g is not finite", j + 1,
+                              u->lti_b[j]);
+        if (!isfinite(u->lti_a[j]))
+            return unit_error(u, "LTI coefficient lti_a[%d] = %g is not finite", j + 1,
+                              u->lti_a[j]);
+    }
+    if (u->lti_order > 0 && u->lti_a[0] != 1.0)
+        return unit_error(u, "parameter lti_a[1] = %g: the LTI denominator must be normalised "
+                             "(lti_a[1] = 1)", u->lti_a[0]);
+    if (!isfinite(u->delay_samples) || u->delay_samples < 0.0 ||
+        u->delay_samples > PIM_DIAG_MAX_DELAY - 2)
+        return unit_error(u, "parameter delay_samples = %g out of range: 0 <= delay_samples <= "
+                             "%d", u->delay_samples, PIM_DIAG_MAX_DELAY - 2);
+    pim_diag d;
+    unit_diag(u, &d);
+    const char *msg = pim_diag_check(&d);
+    if (msg) return unit_error(u, "bad parameters: %s", msg);
+    return 0;
+}
+#endif
+
 /* Quantities derived from checked parameters (inverse PI, envelope struct, rate filter, creep
  * poles); at setup and for every restored FMU state.  0, or -1 with the reason. */
 static int unit_derive(pim_unit *u)
@@ -353,6 +576,9 @@ static int unit_derive(pim_unit *u)
     u->lam = u->rate_tc > 0.0 ? exp(-u->Ts / u->rate_tc) : 0.0;
 #elif PIM_MODEL == 7
     for (size_t i = 0; i < n; ++i) u->a[i] = exp(-u->Ts / u->r[i]);
+#elif PIM_MODEL == 8
+    for (int j = 0; j < u->n_lags; ++j) u->a[j] = exp(-u->Ts / u->creep_tau[j]);
+    unit_diag_join(u);
 #endif
     (void)n;
     return 0;
@@ -361,8 +587,8 @@ static int unit_derive(pim_unit *u)
 /* The parameter rules, shared by initialization and by every FMU state that is restored. */
 static int unit_check_parameters(pim_unit *u)
 {
-    if (u->n < 1 || u->n > PIM_NMAX)
-        return unit_error(u, "parameter n = %d out of range: 1 <= n <= %d", u->n, PIM_NMAX);
+    if (u->n < 1 || u->n > PIM_UNIT_NMAX)
+        return unit_error(u, "parameter n = %d out of range: 1 <= n <= %d", u->n, PIM_UNIT_NMAX);
     if (!isfinite(u->Ts) || !(u->Ts >= PIM_TS_MIN))
         return unit_error(u, "parameter Ts = %g: the sample time must be > 0 (finite, >= %g)",
                           u->Ts, PIM_TS_MIN);
@@ -373,6 +599,8 @@ static int unit_check_parameters(pim_unit *u)
 #endif
 #if PIM_MODEL == 7
     return unit_check_creep(u);
+#elif PIM_MODEL == 8
+    return unit_check_diag(u);
 #else
     for (int i = 0; i < u->n; ++i) {
 #if PIM_MODEL == 5
@@ -449,7 +677,7 @@ static int unit_check_parameters(pim_unit *u)
                              "must be 0)", u->r[0]);
 #endif
     return 0;
-#endif /* PIM_MODEL != 7 */
+#endif /* PIM_MODEL != 7, 8 */
 }
 
 #if PIM_MODEL == 2
@@ -484,6 +712,9 @@ static int unit_setup(pim_unit *u)
 #if PIM_MODEL == 2
     if (unit_init_estimator(u, &u->est) != 0) return -1;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
+#elif PIM_MODEL == 8
+    memset(u->dstate, 0, sizeof u->dstate); /* not started; plays at z0 */
+    for (size_t i = 0; i < n; ++i) u->dstate[PIM_DIAG_HEADER + i] = u->z0;
 #else
     for (size_t i = 0; i < n; ++i) u->z[i] = u->z0;
 #endif
@@ -513,7 +744,7 @@ static int unit_check_inputs(pim_unit *u)
 {
     if (!isfinite(u->in1))
         return unit_error(u, "input %s = %g is not finite (NaN or Inf)",
-                          PIM_MODEL == 3 ? "y_d" : PIM_MODEL >= 4 ? "u" : "v", u->in1);
+                          PIM_MODEL == 3 ? "y_d" : PIM_HAS_INVERSE_FLAG ? "u" : "v", u->in1);
 #if PIM_MODEL == 2
     if (!isfinite(u->in2)) return unit_error(u, "input y = %g is not finite (NaN or Inf)", u->in2);
 #elif PIM_MODEL == 3
@@ -569,11 +800,16 @@ static void unit_sample(pim_unit *u)
     else
         pim_rdpi_run(1, n, u->p, u->r, u->rate_gain, u->lam, u->Ts, u->z, u->hist, &u->in1,
                      &u->out1);
-#else
+#elif PIM_MODEL == 7
     if (u->inverse)
         pim_creep_inverse_run(1, n, u->a, u->p, u->z, &u->in1, &u->out1);
     else
         pim_creep_run(1, n, u->a, u->p, u->z, &u->in1, &u->out1);
+#else
+    pim_diag d;
+    unit_diag(u, &d);
+    u->out1 = pim_diag_step(&d, u->dstate, u->in1, (double)u->k_next * u->Ts);
+    (void)n;
 #endif
 }
 
@@ -624,10 +860,16 @@ static int unit_do_step(pim_unit *u, double t, double h)
     const double out_saved[2] = {u->out1, u->out2};
 #if PIM_MODEL == 2
     const pim_estimator est_saved = u->est;
-#else
+#elif PIM_MODEL != 8
     double z_saved[PIM_MAX_PLAYS];
     for (int i = 0; i < u->n; ++i) z_saved[i] = u->z[i];
     const double hist_saved[2] = {u->hist[0], u->hist[1]};
+#else
+    pim_diag dg;
+    unit_diag(u, &dg);
+    const size_t dsize = pim_diag_state_size(&dg);
+    double dsaved[PIM_DIAG_STATE_MAX];
+    memcpy(dsaved, u->dstate, dsize * sizeof(double));
 #endif
     for (; u->k_next < k1; ++u->k_next) {
         unit_sample(u);
@@ -639,10 +881,12 @@ static int unit_do_step(pim_unit *u, double t, double h)
 #if PIM_MODEL == 2
             u->est = est_saved;
             for (int i = 0; i < u->n; ++i) u->rhat_out[i] = u->est.rhat[i];
-#else
+#elif PIM_MODEL != 8
             memcpy(u->z, z_saved, (size_t)u->n * sizeof(double));
             u->hist[0] = hist_saved[0];
             u->hist[1] = hist_saved[1];
+#else
+            memcpy(u->dstate, dsaved, dsize * sizeof(double));
 #endif
             return unit_error(u, "the outputs overflowed or are undefined (%g, %g) at sample "
                                  "%lld with the inputs held over this step (an input beyond an "
@@ -661,8 +905,8 @@ static int unit_do_step(pim_unit *u, double t, double h)
  * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
 static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
-    /* FMI 2 array elements: base 100, 200, 300 plus an index below PIM_NMAX */
-    const unsigned base = elements && vr >= 100 && vr < 400 ? vr - vr % 100 : vr;
+    /* FMI 2 array elements: base 100, 200, ..., 1300 plus an index below PIM_NMAX */
+    const unsigned base = elements && vr >= 100 && vr < 1400 ? vr - vr % 100 : vr;
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
         if (v->vr != base) continue;
@@ -839,9 +1083,25 @@ static int unit_check_states(pim_unit *u, pim_unit *s)
     if (msg) return unit_error(u, "FMU state rejected: estimator %s", msg);
     s->est = fresh;
     for (size_t i = 0; i < n; ++i) s->rhat_out[i] = s->est.rhat[i];
-#else
+#elif PIM_MODEL != 8
     if (!unit_all_finite(s->z, n))
         return unit_error(u, "FMU state rejected: a play state z is not finite");
+#endif
+#if PIM_MODEL == 8
+    (void)n; /* the plays' states are in dstate */
+    {
+        pim_diag d;
+        unit_diag(s, &d);
+        const size_t size = pim_diag_state_size(&d), nbuf = pim_diag_delay_length(d.delay);
+        const double *x = s->dstate;
+        if (!unit_all_finite(x, size))
+            return unit_error(u, "FMU state rejected: a model state is not finite");
+        if ((x[0] != 0.0 && x[0] != 1.0) || x[3] < 0.0 || x[3] != floor(x[3]) ||
+            (nbuf ? x[3] >= (double)nbuf : x[3] != 0.0))
+            return unit_error(u, "FMU state rejected: model state started = %g, head = %g "
+                                 "(expected 0 or 1, and 0 <= head < %llu)", x[0], x[3],
+                              (unsigned long long)(nbuf ? nbuf : 1));
+    }
 #endif
 #if PIM_MODEL == 6
     if (!unit_all_finite(s->hist, 2) || s->hist[1] < 0.0)

@@ -10,7 +10,7 @@ from ..data import load_record
 from .common import add_columns_option, refuse_overwrite
 
 EXPORT_FILES = ("augmented.json", "nominal.json", "nominal.model.json",
-                "nominal_1_GeneralizedPI.fmu")
+                "augmented_1_DiagnosedModel.fmu", "nominal_1_DiagnosedModel.fmu")
 
 
 def register(sub) -> None:
@@ -35,10 +35,10 @@ def register(sub) -> None:
                    "spans 90 %% of its range) out of fitting and scoring (default: rest)")
     p.add_argument("--export", default=None, metavar="DIR",
                    help="write the augmented and the nominal model as JSON (augmented.json, "
-                   "nominal.json: pimodel.diagnosis.model.load_diagnosed_model) and the "
-                   "nominal model's FMU (FMI 2; nominal.model.json is its operator JSON for "
-                   "'pimodel fmu build --model'); the augmented model has no FMU (its effects "
-                   "are fitted in parallel to the hysteresis: the reason is printed)")
+                   "nominal.json: pimodel.diagnosis.model.load_diagnosed_model; 'pimodel fmu "
+                   "build --model' takes them) and their FMUs (FMI 2, unit DiagnosedModel: "
+                   "augmented_1_DiagnosedModel.fmu, nominal_1_DiagnosedModel.fmu); "
+                   "nominal.model.json is the nominal model as an operator (GeneralizedPI)")
     p.add_argument("--no-fmu", action="store_true",
                    help="with --export: write the JSON files only (no C compiler needed)")
     add_columns_option(p)
@@ -74,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
 
 def export_models(rep, out_dir, *, fmu: bool = True) -> list:
     """Write ``augmented.json``, ``nominal.json``, ``nominal.model.json`` (operator JSON) and,
-    with ``fmu``, the nominal model's FMU into ``out_dir``; returns the paths written."""
+    with ``fmu``, both models' FMUs (unit DiagnosedModel) into ``out_dir``; returns the paths
+    written."""
     from ..models import save_model
 
     out = Path(out_dir)
@@ -82,21 +83,15 @@ def export_models(rep, out_dir, *, fmu: bool = True) -> list:
     aug, nom = rep.model(augmented=True), rep.model(augmented=False)
     paths = [aug.save(out / "augmented.json"), nom.save(out / "nominal.json")]
     try:
-        op = nom.operator_form()
+        paths.append(save_model(nom.operator_form(), out / "nominal.model.json"))
     except ValueError as err:
         print(f"no operator form of the nominal model: {err}")
-        return paths
-    paths.append(save_model(op, out / "nominal.model.json"))
-    if aug.effects:
-        try:
-            aug.operator_form()
-        except ValueError as err:
-            print(f"augmented model: no FMU ({err})")
     if fmu:
         from ..fmu.model_fmu import build_model_fmus
 
-        try:
-            paths += build_model_fmus(op, out, Ts=nom.dt, stem="nominal")
-        except ValueError as err:
-            print(f"nominal model: no FMU ({err})")
+        for stem, model in (("augmented", aug), ("nominal", nom)):
+            try:
+                paths += build_model_fmus(model, out, stem=stem)
+            except ValueError as err:
+                print(f"{stem} model: no FMU ({err})")
     return paths

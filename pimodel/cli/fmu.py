@@ -13,18 +13,21 @@ def register(sub) -> None:
     b = fsub.add_parser("build", help="compile and package the FMUs (needs a C compiler)",
                         description="Compile the C core and FMI glue with the C compiler on "
                         "PATH and write PIHysteresis.fmu, RadiusEstimator.fmu, InversePI.fmu, "
-                        "GeneralizedPI.fmu, AsymmetricPI.fmu, RateDependentPI.fmu and "
-                        "CreepOperator.fmu (Linux binary, sources, buildDescription.xml); with "
+                        "GeneralizedPI.fmu, AsymmetricPI.fmu, RateDependentPI.fmu, "
+                        "CreepOperator.fmu and DiagnosedModel.fmu (Linux binary, sources, "
+                        "buildDescription.xml); with "
                         "--fmi-version 3.0 the FMI 3.0 versions NAME_fmi3.fmu (arrays as "
                         "arrays). With --model MODEL.json: one FMU per operator of the model "
                         "(MODEL_1_Unit.fmu, ...; a Cascade in the order of its stages) with the "
-                        "model's parameters as start values.")
+                        "model's parameters as start values; a DiagnosedModel JSON (pimodel "
+                        "diagnose --export) gives one DiagnosedModel FMU.")
     b.add_argument("--out", required=True, help="output folder")
     b.add_argument("--which", nargs="+", default=None,
                    help="units to build (default: all): PIHysteresis RadiusEstimator InversePI "
-                   "GeneralizedPI AsymmetricPI RateDependentPI CreepOperator")
+                   "GeneralizedPI AsymmetricPI RateDependentPI CreepOperator DiagnosedModel")
     b.add_argument("--model", default=None,
-                   help="a model JSON file (pimodel.models): build its operators' FMUs")
+                   help="a model JSON file (pimodel.models, or a DiagnosedModel): build its "
+                   "operators' FMUs")
     b.add_argument("--dt", type=float, default=None,
                    help="with --model: sample time [s] of rate-independent stages (default: "
                    "the dt of a rate-dependent or creep stage, else 0.001)")

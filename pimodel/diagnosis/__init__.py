@@ -14,6 +14,8 @@ it returns a :class:`DiagnosisReport`. The submodules:
 - :mod:`pimodel.diagnosis.plots`: the figures of a report;
 - :mod:`pimodel.diagnosis.model`: :class:`~pimodel.diagnosis.model.DiagnosedModel`, the model a
   report chose (:meth:`DiagnosisReport.model`), with its causal feedforward inverse;
+- :mod:`pimodel.diagnosis.stream`: that model streamed sample by sample on the C core, as a
+  python-control block and as the DiagnosedModel FMU unit's values;
 - :mod:`pimodel.diagnosis.feedforward`: open-loop feedforward with such a model, tried on a
   simulated true stage.
 

@@ -16,7 +16,10 @@ where ``D`` is the identity, the unit-gain mode (ZOH, ``(D Z)[k]`` depends on ``
 and/or a delay of ``d`` samples (fractional: linear interpolation). ``L_i`` is the exact
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
 ``a = exp(-dt / tau)``. This class evaluates exactly that form, so :meth:`simulate` equals the
-diagnosis' own prediction.
+diagnosis' own prediction. The same form, streamed sample by sample on the C core
+(:mod:`.stream`), is the python-control block (:meth:`DiagnosedModel.block`) and the
+DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
+:meth:`simulate` to 1e-12.
 
 The inverse solves, sample by sample, ``F_k(v[k]) = y_d[k]``: with the play states, the lags
 and the rate memory of sample k - 1 fixed, ``F_k`` is a polynomial of degree at most 3 in
@@ -44,12 +47,16 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
 from ..operator import PIOperator
 from .effects import STEP_SHARE, lag, mode, rate_columns, shift
+
+if TYPE_CHECKING:
+    import control
 
 __all__ = ["DiagnosedModel", "DiagnosedInverse", "load_diagnosed_model"]
 
@@ -220,6 +227,50 @@ class DiagnosedModel:
         """
         return DiagnosedInverse(self)
 
+    def block(self, dt: float | None = None, *, name: str = "diagnosed", input: str = "v",
+              output: str = "y", input_range: float | None = None
+              ) -> control.NonlinearIOSystem:
+        """The model as a discrete python-control block (C core step, :mod:`.stream`).
+
+        Parameters
+        ----------
+        dt : float, optional
+            Sample time [s]: the model's ``dt`` (default; another value raises).
+        name, input, output : str
+            Block name (prefix of its params) and signal names.
+        input_range : float, optional
+            Range of the rate effect's step rule; default ``2 r_n`` (``simulate``'s default is
+            ``ptp(v)``: pass the same value to compare).
+
+        Returns
+        -------
+        control.NonlinearIOSystem
+            ``y[k]`` from ``v[k]`` (direct feedthrough), states
+            :func:`~pimodel.diagnosis.stream.state_labels`, all zero at the start; a drift term
+            reads python-control's time ``t``.
+
+        Raises
+        ------
+        ValueError
+            ``dt`` other than the model's, or a parameter the C core refuses.
+
+        Examples
+        --------
+        >>> import control
+        >>> from pimodel.blocks import initial_state
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+        >>> blk = m.block()
+        >>> t = np.arange(3) * 1e-3
+        >>> res = control.input_output_response(blk, t, [0.0, 1.0, 0.0],
+        ...                                     initial_state=initial_state(blk))
+        >>> bool(np.allclose(res.outputs, m.simulate([0.0, 1.0, 0.0]), rtol=0, atol=1e-12))
+        True
+        """
+        from .stream import diagnosed_block
+
+        return diagnosed_block(self, dt, name=name, input=input, output=output,
+                               input_range=input_range)
+
     @property
     def is_exactly_invertible(self) -> bool:
         """True when no effect of the model is inverted approximately (drift aside)."""
@@ -295,7 +346,8 @@ class DiagnosedModel:
         :class:`~pimodel.generalized.GeneralizedPI` with the weights (signed, positive partial
         sums) and the offset as an affine output envelope, equal to :meth:`simulate`. The
         diagnosis fits the effects in parallel to the hysteresis (module docstring), which no
-        chain of the operator FMUs reproduces.
+        chain of the operator FMUs reproduces; the DiagnosedModel FMU unit runs any model
+        (:func:`pimodel.diagnosis.stream.fmu_parameters`).
 
         Returns
         -------
@@ -319,8 +371,9 @@ class DiagnosedModel:
 
         if self.effects:
             raise ValueError(f"model: the effects {list(self.effects)} are fitted in parallel "
-                             "to the hysteresis; no operator chain (and so no FMU) reproduces "
-                             "them; only the nominal model has an operator form")
+                             "to the hysteresis; no operator chain reproduces them (the "
+                             "DiagnosedModel FMU unit does: save the model and run 'pimodel fmu "
+                             "build --model'); only the nominal model has an operator form")
         return GeneralizedPI(self.weights, self.radii,
                              signed_weights=bool(np.any(self.weights <= 0)),
                              output_envelope=Envelope.affine(1.0, self.offset))

@@ -6,7 +6,7 @@ Examples
 --------
 >>> from pimodel.fmu import MODELS
 >>> sorted(MODELS)[:3]
-['AsymmetricPI', 'CreepOperator', 'GeneralizedPI']
+['AsymmetricPI', 'CreepOperator', 'DiagnosedModel']
 """
 
 from .build import MODELS, build_fmus

@@ -20,9 +20,10 @@ from xml.sax.saxutils import escape
 NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
 MAX_SUBSTEPS = 10_000_000  # samples per doStep; PIM_MAX_SUBSTEPS in fmu/src/pim_unit.h
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c", "pim_generalized.c",
-                "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c")
+                "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c", "pim_diagnosed.c")
 HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_generalized.h",
-           "pim_asymmetric.h", "pim_rate_dependent.h", "pim_creep.h", "pim_unit.h")
+           "pim_asymmetric.h", "pim_rate_dependent.h", "pim_creep.h", "pim_diagnosed.h",
+           "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
 FMI_VERSIONS = tuple(GLUE)
 SUFFIX = {"2.0": "", "3.0": "_fmi3"}  # file NAME{suffix}.fmu per FMI version
@@ -135,11 +136,12 @@ def _arrays(prefix: str, base: int, causality: str, start: str, what: str) -> li
 
 
 def _common(*, elements: str = "plays", z0: str = "initial play state (input unit)",
-            weights: tuple[str, str, str] = ("p", "1", "weight p (> 0), play")) -> list[Var]:
+            weights: tuple[str, str, str] = ("p", "1", "weight p (> 0), play"),
+            n_max: int = NMAX) -> list[Var]:
     """Ts, n, z0 and the weight array (name, start, description) of a unit."""
     return [
         Var("Ts", 0, "Real", "parameter", "0.001", "sample time [s] (>= 1e-12)"),
-        Var("n", 1, "Integer", "parameter", "1", f"number of {elements}, 1 <= n <= {NMAX}"),
+        Var("n", 1, "Integer", "parameter", "1", f"number of {elements}, 1 <= n <= {n_max}"),
         Var("z0", 2, "Real", "parameter", "0", z0),
         *_arrays(weights[0], 100, "parameter", weights[1], weights[2]),
     ]
@@ -249,6 +251,59 @@ MODELS: dict[str, dict] = {
                  *_arrays("tau", 200, "parameter", "1", "time constant tau [s] (> 0), lag"),
                  _inverse_flag("u, y = G[u]", "y, y = G^-1[y]"),
                  *_io("input (u, or y when inverse)", "output (G[u], or u when inverse)")],
+    },
+    "DiagnosedModel": {
+        "id": 8,
+        "description": "The model a diagnosis chose: PI hysteresis with signed weights and the "
+                       "effect terms in parallel, creep, asymmetry, rate, drift, an LTI (b, a) "
+                       "and a delay (pimodel.diagnosis.model.DiagnosedModel, dt = Ts)",
+        "vars": [*_common(z0="initial play state (input unit; a diagnosis starts at 0)",
+                          weights=("p", "1", "weight w (any sign), play"),
+                          n_max=2 * NMAX),
+                 *_arrays("r", 200, "parameter", "0", "radius r (>= 0, sorted), play"),
+                 *_arrays("w0", 400, "parameter", "1",
+                          "reference weight w0 of h0 (effect terms), play"),
+                 Var("offset", 50, "Real", "parameter", "0", "offset c (output unit)"),
+                 Var("reference_offset", 51, "Real", "parameter", "0", "offset c0 of h0"),
+                 Var("n_lags", 52, "Integer", "parameter", "0",
+                     f"creep lags, 0 <= n_lags <= {NMAX}"),
+                 *_arrays("creep_gain", 500, "parameter", "0", "creep gain g, lag"),
+                 *_arrays("creep_tau", 600, "parameter", "1",
+                          "creep time constant tau [s] (> 0), lag"),
+                 Var("asymmetry_quadratic", 53, "Real", "parameter", "0",
+                     "asymmetry q of u^2, u = (h0 - center) / half_range"),
+                 Var("asymmetry_cubic", 54, "Real", "parameter", "0", "asymmetry c3 of u^3"),
+                 Var("center", 55, "Real", "parameter", "0", "asymmetry center (output unit)"),
+                 Var("half_range", 56, "Real", "parameter", "1", "asymmetry half range (> 0)"),
+                 *_arrays("rate_band_gain", 700, "parameter", "0",
+                          "rate band gain (0: no rate term), play"),
+                 Var("rate_scale", 57, "Real", "parameter", "1",
+                     "input rate [input unit / s] of rho = 1 (> 0)"),
+                 Var("input_range", 58, "Real", "parameter", "1",
+                     "input range of the step rule: a jump above 5 % of it has no rate (> 0)"),
+                 Var("drift_per_s", 59, "Real", "parameter", "0", "drift [output unit / s]"),
+                 Var("drift_clock", 60, "Integer", "parameter", "0",
+                     "drift clock: 0 none, 1 record (t - t_start), 2 absolute (t = k Ts)"),
+                 Var("lti_order", 61, "Integer", "parameter", "0",
+                     "order of the LTI b(z^-1) / a(z^-1) on the hysteresis (0: none, <= 63)"),
+                 *_arrays("lti_b", 800, "parameter", "0",
+                          "LTI numerator, coefficient of z^-(i-1), element"),
+                 *[Var(f"lti_a[{i + 1}]", 900 + i, "Real", "parameter", "1" if i == 0 else "0",
+                       f"LTI denominator (lti_a[1] = 1), coefficient of z^-(i-1), element "
+                       f"{i + 1}") for i in range(NMAX)],
+                 Var("delay_samples", 62, "Real", "parameter", "0",
+                     "delay of the hysteresis term [samples] (0 <= d <= 4094, fractional: "
+                     "linear interpolation)"),
+                 *_arrays("p_hi", 1000, "parameter", "1",
+                          "weight w of play 64 + i (used when n > 64), element"),
+                 *_arrays("r_hi", 1100, "parameter", "0",
+                          "radius of play 64 + i (used when n > 64), element"),
+                 *_arrays("w0_hi", 1200, "parameter", "1",
+                          "reference weight of play 64 + i (used when n > 64), element"),
+                 *_arrays("rate_band_gain_hi", 1300, "parameter", "0",
+                          "rate band gain of play 64 + i (used when n > 64), element"),
+                 Var("v", 10, "Real", "input", "0", "input v"),
+                 Var("y", 11, "Real", "output", "0", "output y")],
     },
 }
 

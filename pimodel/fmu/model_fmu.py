@@ -25,6 +25,7 @@ __all__ = ["build_model_fmus", "cosimulate_chain"]
 # FMU variable -> pim_unit field (fmu/src/pim_unit.h) for the compiled start values
 _FIELDS = {"in_kind": "kind_in", "out_kind": "kind_out", "shape_kind": "kind_in",
            "rate_time_constant": "rate_tc", "c": "p", "tau": "r",
+           "asymmetry_quadratic": "asym_q", "asymmetry_cubic": "asym_c3",
            **{f"{k}_c{j}": f"{'c_out' if k == 'out' else 'c_in'}[{j}]"
               for k in ("in", "out", "shape") for j in range(4)}}
 

@@ -49,13 +49,16 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
 
     Parameters
     ----------
-    op : GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, an inverse of these, or
-        a PIOperator (unit PIHysteresis, input ``v``; no ``inverse`` variable)
+    op : GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, an inverse of these,
+        a PIOperator (unit PIHysteresis, input ``v``; no ``inverse`` variable) or a
+        :class:`~pimodel.diagnosis.model.DiagnosedModel` (unit DiagnosedModel, input ``v``,
+        ``Ts`` its ``dt``; :func:`pimodel.diagnosis.stream.fmu_parameters`)
         The operator (inverses: ``AsymmetricPIInverse``, ``RateDependentPIInverse``, an
         inverted ``CreepOperator``, the result of ``GeneralizedPI.inverse()``).
     Ts : float, optional
         Sample time [s] for the rate-independent operators (default 1e-3); the rate-dependent
-        and creep operators use their own ``dt`` (a different ``Ts`` raises ValueError).
+        and creep operators and a DiagnosedModel use their own ``dt`` (a different ``Ts``
+        raises ValueError).
 
     Returns
     -------
@@ -77,6 +80,14 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
     >>> name, params["inverse"], params["tau[1]"]
     ('CreepOperator', True, 0.1)
     """
+    from ..diagnosis.model import DiagnosedModel
+
+    if isinstance(op, DiagnosedModel):
+        from ..diagnosis.stream import fmu_parameters
+
+        if Ts is not None and Ts != op.dt:
+            raise ValueError(f"Ts: {Ts!r} differs from the model's dt = {op.dt!r}")
+        return fmu_parameters(op)
     inverse = False
     if isinstance(op, GeneralizedPI) and isinstance(getattr(op, "forward", None),
                                                     GeneralizedPI):

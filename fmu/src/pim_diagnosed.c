@@ -1,0 +1,168 @@
+/* The diagnosed model streamed sample by sample; semantics and state layout in pim_diagnosed.h. */
+#include "pim_diagnosed.h"
+
+#include <math.h>
+
+static inline double diag_clamp(double z, double lo, double hi)
+{
+    z = z < hi ? z : hi; /* as pim_pi.c, so the play states are the operator's bit for bit */
+    return z > lo ? z : lo;
+}
+
+size_t pim_diag_delay_length(double delay)
+{
+    return delay > 0.0 ? (size_t)floor(delay) + 2 : 0;
+}
+
+size_t pim_diag_state_size(const pim_diag *d)
+{
+    return PIM_DIAG_HEADER + d->n + (d->rate_w ? d->n : 0) + d->m + d->order +
+           pim_diag_delay_length(d->delay);
+}
+
+static int all_finite(const double *x, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(x[i])) return 0;
+    return 1;
+}
+
+const char *pim_diag_check(const pim_diag *d)
+{
+    if (d->n < 1) return "the model needs at least one play";
+    if (!all_finite(d->w, d->n)) return "a weight is not finite";
+    if (!all_finite(d->w0, d->n)) return "a reference weight is not finite";
+    for (size_t i = 0; i < d->n; ++i) {
+        if (!isfinite(d->r[i]) || d->r[i] < 0.0) return "a radius is negative or not finite";
+        if (i > 0 && d->r[i] < d->r[i - 1]) return "radii not sorted";
+    }
+    if (!isfinite(d->c) || !isfinite(d->c0)) return "an offset is not finite";
+    if (!(isfinite(d->dt) && d->dt > 0.0)) return "the sample time must be finite and > 0";
+    for (size_t j = 0; j < d->m; ++j) {
+        if (!isfinite(d->lag_g[j])) return "a creep gain is not finite";
+        if (!(d->lag_a[j] > 0.0 && d->lag_a[j] < 1.0))
+            return "a creep time constant is not finite and > 0";
+    }
+    if (d->asym) {
+        if (!isfinite(d->q) || !isfinite(d->c3) || !isfinite(d->center))
+            return "an asymmetry coefficient is not finite";
+        if (!(isfinite(d->half) && d->half > 0.0)) return "half_range must be finite and > 0";
+    }
+    if (d->rate_w) {
+        if (!all_finite(d->rate_w, d->n)) return "a rate band gain is not finite";
+        if (!(isfinite(d->rate_scale) && d->rate_scale > 0.0))
+            return "rate_scale must be finite and > 0";
+        if (!(isfinite(d->input_range) && d->input_range > 0.0))
+            return "input_range must be finite and > 0";
+    }
+    if (d->order > PIM_DIAG_MAX_ORDER) return "the LTI order is above 63";
+    if (d->order > 0) {
+        if (!all_finite(d->b, d->order + 1) || !all_finite(d->a, d->order + 1))
+            return "an LTI coefficient is not finite";
+        if (d->a[0] != 1.0) return "the LTI denominator must start with a[0] = 1";
+        double sa = 0.0;
+        for (size_t j = 0; j <= d->order; ++j) sa += d->a[j];
+        if (sa == 0.0) return "the LTI has a pole at z = 1 (sum of a is 0): no rest state";
+    }
+    if (!(isfinite(d->delay) && d->delay >= 0.0 && d->delay <= PIM_DIAG_MAX_DELAY - 2))
+        return "the delay must be finite, >= 0 and <= 4094 samples";
+    if (d->drift_clock < 0 || d->drift_clock > 2) return "drift_clock must be 0, 1 or 2";
+    if (!isfinite(d->drift)) return "the drift is not finite";
+    return NULL;
+}
+
+double pim_diag_step(const pim_diag *d, double *x, double v, double t)
+{
+    const size_t n = d->n, nr = d->rate_w ? n : 0, q = d->order;
+    const size_t nbuf = pim_diag_delay_length(d->delay);
+    double *z = x + PIM_DIAG_HEADER, *mem = z + n, *lag = mem + nr, *s = lag + d->m,
+           *buf = s + q;
+    const int first = x[0] == 0.0;
+    if (first) {
+        x[1] = v;
+        x[2] = t;
+    }
+    /* plays, the hysteresis h and the reference h0; rate memory of the plays that moved */
+    double rho = 0.0;
+    if (nr && !first) {
+        const double dv = fabs(v - x[1]);
+        rho = dv <= PIM_DIAG_STEP_SHARE * d->input_range ? dv / d->dt / d->rate_scale : 0.0;
+    }
+    double h = 0.0, h0 = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double zo = z[i], zn = diag_clamp(zo, v - d->r[i], v + d->r[i]);
+        z[i] = zn;
+        h += d->w[i] * zn;
+        h0 += d->w0[i] * zn;
+        if (nr && !first && zn != zo) mem[i] = zn > zo ? -rho : rho;
+    }
+    h0 += d->c0;
+    /* LTI, transposed direct form II, started at rest around h[0] */
+    double xk = h;
+    if (q) {
+        const double *b = d->b, *a = d->a;
+        if (first) {
+            double sb = 0.0, sa = 0.0;
+            for (size_t j = 0; j <= q; ++j) {
+                sb += b[j];
+                sa += a[j];
+            }
+            const double gain = sb / sa;
+            double acc = 0.0;
+            for (size_t j = q; j >= 1; --j) {
+                acc += b[j] - a[j] * gain;
+                s[j - 1] = acc * h;
+            }
+        }
+        xk = b[0] * h + s[0];
+        for (size_t j = 1; j < q; ++j) s[j - 1] = b[j] * h - a[j] * xk + s[j];
+        s[q - 1] = b[q] * h - a[q] * xk;
+    }
+    /* delay line: buf[head] holds x[k] after the write */
+    double y = xk;
+    if (nbuf) {
+        size_t head = first ? 0 : ((size_t)x[3] + 1) % nbuf;
+        if (first)
+            for (size_t j = 0; j < nbuf; ++j) buf[j] = xk;
+        buf[head] = xk;
+        x[3] = (double)head;
+        const size_t d0 = (size_t)floor(d->delay);
+        const double f = d->delay - (double)d0;
+        const double x0 = buf[(head + nbuf - d0) % nbuf];
+        if (f > 1e-12) {
+            const double x1 = buf[(head + nbuf - d0 - 1) % nbuf];
+            y = (1.0 - f) * x0 + f * x1;
+        } else {
+            y = x0;
+        }
+    }
+    y += d->c;
+    /* the effect terms, in the order of DiagnosedModel.simulate */
+    for (size_t j = 0; j < d->m; ++j) {
+        const double a = d->lag_a[j];
+        lag[j] = (1.0 - a) * h0 + a * (first ? h0 : lag[j]);
+        y += d->lag_g[j] * (lag[j] - h0);
+    }
+    if (d->asym) {
+        const double u = (h0 - d->center) / d->half;
+        y += d->q * (u * u) + d->c3 * (u * u * u);
+    }
+    if (nr) {
+        double acc = 0.0;
+        for (size_t i = 0; i < n; ++i) acc += d->rate_w[i] * (mem[i] * d->r[i]);
+        y += acc;
+    }
+    if (d->drift_clock == 1)
+        y += d->drift * (t - x[2]);
+    else if (d->drift_clock == 2)
+        y += d->drift * t;
+    x[0] = 1.0;
+    x[1] = v;
+    return y;
+}
+
+void pim_diag_run(const pim_diag *d, double *x, size_t N, const double *v, const double *t,
+                  double *y)
+{
+    for (size_t k = 0; k < N; ++k) y[k] = pim_diag_step(d, x, v[k], t ? t[k] : (double)k * d->dt);
+}

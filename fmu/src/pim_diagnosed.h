@@ -1,0 +1,96 @@
+/*
+ * The model a diagnosis chose (pimodel.diagnosis.model.DiagnosedModel), streamed sample by
+ * sample: the PI hysteresis of a radius grid with signed weights and, in parallel, the effect
+ * terms the diagnosis fitted jointly with it.  One implementation for the python-control block
+ * (DiagnosedModel.block), the Python runner (pimodel.diagnosis.stream) and the DiagnosedModel
+ * FMU unit (pim_unit.h, unit 8).
+ *
+ * Discrete-time semantics, sample k at time t[k], input v[k], plays at rest at z_i[-1] (the
+ * state, normally 0):
+ *
+ *     z_i[k] = max(v[k] - r_i, min(v[k] + r_i, z_i[k-1]))              plays (pim_core.h)
+ *     h[k]   = sum_i w_i z_i[k],   h0[k] = sum_i w0_i z_i[k] + c0
+ *     x[k]   = LTI[h][k]          b(z^-1) / a(z^-1), a_0 = 1, at rest around h[0]
+ *     y[k]   = (1 - f) x[k - d0] + f x[k - d0 - 1] + c               delay d = d0 + f samples,
+ *                                                                    x[j < 0] = x[0]
+ *            + sum_j g_j (L_j[k] - h0[k])     creep: L_j[k] = a_j L_j[k-1] + (1 - a_j) h0[k],
+ *                                                    L_j[-1] = h0[0]
+ *            + q u^2 + c3 u^3,  u = (h0[k] - center) / half            asymmetry
+ *            + sum_i rw_i r_i m_i[k]                                   rate
+ *            + s (t[k] - t[0])  or  s t[k]                              drift (record/absolute)
+ *
+ * Rate: m_i[k] = -sign(z_i[k] - z_i[k-1]) rho[k] when play i moved at sample k >= 1, else
+ * m_i[k-1] (m_i = 0 at the start), with rho[k] = |v[k] - v[k-1]| / dt / rate_scale when
+ * |v[k] - v[k-1]| <= PIM_DIAG_STEP_SHARE * input_range, else 0 (a sampled step has no rate).
+ * A fractional delay part f <= 1e-12 counts as 0 (as pimodel.diagnosis.effects.shift).
+ *
+ * State (one flat array of pim_diag_state_size(d) doubles, so that python-control blocks and FMU
+ * states hold it as is): [started, v_prev, t_start, head, z[n], m[n_rate], L[m], s[order],
+ * buf[nbuf]]; all zero (except z = the initial play states) before the first sample.  `head` is
+ * the ring position of x[k-1] in buf (nbuf = floor(d) + 2 when d > 0, else 0).  Units: v and r
+ * in the input unit, y, c, c0, center, half in the output unit, t in s, s in output unit / s.
+ */
+#ifndef PIM_DIAGNOSED_H
+#define PIM_DIAGNOSED_H
+
+#include "pim_core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define PIM_DIAG_STEP_SHARE 0.05     /* pimodel.diagnosis.effects.STEP_SHARE */
+#define PIM_DIAG_MAX_DELAY 4096      /* longest delay line (samples), so d <= 4094 */
+#define PIM_DIAG_MAX_ORDER 63        /* LTI order: b[0..order], a[0..order] in 64 values */
+#define PIM_DIAG_HEADER 4            /* started, v_prev, t_start, head */
+#define PIM_DIAG_MAX_PLAYS (2 * PIM_MAX_PLAYS) /* plays of the FMU unit (a diagnosis: <= 80) */
+#define PIM_DIAG_MAX_LAGS PIM_MAX_PLAYS        /* creep lags of the FMU unit */
+#define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + PIM_DIAG_MAX_LAGS + \
+                            PIM_DIAG_MAX_ORDER + PIM_DIAG_MAX_DELAY)
+
+typedef struct {
+    size_t n;              /* plays */
+    const double *w;       /* weights w_i (any sign) */
+    const double *r;       /* radii, 0 <= r_1 <= ... <= r_n */
+    const double *w0;      /* reference weights w0_i (of h0) */
+    double c, c0;          /* offset and reference offset */
+    size_t m;              /* creep lags (0: none) */
+    const double *lag_a;   /* a_j = exp(-dt / tau_j) */
+    const double *lag_g;   /* gains g_j */
+    int asym;              /* 0: no asymmetry term */
+    double q, c3, center, half;
+    const double *rate_w;  /* per play band gain rw_i, or NULL: no rate term (n_rate = 0) */
+    double dt, rate_scale, input_range;
+    size_t order;          /* LTI order (0: none) */
+    const double *b, *a;   /* b[0..order], a[0..order], a[0] = 1 */
+    double delay;          /* d >= 0 [samples] */
+    int drift_clock;       /* 0 none, 1 record (t - t[0]), 2 absolute (t) */
+    double drift;          /* s */
+} pim_diag;
+
+/* Length of the flat state of d (the layout above). */
+PIM_API size_t pim_diag_state_size(const pim_diag *d);
+
+/* Delay line length for a delay of `delay` samples: floor(delay) + 2, or 0 for delay == 0. */
+PIM_API size_t pim_diag_delay_length(double delay);
+
+/*
+ * NULL when the parameters are valid (finite; radii sorted >= 0; half > 0, rate_scale > 0 and
+ * input_range > 0 where used; lags 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state
+ * exists; 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2), else a static message naming
+ * the first bad one (the FMU adds the value).
+ */
+PIM_API const char *pim_diag_check(const pim_diag *d);
+
+/* One sample: y[k] for v[k] at time t[k]; the state x advances to after sample k. */
+PIM_API double pim_diag_step(const pim_diag *d, double *x, double v, double t);
+
+/* N samples (t may be NULL: t[k] = k dt); x advances. */
+PIM_API void pim_diag_run(const pim_diag *d, double *x, size_t N, const double *v,
+                          const double *t, double *y);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PIM_DIAGNOSED_H */

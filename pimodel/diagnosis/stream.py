@@ -1,0 +1,455 @@
+"""A :class:`~pimodel.diagnosis.model.DiagnosedModel` streamed sample by sample on the C core
+(``fmu/src/pim_diagnosed.c``): the python-control block (:meth:`DiagnosedModel.block`), a
+runner (:func:`stream_simulate`) and the values of the DiagnosedModel FMU unit
+(:func:`fmu_parameters`), so that the block, the runner and the FMU are one implementation.
+:meth:`DiagnosedModel.simulate` stays the NumPy form of the diagnosis (its own prediction);
+``tests/test_diagnosed_block_fmu.py`` holds the two equal to 1e-12 for every effect.
+
+Discrete-time semantics (those of ``simulate``, written per sample): with the play states
+``z_i[k-1]`` (at rest at 0 before the first sample) and the input ``v[k]``,
+``y[k]`` depends on ``v[0..k]`` and ``t[k]`` only; the LTI part (the dynamics) and the delay act
+on the hysteresis term ``sum_i w_i z_i[k]`` and start at rest around its first value; the creep
+lags start at rest around ``h0[0]``; the rate memory of a play is the last rate at which it
+was pushed (a one-sample jump above ``STEP_SHARE * input_range`` counts as a step, no rate).
+
+Two things ``simulate`` takes from the whole record are parameters here:
+
+* ``input_range`` (the rate effect's step rule): ``simulate`` defaults to ``ptp(v)``, the block
+  and the FMU to ``2 r_n`` (the diagnosis' grid span, as :meth:`DiagnosedInverse.simulate`);
+  pass the same value to compare.
+* the drift clock: ``"record"`` counts from the first sample (``t[k] - t[0]``), ``"absolute"``
+  uses ``t[k]`` as given; in a python-control block ``t[k]`` is python-control's time, in the
+  FMU ``k Ts`` (its sample instants).
+
+The dynamics is an LTI part ``b(z^-1) / a(z^-1)`` (``a[0] = 1``): the model's
+``params["lti_b"]``, ``params["lti_a"]`` when given, else the unit-gain mode
+(:func:`~pimodel.diagnosis.effects.mode_coefficients` of ``mode_hz``, ``mode_damping``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import control
+import numpy as np
+
+from .. import _native
+from ..blocks import _Block, _labels, _Settings
+from ..fmu.build import NMAX
+from .effects import mode_coefficients
+
+__all__ = ["NativeModel", "diagnosed_block", "fmu_parameters", "state_labels",
+           "stream_simulate"]
+
+MAX_DELAY = 4094  # samples: PIM_DIAG_MAX_DELAY - 2 (fmu/src/pim_diagnosed.h)
+MAX_ORDER = 63  # LTI order: PIM_DIAG_MAX_ORDER
+CLOCKS = {"record": 1, "absolute": 2}
+
+
+def lti_coefficients(model) -> tuple[np.ndarray, np.ndarray] | None:
+    """The LTI part ``(b, a)`` of a model with ``"dynamics"`` (powers of ``z^-1``, ``a[0] = 1``),
+    or None.
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model.
+
+    Returns
+    -------
+    tuple of numpy.ndarray or None
+        ``params["lti_b"], params["lti_a"]`` (normalised by ``a[0]``) when given, else the
+        ZOH mode of ``mode_hz``, ``mode_damping`` at the model's ``dt``.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3, effects=("dynamics",),
+    ...                    params={"mode_hz": 50.0, "mode_damping": 0.7})
+    >>> b, a = lti_coefficients(m)
+    >>> round(float(b.sum() / a.sum()), 12), float(a[0])
+    (1.0, 1.0)
+    """
+    if "dynamics" not in model.effects:
+        return None
+    p = model.params
+    if "lti_b" in p and "lti_a" in p:
+        b, a = np.asarray(p["lti_b"], float), np.asarray(p["lti_a"], float)
+        if a.ndim != 1 or b.ndim != 1 or a.size == 0 or a[0] == 0:
+            raise ValueError("params: lti_b, lti_a: expected 1-D coefficients with a[0] != 0")
+        return b / a[0], a / a[0]
+    return mode_coefficients(p["mode_hz"], p["mode_damping"], model.dt)
+
+
+def _band_gains(gains, n: int) -> np.ndarray:
+    """Per play, the gain of its rate band (the diagnosis' ``np.array_split`` groups)."""
+    gains = np.asarray(gains, float)
+    out = np.empty(n)
+    for g, idx in zip(gains, np.array_split(np.arange(n), min(gains.size, n)), strict=True):
+        out[idx] = g
+    return out
+
+
+class NativeModel:
+    """A model in the C core's form (``pim_diag``), with its arrays kept alive.
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model.
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n``.
+
+    Raises
+    ------
+    ValueError
+        A parameter the C core refuses (named), more than 64 play columns in a rate model, an
+        LTI order above 63 or a delay above 4094 samples.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> nm = NativeModel(DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3))
+    >>> x = nm.initial_state()
+    >>> round(nm.step(x, 1.0, 0.0), 12), x[:2].tolist()  # y[0], (started, v_prev)
+    (1.35, [1.0, 1.0])
+    """
+
+    def __init__(self, model, input_range: float | None = None):
+        e, p, r = model.effects, model.params, model.radii
+        n = r.size
+        self.model = model
+        self.input_range = float(2 * r[-1] if input_range is None else input_range)
+        keep = {"w": model.weights, "r": r, "w0": model.reference_weights}
+        d = _native.DiagParams()
+        d.n, d.c, d.c0, d.dt = n, model.offset, model.reference_offset, model.dt
+        if "creep" in e:
+            taus = np.asarray(p["creep_time_constants_s"], float)
+            keep["lag_a"] = np.exp(-model.dt / taus)  # as effects.lag
+            keep["lag_g"] = np.asarray(p["creep_lag_gains"], float)
+            if keep["lag_g"].shape != taus.shape:
+                raise ValueError("params: creep_lag_gains and creep_time_constants_s: expected "
+                                 "as many gains as time constants")
+            d.m = taus.size
+        if "asymmetry" in e:
+            d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
+            d.center, d.half = p["center"], p["half_range"]
+        if "rate" in e:
+            keep["rate_w"] = _band_gains(p["rate_band_gains"], n)
+            d.rate_scale, d.input_range = p["rate_scale"], self.input_range
+        lti = lti_coefficients(model)
+        if lti is not None:
+            order = max(lti[0].size, lti[1].size) - 1
+            if order > MAX_ORDER:
+                raise ValueError(f"params: the LTI order {order} is above {MAX_ORDER}")
+            keep["b"] = np.pad(lti[0], (0, order + 1 - lti[0].size))
+            keep["a"] = np.pad(lti[1], (0, order + 1 - lti[1].size))
+            d.order = order
+        if "delay" in e:
+            d.delay = float(p["delay_samples"])
+            if not 0 <= d.delay <= MAX_DELAY:
+                raise ValueError(f"params: delay_samples = {d.delay!r}: expected 0 to "
+                                 f"{MAX_DELAY} samples")
+        if "drift" in e:
+            if p["drift_clock"] not in CLOCKS:
+                raise ValueError(f"params: drift_clock = {p['drift_clock']!r}: expected one of "
+                                 f"{sorted(CLOCKS)}")
+            d.drift_clock, d.drift = CLOCKS[p["drift_clock"]], p["drift_per_s"]
+        self._keep = {k: np.ascontiguousarray(v, dtype=float) for k, v in keep.items()}
+        for k, v in self._keep.items():
+            setattr(d, k, _native.diag_pointer(v))
+        msg = _native.diag_check(d)
+        if msg:
+            raise ValueError(f"model: {msg}")
+        self.params = d
+        self.nstates = _native.diag_state_size(d)
+
+    def initial_state(self) -> np.ndarray:
+        """The state before the first sample: not started, plays at rest at 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            Zeros, ``nstates`` values (labels: :func:`state_labels`).
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> NativeModel(DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3)).initial_state().tolist()
+        [0.0, 0.0, 0.0, 0.0, 0.0]
+        """
+        return np.zeros(self.nstates)
+
+    def step(self, x: np.ndarray, v: float, t: float) -> float:
+        """``y[k]`` for ``v[k]`` at time ``t[k]`` [s]; ``x`` (float64) advances in place.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The state after sample k - 1 (``nstates`` float64 values, C-contiguous).
+        v, t : float
+            Input sample and its time [s].
+
+        Returns
+        -------
+        float
+
+        Raises
+        ------
+        ValueError
+            ``x`` of another length, ``v`` or ``t`` not finite.
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> nm = NativeModel(DiagnosedModel([0.0], [2.0], 0.0, dt=1e-3))
+        >>> nm.step(nm.initial_state(), 0.5, 0.0)
+        1.0
+        """
+        if x.shape != (self.nstates,):
+            raise ValueError(f"state: expected {self.nstates} values, got {x.shape}")
+        if not (math.isfinite(v) and math.isfinite(t)):
+            raise ValueError(f"v, t: sample ({v!r}, {t!r}) is not finite")
+        return _native.diag_step(self.params, x, v, t)
+
+    def run(self, v: np.ndarray, t: np.ndarray | None = None) -> np.ndarray:
+        """``y[k]`` for a whole signal from the initial state (``t``: None gives ``k dt``).
+
+        Parameters
+        ----------
+        v : numpy.ndarray
+            Input samples.
+        t : numpy.ndarray, optional
+            Their times [s].
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> NativeModel(DiagnosedModel([0.0], [2.0], 0.0, dt=1e-3)).run(np.ones(2)).tolist()
+        [2.0, 2.0]
+        """
+        v = np.ascontiguousarray(v, dtype=float)
+        t = None if t is None else np.ascontiguousarray(t, dtype=float)
+        return _native.diag_run(self.params, self.initial_state(), v, t)
+
+
+def stream_simulate(model, v, t=None, *, input_range: float | None = None) -> np.ndarray:
+    """``model.simulate(v, t)`` on the C core, sample by sample (what the block and the FMU run).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model.
+    v : array_like
+        Input samples, every ``dt``.
+    t : array_like, optional
+        Times [s] (drift); default ``k dt``.
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n`` (``simulate``: ``ptp(v)``).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    ValueError
+        ``v`` not a finite 1-D signal, ``t`` of another length, a bad model parameter.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> stream_simulate(m, [0.0, 1.0, 0.0]).round(3).tolist()
+    [0.1, 1.35, 0.35]
+    """
+    from .model import _signal
+
+    v = _signal(v, "v")
+    tk = model._clock(v, t)
+    return NativeModel(model, input_range).run(v, tk)
+
+
+def state_labels(model) -> list[str]:
+    """Names of the block's states, in the C core's layout (``fmu/src/pim_diagnosed.h``).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model.
+
+    Returns
+    -------
+    list of str
+        ``started``, ``v_prev``, ``t_start``, ``head`` (delay line position), ``z[1..n]`` (play
+        states), ``m[1..n]`` (rate memory, with a rate effect), ``L[1..m]`` (creep lags),
+        ``s[1..q]`` (LTI states), ``x_delay[1..nbuf]`` (delay line).
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> state_labels(DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3))
+    ['started', 'v_prev', 't_start', 'head', 'z[1]', 'z[2]']
+    """
+    d = NativeModel(model).params
+    n = model.radii.size
+    nbuf = int(math.floor(d.delay)) + 2 if d.delay > 0 else 0
+    return (["started", "v_prev", "t_start", "head"] + _labels("z", n)
+            + (_labels("m", n) if d.rate_w else []) + _labels("L", d.m)
+            + _labels("s", d.order) + _labels("x_delay", nbuf))
+
+
+def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
+                    input: str = "v", output: str = "y",
+                    input_range: float | None = None) -> control.NonlinearIOSystem:
+    """The model as a discrete python-control block (C step, :mod:`pimodel.blocks` contract).
+
+    ``outfcn(t, x[k], v[k])`` gives ``y[k]`` and ``updfcn`` the state after sample k (direct
+    feedthrough); ``t`` is python-control's time, used by a drift term (module docstring).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model.
+    dt : float, optional
+        Sample time [s]; must be the model's ``dt`` (default), at which its lags, LTI part and
+        delay were fitted.
+    name, input, output : str
+        Block name (params prefix) and signal names.
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n``.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        States :func:`state_labels`; initial state all zeros (``pimodel.blocks.initial_state``).
+
+    Raises
+    ------
+    ValueError
+        ``dt`` other than the model's, a bad model parameter.
+
+    Notes
+    -----
+    Params (defaults from the model): ``"<name>.weights"``, ``"<name>.offset"``,
+    ``"<name>.reference_weights"``, ``"<name>.reference_offset"``, ``"<name>.input_range"``
+    and every effect parameter of ``model.params`` (``"<name>.creep_lag_gains"``, ...). A
+    change that alters the state layout (number of lags, LTI order, delay line) is refused.
+
+    Examples
+    --------
+    >>> import control
+    >>> from pimodel.blocks import initial_state
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> blk = diagnosed_block(m)
+    >>> t = np.arange(3) * 1e-3
+    >>> res = control.input_output_response(blk, t, [0.0, 1.0, 0.0],
+    ...                                     initial_state=initial_state(blk))
+    >>> res.outputs.round(3).tolist()
+    [0.1, 1.35, 0.35]
+    """
+    dt = model.dt if dt is None else float(dt)
+    if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
+        raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its lags, "
+                         "LTI part and delay are per sample of that dt)")
+    native = NativeModel(model, input_range)
+    labels = state_labels(model)
+
+    def build(s: dict) -> NativeModel:
+        params = {k: s[k] for k in model.params}
+        new = replace(model, weights=s["weights"], offset=s["offset"],
+                      reference_weights=s["reference_weights"],
+                      reference_offset=s["reference_offset"], params=params)
+        nm = NativeModel(new, s["input_range"])
+        if nm.nstates != len(labels):
+            raise ValueError(f"the state layout changed ({nm.nstates} states, the block has "
+                             f"{len(labels)}): build a new block for this model")
+        return nm
+
+    defaults = {"weights": model.weights.copy(), "offset": model.offset,
+                "reference_weights": model.reference_weights.copy(),
+                "reference_offset": model.reference_offset,
+                "input_range": native.input_range, **model.params}
+    settings = _Settings(name, defaults, build)
+
+    def run(t, x, u, params):
+        nm = settings.get(params)
+        xs = np.array(x, dtype=float)
+        y = nm.step(xs, float(u[0]), float(t))
+        return y, xs
+
+    def upd(t, x, u, params):
+        return run(t, x, u, params)[1]
+
+    def out(t, x, u, params):
+        return np.array([run(t, x, u, params)[0]])
+
+    return _Block(upd, out, own_state=lambda params: settings.get(params).initial_state(),
+                  inputs=[input], outputs=[output], states=labels, dt=model.dt, name=name,
+                  params=settings.params)
+
+
+def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dict]:
+    """The DiagnosedModel FMU unit and its variable values for ``model`` (``Ts = dt``).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model (at most 128 plays, ``p[1..64]`` and ``p_hi[1..64]``, and 64 creep lags).
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n``.
+
+    Returns
+    -------
+    (str, dict)
+        ``"DiagnosedModel"`` and ``{variable name: value}`` (FMI 2 names, ``"p[2]"``).
+
+    Raises
+    ------
+    ValueError
+        More than 128 plays or 64 lags, or a parameter the C core refuses.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> name, values = fmu_parameters(DiagnosedModel([0.0, 0.5], [1.0, -0.2], 0.1, dt=1e-3))
+    >>> name, values["n"], values["p[2]"], values["offset"]
+    ('DiagnosedModel', 2, -0.2, 0.1)
+    """
+    nm = NativeModel(model, input_range)  # checks the parameters
+    d, k = nm.params, nm._keep
+    n = model.radii.size
+    if n > 2 * NMAX or d.m > NMAX:
+        raise ValueError(f"model: {n} plays and {d.m} creep lags; the FMU takes at most "
+                         f"{2 * NMAX} plays and {NMAX} lags")
+
+    def arr(name, values):
+        """Plays 1..64 in NAME[i], 65..128 in NAME_hi[i] (other arrays: up to 64)."""
+        return {(f"{name}[{i + 1}]" if i < NMAX else f"{name}_hi[{i - NMAX + 1}]"): float(x)
+                for i, x in enumerate(values)}
+
+    out = {"Ts": model.dt, "n": n, "z0": 0.0, **arr("p", model.weights), **arr("r", model.radii),
+           **arr("w0", model.reference_weights), "offset": model.offset,
+           "reference_offset": model.reference_offset, "input_range": nm.input_range}
+    if d.m:
+        out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
+                    **arr("creep_tau", model.params["creep_time_constants_s"])})
+    if d.asym:
+        out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
+                    "half_range": d.half})
+    if "rate_w" in k:
+        out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale})
+    if d.order:
+        out.update({"lti_order": int(d.order), **arr("lti_b", k["b"]), **arr("lti_a", k["a"])})
+    if d.delay:
+        out["delay_samples"] = d.delay
+    if d.drift_clock:
+        out.update({"drift_per_s": d.drift, "drift_clock": int(d.drift_clock)})
+    return "DiagnosedModel", out
+
