@@ -110,7 +110,7 @@ def test_augmented_feedforward(tmp_path):
     assert named >= 2  # creep and asymmetry named on truth: the check above is not vacuous
     real = res.numbers["real"]
     if "skipped" not in real:
-        assert all(np.isfinite(real[loop][m]) for loop in ("open", "closed")
+        assert all(np.isfinite(real["open"][m]) and real["open"][m] > 0
                    for m in ("nominal", "augmented"))
 
 

@@ -1,6 +1,5 @@
 """Feedforward with a diagnosed model's inverse, tried on a simulated true stage: open loop
-(:func:`open_loop_rms`) and inside an integral feedback loop (:func:`integral_loop`,
-:func:`integral_loop_batch`).
+(:func:`open_loop_rms`) and inside an integral feedback loop (:func:`integral_loop`).
 
 The reference is the true stage's own noise-free response to the validate input (reachable by
 construction); the feedforward ``v_ff = model.inverse().simulate(y_d)`` drives the noise-free
@@ -17,7 +16,7 @@ import numpy as np
 
 from .where import startup_length
 
-__all__ = ["integral_loop", "integral_loop_batch", "open_loop_rms"]
+__all__ = ["integral_loop", "open_loop_rms"]
 
 
 def open_loop_rms(truth, t: np.ndarray, v: np.ndarray, models: dict) -> dict:
@@ -122,75 +121,3 @@ def integral_loop(step, t, ff, y_d, ki: float) -> tuple[np.ndarray, np.ndarray]:
         y[k] = step(t[k], v[k])
         u += ki * dt * (y_d[k] - y[k])
     return v, y
-
-
-def integral_loop_batch(simulate, t, ff, y_d, ki: float, *, window: int = 25,
-                        tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`integral_loop` around a stage given only as a causal batch simulation.
-
-    ``simulate(t[:m], v[:m])`` must return the stage's output ``y[:m]``, with ``y[k]``
-    depending on ``v[0..k]`` only. The loop is solved window by window (``window`` samples),
-    by waveform relaxation: the window's input is guessed (the last integral state held),
-    the prefix simulated, the window's ``u`` recomputed from its errors, until the input moves
-    by at most ``tol`` times its scale. By causality each pass settles at least one more
-    sample, so the iteration ends (at most ``window + 1`` passes). Keep
-    ``ki dt |dy/dv| window`` below about 1 (the loop gain over a window): then each pass
-    contracts and about 15 passes reach 1e-12; much longer windows let the passes grow
-    before they settle, and a nonlinear stage can overflow on the way. The result satisfies
-    the loop's equations to ``tol`` and ``y`` is the simulation of the returned ``v``. Cost:
-    about ``N / window`` times the passes, each a simulation of a prefix.
-
-    Parameters
-    ----------
-    simulate : callable
-        ``simulate(t_prefix, v_prefix) -> y_prefix``.
-    t, ff, y_d, ki
-        As in :func:`integral_loop`.
-    window : int, optional
-        Samples per window (default 25).
-    tol : float, optional
-        Convergence bound on the input change, relative to ``1 + max |v|``.
-
-    Returns
-    -------
-    v, y : numpy.ndarray
-        The stage's input and output.
-
-    Raises
-    ------
-    ValueError
-        As :func:`integral_loop`, or ``window < 1``.
-
-    Examples
-    --------
-    >>> from pimodel import PIOperator
-    >>> stage = PIOperator([1.0, 0.5], [0.0, 0.3])
-    >>> t = np.arange(1500) * 1e-4
-    >>> y_d = np.sin(2 * np.pi * 5 * t)
-    >>> ff = np.zeros(t.size)
-    >>> v1, y1 = integral_loop_batch(lambda tt, vv: stage.simulate(vv), t, ff, y_d, 80.0)
-    >>> stage.reset()
-    >>> v2, y2 = integral_loop(lambda tk, vk: stage.step(vk), t, ff, y_d, 80.0)
-    >>> bool(np.max(np.abs(v1 - v2)) < 1e-9)
-    True
-    """
-    ff, y_d, dt = _loop_inputs(t, ff, y_d)
-    t = np.asarray(t, float)
-    if int(window) < 1:
-        raise ValueError(f"window: expected >= 1 samples, got {window!r}")
-    window = int(window)
-    v = ff.copy()
-    u0 = 0.0
-    for s in range(0, ff.size, window):
-        e = min(s + window, ff.size)
-        v[s:e] = ff[s:e] + u0
-        for _ in range(e - s + 1):
-            err = y_d[s:e] - np.asarray(simulate(t[:e], v[:e]), float)[s:e]
-            u = u0 + ki * dt * np.concatenate(([0.0], np.cumsum(err[:-1])))
-            new = ff[s:e] + u
-            moved = float(np.max(np.abs(new - v[s:e])))
-            v[s:e] = new
-            if moved <= tol * (1.0 + float(np.max(np.abs(v[:e])))):
-                break
-        u0 = float(u[-1] + ki * dt * err[-1])
-    return v, np.asarray(simulate(t, v), float)
