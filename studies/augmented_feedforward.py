@@ -103,8 +103,16 @@ def _stage_case(params: dict) -> dict:
         model = rep.model(augmented=name == "augmented")
         ff = model.inverse().simulate(y_d)
         row["open"][name] = _rms(stage.simulate(t, ff, rng) - y_d, start)
-        stepper = stage_stepper(stage, dt, input_range=float(np.ptp(v_ref)), length=t.size)
-        v, y = integral_loop(stepper.step, t, ff, y_d, ki)
+        # pimodel.truth's rate effect takes the step rule's range from the whole record
+        # (ptp(v)); the loop's input is known only at its end, so the loop is rerun with the
+        # range it produced until the two agree (once or twice)
+        span = float(np.ptp(ff))
+        for _ in range(5):
+            stepper = stage_stepper(stage, dt, input_range=span, length=t.size)
+            v, y = integral_loop(stepper.step, t, ff, y_d, ki)
+            if float(np.ptp(v)) == span or getattr(truth, "rate_gain", None) is None:
+                break
+            span = float(np.ptp(v))
         # the stepper must be the generator: the closed loop's input replayed in one batch
         gap = float(np.max(np.abs(stage.simulate(t, v, rng) - y)))
         if gap > 1e-9 * (1.0 + float(np.ptp(y_d))):
