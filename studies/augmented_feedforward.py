@@ -33,7 +33,7 @@ SEEDS = 3
 TARGET_EFFECTS = ("asymmetry", "rate", "creep")  # the target: where the verdict names one
 MIN_CUT = 2.0  # ... the augmented inverse cuts the open-loop RMS at least 2x
 KI_COMPENSATION = 20.0  # V/(um s): the compensation study's loop, PID(0, 20) on its stage
-TWIN_SECONDS = 2.0  # s of the real record's validate half driven through the twin
+TWIN_SECONDS = 2.0  # s of the real record's validate half driven through the twin (quick: 1 s)
 MODELS = ("nominal", "augmented")
 
 
@@ -42,8 +42,8 @@ def cases(quick: bool) -> list[dict]:
     out = [{"generator": gen, "effect": eff, "seed": seed}
            for gen in GENERATORS for eff in (QUICK_EFFECTS[gen] if quick else EFFECTS)
            for seed in range(1 if quick else SEEDS)]
-    out.append({"generator": "real", "effect": "twin", "seed": 0, "seconds": TWIN_SECONDS,
-                "loop": "open"})
+    out.append({"generator": "real", "effect": "twin", "seed": 0,
+                "seconds": TWIN_SECONDS / 2 if quick else TWIN_SECONDS, "loop": "open"})
     return out
 
 
