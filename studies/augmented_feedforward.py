@@ -233,7 +233,6 @@ def _figure(out: Path, rows: list[dict], real: dict | None) -> Path:
             a.bar(i, real[loop][model], 0.6, color=color, hatch=hatch, edgecolor="k",
                   linewidth=0.4, label=f"{model}, open loop")
         a.set_xticks(range(2), ["nominal", "augmented"])
-        a.set_yscale("log")
         a.set(xlabel="inverse used as feedforward", ylabel="RMS tracking error [um]",
               title="real record through its twin, simulated (" + "+".join(real["twin_effects"] or
                                                                    ["no effect"]) + ")")
