@@ -107,6 +107,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.plots",
     "pimodel.truth",
     "pimodel.truth_alt",
+    "pimodel.truth_steps",
 ]
 # The other modules are being written in parallel: a reST problem in one of their docstrings
 # (e.g. ``name``s) is reported at the end of the build as a note, not as a warning, so the

@@ -205,12 +205,38 @@ def rate_dependent_pi(weights, radii, v: np.ndarray, dt: float, gain: float) -> 
     return y
 
 
-def _filter(G, x: np.ndarray, dt: float) -> np.ndarray:
-    """Apply a continuous SISO system (ZOH-discretised) to ``x``, starting at rest around x[0]."""
+def zoh_coefficients(G, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(b, a)`` of a continuous SISO system discretised with a zero-order hold, for
+    :func:`scipy.signal.lfilter` (coefficients of ``z^0, z^-1, ...``).
+
+    Parameters
+    ----------
+    G : control.TransferFunction or LTI system
+        The continuous-time system.
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    b, a : numpy.ndarray
+        Numerator and denominator, of equal length.
+
+    Examples
+    --------
+    >>> from pimodel.actuators import second_order_mode
+    >>> b, a = zoh_coefficients(second_order_mode(1000.0, 0.05), 1e-4)
+    >>> b.size == a.size, round(float(b.sum() / a.sum()), 12)  # unit static gain
+    (True, 1.0)
+    """
     Gd = control.c2d(control.tf(G), dt, method="zoh")
     a = np.ravel(Gd.den[0][0])
     b = np.ravel(Gd.num[0][0])
-    b = np.concatenate((np.zeros(a.size - b.size), b))  # coefficients of z^0, z^-1, ...
+    return np.concatenate((np.zeros(a.size - b.size), b)), a
+
+
+def _filter(G, x: np.ndarray, dt: float) -> np.ndarray:
+    """Apply a continuous SISO system (ZOH-discretised) to ``x``, starting at rest around x[0]."""
+    b, a = zoh_coefficients(G, dt)
     out, _ = lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])
     return out
 

@@ -163,26 +163,54 @@ class AltTruth:
         out = np.empty(v.size)
         e_sat = self.everett(U_SAT, -U_SAT)
         for k, u in enumerate(np.clip(v, -U_SAT, U_SAT)):
-            last_is_max = len(ext) % 2 == 0
-            if len(ext) == 1:
-                if u > ext[0]:
-                    ext.append(u)
-            elif (last_is_max and u >= ext[-1]) or (not last_is_max and u <= ext[-1]):
-                ext[-1] = u
-            else:
-                ext.append(u)
-            while len(ext) >= 4 and ((len(ext) % 2 == 0 and ext[-1] >= ext[-3]) or
-                                     (len(ext) % 2 == 1 and ext[-1] <= ext[-3])):
-                del ext[-3:-1]
-            if len(ext) == 3 and ext[-1] <= ext[0]:
-                del ext[1:]
-            y = -e_sat
-            for i in range(1, len(ext), 2):
-                y += 2 * self.everett(ext[i], ext[i - 1])
-                if i + 1 < len(ext):
-                    y -= 2 * self.everett(ext[i], ext[i + 1])
-            out[k] = y
+            out[k] = self.preisach_step(ext, u, e_sat)
         return out
+
+    def preisach_step(self, ext: list, u: float, e_sat: float) -> float:
+        """One sample of :meth:`preisach`: ``ext`` (the alternating dominant extrema, from
+        ``[-U_SAT]`` at negative saturation) is updated in place with the input ``u``.
+
+        Parameters
+        ----------
+        ext : list of float
+            The memory, ``[m0, M1, m1, M2, ...]``, the last entry the previous input.
+        u : float
+            Input [V], within ``+-U_SAT``.
+        e_sat : float
+            ``everett(U_SAT, -U_SAT)``.
+
+        Returns
+        -------
+        float
+            ``P`` after ``u`` [um].
+
+        Examples
+        --------
+        >>> truth, ext = AltTruth(), [-U_SAT]
+        >>> e_sat = truth.everett(U_SAT, -U_SAT)
+        >>> ys = [truth.preisach_step(ext, u, e_sat) for u in (0.0, 0.5, 0.2)]
+        >>> bool(np.allclose(ys, truth.preisach(np.array([0.0, 0.5, 0.2])))), len(ext)
+        (True, 3)
+        """
+        last_is_max = len(ext) % 2 == 0
+        if len(ext) == 1:
+            if u > ext[0]:
+                ext.append(u)
+        elif (last_is_max and u >= ext[-1]) or (not last_is_max and u <= ext[-1]):
+            ext[-1] = u
+        else:
+            ext.append(u)
+        while len(ext) >= 4 and ((len(ext) % 2 == 0 and ext[-1] >= ext[-3]) or
+                                 (len(ext) % 2 == 1 and ext[-1] <= ext[-3])):
+            del ext[-3:-1]
+        if len(ext) == 3 and ext[-1] <= ext[0]:
+            del ext[1:]
+        y = -e_sat
+        for i in range(1, len(ext), 2):
+            y += 2 * self.everett(ext[i], ext[i - 1])
+            if i + 1 < len(ext):
+                y -= 2 * self.everett(ext[i], ext[i + 1])
+        return y
 
     def hysteresis(self, v: np.ndarray, dt: float) -> np.ndarray:
         """``k v[k] + P[v][k]`` (Preisach, rate-dependent width) or, with ``bouc_wen``, the
@@ -214,17 +242,40 @@ class AltTruth:
                 rho = lfilter([1 - a], [1, -a], rho)
                 p = p * (1.0 + self.rate * rho)
             return self.k_lin * v + p
-        sub = 20
         z = 0.0
         out = np.empty(v.size)
         dv = np.diff(v, prepend=v[0])
         for i in range(v.size):
-            step = dv[i] / sub
-            for _ in range(sub):
-                z += self.bw_a * step - (self.bw_beta * abs(step) * z
-                                         + self.bw_gamma * step * abs(z))
+            z = self.bouc_wen_step(z, dv[i])
             out[i] = self.k_lin * v[i] + z
         return out
+
+    def bouc_wen_step(self, z: float, dv: float) -> float:
+        """One sample of the Bouc-Wen element (20 explicit sub-steps of the input change).
+
+        Parameters
+        ----------
+        z : float
+            The element's state before the sample [um].
+        dv : float
+            Input change over the sample [V].
+
+        Returns
+        -------
+        float
+            The state after the sample [um].
+
+        Examples
+        --------
+        >>> round(AltTruth().bouc_wen_step(0.0, 0.01), 6)  # about bw_a dv, less the damping
+        0.039249
+        """
+        sub = 20
+        step = dv / sub
+        for _ in range(sub):
+            z += self.bw_a * step - (self.bw_beta * abs(step) * z
+                                     + self.bw_gamma * step * abs(z))
+        return z
 
     def simulate(self, t: np.ndarray, v: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t[k]`` [s].

@@ -15,7 +15,7 @@ from pimodel.study_runner import available_studies, run_study
 def test_all_studies_are_listed():
     assert set(available_studies()) >= {"paper_simulation", "paper_experiment", "compensation",
                                         "cosimulation", "sim_to_real", "real_data", "limit_cycle",
-                                        "convergence_map"}
+                                        "convergence_map", "augmented_feedforward"}
 
 
 def _run(name, tmp_path):
@@ -82,6 +82,36 @@ def test_sim_to_real(tmp_path):
         if d["kind"] == "effect":
             strong = case.endswith(("asymmetry", "rate"))
             assert d["min_shrink"] >= (0.7 if strong else 0.5), case
+
+
+@pytest.mark.slow
+def test_augmented_feedforward(tmp_path):
+    """Quick size: every case gives a complete table row with finite errors, the figure is
+    written, and on ``pimodel.truth`` the augmented inverse tracks better than the nominal one
+    (open loop) wherever the verdict names asymmetry or creep."""
+    from pimodel.study_runner import load_study
+
+    res = _run("augmented_feedforward", tmp_path)
+    out = tmp_path / "augmented_feedforward"
+    assert (out / "augmented_feedforward.png").exists()
+    stage_cases = [c for c in load_study("augmented_feedforward").cases(True)
+                   if c["generator"] != "real"]
+    table = res.tables[0]
+    assert len(table.rows) == len(stage_cases) == len(res.numbers["cases"])
+    for row in table.rows:
+        assert len(row) == len(table.columns)
+        assert all(np.isfinite(x) and x > 0 for x in row[4:6] + row[7:9]), row
+    named = 0
+    for key, d in res.numbers["cases"].items():
+        assert d["loop_check"] < 1e-9, key  # the stepped stage is the generator
+        if key.startswith("truth:") and set(d["verdict"]) & {"asymmetry", "creep"}:
+            named += 1
+            assert d["open_cut"] > 1.0, (key, d)
+    assert named >= 2  # creep and asymmetry named on truth: the check above is not vacuous
+    real = res.numbers["real"]
+    if "skipped" not in real:
+        assert all(np.isfinite(real["open"][m]) and real["open"][m] > 0
+                   for m in ("nominal", "augmented"))
 
 
 def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
