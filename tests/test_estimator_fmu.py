@@ -123,32 +123,33 @@ def test_estimator_fmu_refuses_a_bad_law(fmus, fmi, law):
 # ---- health: the FMU's `health` output and its warning at terminate --------------------------
 
 WARNING = 1  # fmi2Warning == fmi3Warning
-HEALTH_CASES = {  # initial radii, input amplitude, record length [s], bits that must be set
-    "healthy, from the truth": (R, 30.0, 3.0, 0),
-    "degenerate start (all 0), short record": ([0.0] * 5, 30.0, 0.2, 1 | 2 | 4),
-    "from below, record too short": (STARTS["below"], 30.0, 3.0, 8),
-    "input range below 2 r_n": (R, 2.0, 3.0, 1),
+HEALTH_CASES = {  # law, initial radii, input amplitude, record length [s], bits that must be set
+    "healthy, from the truth": ("data", R, 30.0, 3.0, 0),
+    "degenerate start (all 0), short record": ("data", [0.0] * 5, 30.0, 0.2, 1 | 2 | 4),
+    "from below, record too short": ("data", STARTS["below"], 30.0, 3.0, 8),
+    "input range below 2 r_n": ("data", R, 2.0, 3.0, 1),
+    "paper's law from below: a wrong fixed point": ("paper", STARTS["below"], 30.0, 3.0, 16),
 }
 PHRASES = {1: "cannot excite every play", 2: "plays merged", 4: "pinned at the projection bound",
-           8: "still moving"}
+           8: "still moving", 16: "does not fit the data"}
 
 
 def python_health_bits(health) -> int:
-    """estimate_radii's health report as the FMU's bit mask (the fit check is Python's own)."""
+    """estimate_radii's health report as the FMU's bit mask."""
     return ((not health.excitation_ok) * 1 | bool(health.merged) * 2 | bool(health.pinned) * 4
-            | bool(health.still_moving) * 8)
+            | bool(health.still_moving) * 8 | (not health.fit_ok) * 16)
 
 
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", list(HEALTH_CASES))
 def test_estimator_fmu_health_output_and_log_equal_python(fmus, case, fmi):
-    r0, amplitude, duration, must = HEALTH_CASES[case]
+    law, r0, amplitude, duration, must = HEALTH_CASES[case]
     t, v = sinusoid(amplitude, 1, fs=1 / TS, duration=duration)
     y = PIOperator(P, R).simulate(v)
-    ref = estimate_radii(v, y, P, dt=TS, initial_radii=r0, **SETTINGS)
+    ref = estimate_radii(v, y, P, dt=TS, initial_radii=r0, law=law, **SETTINGS)
     want = python_health_bits(ref.health)
     assert want & must == must and (want != 0) == (must != 0), (want, ref.health.messages)
-    out, unit = run_fmu(fmus, fmi, r0, v, y, ["health"])
+    out, unit = run_fmu(fmus, fmi, r0, v, y, ["health"], law=LAWS[law])
     assert int(out[-1, 0]) == want
     warnings = [(cat, msg) for status, cat, msg in unit.log_entries if status == WARNING]
     if want == 0:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pimodel._native import HEALTH_MERGED, HEALTH_MOVING, HEALTH_PINNED, health_checks
+from pimodel._native import HEALTH_FIT, HEALTH_MERGED, HEALTH_MOVING, HEALTH_PINNED, health_checks
 from pimodel.estimator_health import estimator_health
 
 
@@ -58,3 +58,24 @@ def test_report_uses_the_c_checks():
 def test_more_plays_than_the_core_holds_is_an_error():
     with pytest.raises(ValueError, match="history: n: must be between 1 and 64"):
         estimator_health(np.sin(np.arange(0, 6, 0.01)), np.ones(65), np.ones((600, 65)))
+
+
+def test_fit_check_of_the_core_matches_the_python_report():
+    """The C fit check (the FMU's; noise level from the mean absolute second difference) on
+    estimate_radii's own run: the RMS over the last quarter is Python's exactly up to 64 rows,
+    and its noise bound is within 5 % of Python's (median based) on a noisy record."""
+    from pimodel import PIOperator, estimate_radii
+    from pimodel.estimator_settings import noise_level
+    from pimodel.signals import add_noise_snr, sinusoid
+
+    p, r = np.array([0.3, 0.5, 0.8]), np.array([0.4, 1.0, 1.5])
+    t, v = sinusoid(5, 1, fs=1000, duration=20)
+    y = add_noise_snr(PIOperator(p, r).simulate(v), 20, np.random.default_rng(0))
+    res = estimate_radii(v, y, p, dt=1e-3, initial_radii=[0.1, 0.2, 0.3], law="paper")
+    short = health_checks(p, res.history[:64], linear_play=False, y=y[:64],
+                          error=res.error[:64])
+    assert short["fit"][0] == pytest.approx(np.sqrt(np.mean(res.error[48:64] ** 2)), rel=1e-12)
+    full = health_checks(p, res.history, linear_play=False, y=y, error=res.error)
+    bound = 1.1 * noise_level(y) + 1e-4 * np.ptp(y)
+    assert full["fit"][1] == pytest.approx(bound, rel=0.05)
+    assert bool(full["flags"] & HEALTH_FIT) == (not res.health.fit_ok)

@@ -486,11 +486,11 @@ static int unit_init_estimator(pim_unit *u, pim_estimator *est)
 
 /* The checks of pim_est_health.h on the samples processed so far (reversals: the estimator's
  * rule); merged and pinned (nullable) get the per-play flags. */
-static int unit_health(const pim_unit *u, double *drift, double *range, int *merged,
-                       int *pinned)
+static int unit_health(const pim_unit *u, double *drift, double *range, double *fit,
+                       int *merged, int *pinned)
 {
     return pim_health_eval(&u->est_health, u->p, u->linear_play, u->est.have_rev > 0.0,
-                           drift, range, merged, pinned);
+                           drift, range, fit, merged, pinned);
 }
 
 /*
@@ -500,11 +500,11 @@ static int unit_health(const pim_unit *u, double *drift, double *range, int *mer
 static int unit_health_report(const pim_unit *u, char *buf, size_t size)
 {
     int merged[PIM_NMAX], pinned[PIM_NMAX];
-    double drift, range;
+    double drift, range, fit[2];
     const int n = u->n;
     buf[0] = '\0';
     if (u->est_health.count == 0.0) return 0;
-    const int flags = unit_health(u, &drift, &range, merged, pinned);
+    const int flags = unit_health(u, &drift, &range, fit, merged, pinned);
     if (!flags) return 0;
     const double *r = u->est_health.last;
     double sp = 0.0, spr = 0.0;
@@ -537,6 +537,10 @@ static int unit_health_report(const pim_unit *u, char *buf, size_t size)
         PIM_ADD(" estimate still moving at the end: drift %g between the last two quarters of "
                 "the record (above 1 percent of max r_hat = %g); use a longer record or larger "
                 "gains;", drift, r[n - 1]);
+    if (flags & PIM_HEALTH_FIT)
+        PIM_ADD(" the model does not fit the data: RMS error %g over the last quarter exceeds "
+                "the noise bound %g (a wrong fixed point, e.g. law = 1 from below, weights "
+                "that do not match the data, or dynamics the PI model lacks);", fit[0], fit[1]);
 #undef PIM_ADD
     for (char *q = buf; *q; ++q)
         if (*q == '%') *q = ' ';
@@ -563,7 +567,7 @@ static int unit_setup(pim_unit *u)
 #if PIM_MODEL == 2
     if (unit_init_estimator(u, &u->est) != 0) return -1;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
-    (void)pim_health_init(&u->est_health, n);
+    (void)pim_health_init(&u->est_health, n, 1);
     u->health = 0;
 #else
     for (size_t i = 0; i < n; ++i) u->z[i] = u->z0;
@@ -620,9 +624,10 @@ static void unit_sample(pim_unit *u)
 #if PIM_MODEL == 1
     u->out1 = pim_pi_step(n, u->p, u->r, u->z, u->in1);
 #elif PIM_MODEL == 2
-    double yh, e, ed;
-    pim_health_add(&u->est_health, 1, &u->in1, u->est.rhat); /* the row of rhat[k] */
+    double yh, e, ed, rhat[PIM_MAX_PLAYS];
+    memcpy(rhat, u->est.rhat, n * sizeof(double)); /* rhat[k], the estimate used at k */
     (void)pim_est_step(&u->est, u->in1, u->in2, NULL, &yh, &e, &ed);
+    pim_health_add(&u->est_health, 1, &u->in1, rhat, &u->in2, &e);
     u->out1 = yh;
     u->out2 = e;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
@@ -736,7 +741,7 @@ static int unit_do_step(pim_unit *u, double t, double h)
         }
     }
 #if PIM_MODEL == 2
-    u->health = unit_health(u, NULL, NULL, NULL, NULL);
+    u->health = unit_health(u, NULL, NULL, NULL, NULL, NULL);
 #endif
     u->time = t_end;
     return 0;
@@ -928,7 +933,7 @@ static int unit_check_states(pim_unit *u, pim_unit *s)
     for (size_t i = 0; i < n; ++i) s->rhat_out[i] = s->est.rhat[i];
     msg = pim_health_check(&s->est_health, n);
     if (msg) return unit_error(u, "FMU state rejected: %s", msg);
-    s->health = s->est_health.count > 0.0 ? unit_health(s, NULL, NULL, NULL, NULL) : 0;
+    s->health = s->est_health.count > 0.0 ? unit_health(s, NULL, NULL, NULL, NULL, NULL) : 0;
 #else
     if (!unit_all_finite(s->z, n))
         return unit_error(u, "FMU state rejected: a play state z is not finite");

@@ -169,8 +169,8 @@ def _io(inp: str, out: str) -> list[Var]:
 # The RadiusEstimator's health output (PIM_HEALTH_* in fmu/src/pim_est_health.h); the report in
 # words goes to the FMU log (category logStatusWarning) at terminate.
 HEALTH_BITS = ("health of the estimate so far, a bit mask: 1 the record cannot excite every "
-               "play (Lemma 2), 2 plays merged, 4 a radius pinned at 0, 8 still moving; "
-               "0 healthy (and before the first sample)")
+               "play (Lemma 2), 2 plays merged, 4 a radius pinned at 0, 8 still moving, "
+               "16 the model does not fit the data; 0 healthy (and before the first sample)")
 LOG_CATEGORIES = ('  <LogCategories><Category name="logStatusWarning" description="warnings (the '
                   'radius estimate\'s health)"/><Category name="logStatusError" '
                   'description="errors"/></LogCategories>')
