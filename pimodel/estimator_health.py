@@ -19,7 +19,10 @@ Five checks on a finished run (the estimate history ``rhat[k]`` over the record)
 
 Merged, pinned and still moving are computed by the C core (``fmu/src/pim_est_health.c``), the
 same code the RadiusEstimator FMU runs on its samples (its ``health`` output and the warning it
-logs at terminate), so the two agree to the last bit.
+logs at terminate), so the two agree to the last bit. The FMU checks the excitation and the
+fit in C too: reversals by the estimator's own rule, and the noise level of y from the mean
+absolute second difference (a streaming stand-in for the median of ``noise_level``); tests hold
+its flags equal to this report.
 """
 
 from __future__ import annotations
@@ -113,6 +116,11 @@ def estimator_health(v, weights, history, *, linear_play: bool = False, y=None, 
     Returns
     -------
     EstimatorHealth
+
+    Raises
+    ------
+    ValueError
+        A history with more than 64 plays (the C core's limit, as the estimator's).
 
     Examples
     --------
