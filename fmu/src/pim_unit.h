@@ -138,12 +138,6 @@ typedef struct {
     double z[PIM_MAX_PLAYS];
     double pinv[PIM_MAX_PLAYS], rinv[PIM_MAX_PLAYS];
     pim_estimator est;
-    /* RadiusEstimator: law (PIM_LAW_DATA 0, PIM_LAW_PAPER 1, a parameter) and the health bit
-     * mask of the estimate so far (an output, 0 before the first sample) */
-    int law, health;
-#if PIM_MODEL == 2
-    pim_est_health est_health; /* rows v[k], rhat[k] of the samples processed */
-#endif
     /* parameters of units 4-7 (GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator;
      * the creep's gains c and time constants tau are stored in p and r) */
     int inverse, kind_in, kind_out;
@@ -155,6 +149,12 @@ typedef struct {
     pim_asym asym;
     /* rate-dependent state: v[k-1], rate[k] */
     double hist[2];
+    /* RadiusEstimator: law (PIM_LAW_DATA 0, PIM_LAW_PAPER 1, a parameter) and the health bit
+     * mask of the estimate so far (an output, 0 before the first sample) */
+    int law, health;
+#if PIM_MODEL == 2
+    pim_est_health est_health; /* rows v[k], rhat[k], y[k], e[k] of the samples processed */
+#endif
     char msg[256]; /* reason of the last failure */
 } pim_unit;
 
