@@ -227,16 +227,20 @@ class FMUUnit:
         array([0.5, 0.3])
         """
         ints = [self._var(n)[0].type in ("Integer", "Int32") for n in names]
-        if not self.fmi3 and not any(ints):
-            return np.array(self.fmu.getReal([self._var(n)[0].valueReference for n in names]))
+        if not self.fmi3:  # one getReal and one getInteger call
+            vrs = np.array([self._var(n)[0].valueReference for n in names], dtype=np.int64)
+            mask = np.array(ints, dtype=bool)
+            out2 = np.empty(len(names))
+            if not mask.all():
+                out2[~mask] = self.fmu.getReal(vrs[~mask].tolist())
+            if mask.any():
+                out2[mask] = self.fmu.getInteger(vrs[mask].tolist())
+            return out2
         out, arrays = [], {}
         for name, is_int in zip(names, ints, strict=True):
             v, i = self._var(name)
             if is_int:
-                get = self.fmu.getInt32 if self.fmi3 else self.fmu.getInteger
-                out.append(float(get([v.valueReference])[0]))
-            elif not self.fmi3:
-                out.append(self.fmu.getReal([v.valueReference])[0])
+                out.append(float(self.fmu.getInt32([v.valueReference])[0]))
             elif v.dimensions:
                 if v.name not in arrays:
                     arrays[v.name] = self._get_array(v)
