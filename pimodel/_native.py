@@ -240,3 +240,47 @@ def diag_run(d: DiagParams, x: np.ndarray, v: np.ndarray, t: np.ndarray | None) 
     y = np.empty(v.shape[0])
     lib.pim_diag_run(ctypes.byref(d), x, v.shape[0], v, t, y)
     return y
+
+
+# -- health of a radius estimate (fmu/src/pim_est_health.h) ------------------------------------
+
+HEALTH_EXCITATION, HEALTH_MERGED, HEALTH_PINNED, HEALTH_MOVING, HEALTH_FIT = 1, 2, 4, 8, 16
+HEALTH_MAX_PLAYS = 64  # PIM_MAX_PLAYS
+
+lib.pim_health_sizeof.restype = c_size
+lib.pim_health_init.restype = ctypes.c_char_p
+lib.pim_health_init.argtypes = [ctypes.c_void_p, c_size, c_int]
+lib.pim_health_add.restype = None
+lib.pim_health_add.argtypes = [ctypes.c_void_p, c_size, F64_OR_NULL, F64, F64_OR_NULL,
+                               F64_OR_NULL]
+lib.pim_health_eval.restype = c_int
+lib.pim_health_eval.argtypes = [ctypes.c_void_p, F64, c_int, ctypes.c_long, c_double_p,
+                                c_double_p, F64_OR_NULL, np.ctypeslib.ndpointer(dtype=np.intc),
+                                np.ctypeslib.ndpointer(dtype=np.intc)]
+
+
+def health_checks(weights: np.ndarray, history: np.ndarray, *, linear_play: bool,
+                  v: np.ndarray | None = None, reversals: int = 0, y: np.ndarray | None = None,
+                  error: np.ndarray | None = None) -> dict:
+    """The C health checks (``pim_health_eval``) on ``history`` (N x n rows ``rhat[k]``, 1 <= n
+    <= 64): ``flags`` (bit mask), ``drift``, ``input_range`` (0 without ``v``), ``fit`` (RMS of
+    ``error`` over the last quarter and its bound, zeros without ``y`` and ``error``),
+    ``merged`` (n - 1 booleans) and ``pinned`` (n booleans)."""
+    hist = np.ascontiguousarray(history, dtype=np.float64)
+    n = hist.shape[1]
+    buf = ctypes.create_string_buffer(lib.pim_health_sizeof())
+    with_fit = y is not None and error is not None
+    msg = lib.pim_health_init(buf, n, int(with_fit))
+    if msg:
+        raise ValueError(f"history: {msg.decode()} (got {n} columns)")
+    x = None if v is None else np.ascontiguousarray(v, dtype=np.float64)
+    ys, es = ((np.ascontiguousarray(y, dtype=np.float64),
+               np.ascontiguousarray(error, dtype=np.float64)) if with_fit else (None, None))
+    lib.pim_health_add(buf, hist.shape[0], x, hist, ys, es)
+    drift, rng, fit = c_double(), c_double(), np.zeros(2)
+    merged, pinned = np.zeros(max(n - 1, 1), np.intc), np.zeros(n, np.intc)
+    p = np.ascontiguousarray(weights, dtype=np.float64)
+    flags = lib.pim_health_eval(buf, p, int(linear_play), int(reversals), ctypes.byref(drift),
+                                ctypes.byref(rng), fit, merged, pinned)
+    return {"flags": int(flags), "drift": drift.value, "input_range": rng.value, "fit": fit,
+            "merged": merged[: n - 1].astype(bool), "pinned": pinned.astype(bool)}

@@ -8,11 +8,21 @@ Five checks on a finished run (the estimate history ``rhat[k]`` over the record)
   of the projection is active: the record did not separate them, or the law is stuck);
 - pinned at the projection bound: ``rhat_j = 0`` for a play not declared linear;
 - still moving: the mean of the last quarter of the record differs from the mean of the
-  quarter before it by more than 1 % of ``max(rhat)`` (the record is too short for the gains);
+  quarter before it by more than 1 % of ``max(rhat)`` (the record is too short for the gains).
+  The quarter boundaries are ``N - 2q`` and ``N - q`` (``q = N // 4``) rounded down to a grid
+  of cumulative sums kept every ``block`` rows (1 while ``N <= 64``, then doubled as needed,
+  so within ``N / 32`` rows), which the RadiusEstimator FMU can keep in bounded memory;
 - model fits the data: the RMS of ``e[k] = yhat[k] - y[k]`` over the last quarter is at most
   ``1.1 sigma_y + 1e-4 range(y)`` (``sigma_y`` the noise level of y,
   :func:`pimodel.estimator_settings.noise_level`). A law stuck at a wrong fixed point (the
   paper's law from below) keeps the estimate still, so only this check sees it.
+
+Merged, pinned and still moving are computed by the C core (``fmu/src/pim_est_health.c``), the
+same code the RadiusEstimator FMU runs on its samples (its ``health`` output and the warning it
+logs at terminate), so the two agree to the last bit. The FMU checks the excitation and the
+fit in C too: reversals by the estimator's own rule, and the noise level of y from the mean
+absolute second difference (a streaming stand-in for the median of ``noise_level``); tests hold
+its flags equal to this report.
 """
 
 from __future__ import annotations
@@ -22,6 +32,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ._native import HEALTH_MOVING, health_checks
 from .estimator_settings import noise_level
 from .excitation import check_excitation
 
@@ -106,6 +117,11 @@ def estimator_health(v, weights, history, *, linear_play: bool = False, y=None, 
     -------
     EstimatorHealth
 
+    Raises
+    ------
+    ValueError
+        A history with more than 64 plays (the C core's limit, as the estimator's).
+
     Examples
     --------
     >>> import numpy as np
@@ -121,21 +137,18 @@ def estimator_health(v, weights, history, *, linear_play: bool = False, y=None, 
     exc = check_excitation(v, weights, final, warn=False)
     if not exc.ok:
         msgs.extend(exc.messages)
-    tol = 1e-6 * max(scale, 1e-12)
-    merged = [(j + 1, j + 2) for j in range(final.size - 1) if final[j + 1] - final[j] <= tol]
+    checks = health_checks(np.asarray(weights, float), hist, linear_play=linear_play)
+    merged = [(j + 1, j + 2) for j in np.flatnonzero(checks["merged"]).tolist()]
     if merged:
         msgs.append("plays merged (equal estimates, the ordering constraint is active): "
                     + ", ".join(f"r_hat[{a}] = r_hat[{b}]" for a, b in merged))
-    start = 1 if linear_play else 0
-    pinned = [j + 1 for j in range(start, final.size) if final[j] == 0.0]
+    pinned = [j + 1 for j in np.flatnonzero(checks["pinned"]).tolist()]
     if pinned:
         msgs.append("radius pinned at the projection bound 0: "
                     + ", ".join(f"r_hat[{j}]" for j in pinned))
     q = hist.shape[0] // 4
-    drift = 0.0
-    if q >= 1:
-        drift = float(np.max(np.abs(hist[-q:].mean(axis=0) - hist[-2 * q:-q].mean(axis=0))))
-    moving = drift > 0.01 * scale
+    drift = checks["drift"]
+    moving = bool(checks["flags"] & HEALTH_MOVING)
     if moving:
         msgs.append(f"estimate still moving at the end: drift {drift:.3g} between the last two "
                     f"quarters of the record (> 1 % of max r_hat = {scale:.3g}); use a longer "

@@ -105,6 +105,15 @@ def test_paper_sinusoid_snr10_within_10_percent_with_defaults(start):
     assert max_rel_error(avg, R) < 0.10
 
 
+@pytest.mark.slow
+def test_paper_sinusoid_snr10_within_10_percent_over_20000_s_for_the_worst_seed():
+    """SNR 10 dB, 10 kHz for 20000 s (200 M samples, chunked), default settings, from below:
+    seed 3, whose mean of the last half misses 10 % at 6000 s (13.9 %: r_1 wanders with a
+    correlation time of several hundred seconds), is within 10 % (seeds 0-9: 1.3-5.2 %)."""
+    _, avg = run_noisy_with_defaults(10, 3, "below", fs=10_000, duration=20_000)
+    assert max_rel_error(avg, R) < 0.10
+
+
 @pytest.mark.parametrize("start", ["below", "mixed"])
 def test_biased_staircase_snr20_within_5_percent_with_defaults(start):
     """Periodic biased stair-step (-15..25, steps 0.5 held 5 ms), 1 kHz, 2000 s, SNR 20 dB,

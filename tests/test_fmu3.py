@@ -181,7 +181,8 @@ def test_short_array_gives_logged_error(fmus):
 def test_fmu_block_and_cosimulation(fmus):
     blk = fmu_block(path(fmus, "RadiusEstimator"), TS, name="est3",
                     start={"Ts": TS, "n": 2, "p": [1.0, 0.5], "r": [0.0, 0.3]})
-    assert blk.output_labels == ["y_hat", "e", *[f"r_hat[{i}]" for i in range(1, NMAX + 1)]]
+    assert blk.output_labels == ["y_hat", "e", *[f"r_hat[{i}]" for i in range(1, NMAX + 1)],
+                                 "health"]
     assert blk.input_labels == ["v", "y"]
     dt = 1e-4
     _, yd = sinusoid(8, 20, fs=1 / dt, duration=0.05)

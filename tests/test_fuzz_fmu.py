@@ -49,10 +49,11 @@ IDS = [f"{name}-fmi{fmi[0]}" for name, fmi in CONFIGS]
 OK, ERROR = 0, 3
 VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "guard": 6,
       "slope_window": 7, "inverse": 8, "time": 9, "in1": 10, "out1": 11, "in2": 12, "out2": 13,
-      "in_kind": 20, "in_c0": 21, "in_c1": 22, "in_c2": 23, "in_c3": 24, "rate_gain": 40,
-      "p": 100, "r": 200, "r_hat": 300, "n_lags": 52, "asymmetry_quadratic": 53,
-      "rate_scale": 57, "drift_clock": 60, "lti_order": 61, "delay_samples": 62,
-      "creep_gain": 500, "creep_tau": 600, "rate_band_gain": 700, "lti_b": 800, "lti_a": 900}
+      "law": 14, "health": 15, "in_kind": 20, "in_c0": 21, "in_c1": 22, "in_c2": 23,
+      "in_c3": 24, "rate_gain": 40, "p": 100, "r": 200, "r_hat": 300, "n_lags": 52,
+      "asymmetry_quadratic": 53, "rate_scale": 57, "drift_clock": 60, "lti_order": 61,
+      "delay_samples": 62, "creep_gain": 500, "creep_tau": 600, "rate_band_gain": 700,
+      "lti_b": 800, "lti_a": 900}
 OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
 TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
 CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
@@ -248,6 +249,13 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
             (["exit_init"], ERROR, f"parameter n = {n_max(name) + 1} out of range: 1 <= n <= "
                                    f"{n_max(name)}")],
     }
+    if name == "RadiusEstimator":
+        cases["law out of range"] = expect(init(name, fmi3, extra=[
+            ["set_int", VR["law"], 2]])[:-1]) + [
+            (["exit_init"], ERROR, "parameter law = 2 out of range: 0 data"),
+            (["set_int", VR["law"], 1], OK, None), (["exit_init"], OK, None),
+            (["set_int", VR["health"], 1], ERROR, "variable health (value reference 15) is an "
+                                                  "output and cannot be set"), *step]
     return cases
 
 
@@ -379,6 +387,8 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
                   ["set_real", VR["guard"], _pick_float(rng, rng.uniform(0, 0.1), 0.1 * hostile)],
                   ["set_int", VR["slope_window"], rng.choice([0, 8, 8, 63, 64, -1, 10**9])
                    if hostile else rng.choice([0, 8, 63])],
+                  ["set_int", VR["law"], rng.choice([0, 1, 2, -1, 10**9]) if hostile else
+                   rng.choice([0, 1])],
                   ["set_bool", VR["linear_play"], rng.random() < 0.5]]
     if name == "InversePI":
         extra.append(["set_bool", VR["adaptive"], rng.random() < 0.5])
@@ -415,7 +425,7 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
         acts.insert(rng.randrange(len(acts) + 1), rng.choice(
             [["exit_init"], ["enter_init", 0.0], ["terminate"], ["reset"], ["step_next", 1e-3]]))
     h_base = Ts if isinstance(Ts, float) and 1e-6 < Ts < 10 else 1e-3
-    bad_vrs = [8, 9, 14, 99, 164, 264, 364, 400, 2**31, 2**32 - 1]
+    bad_vrs = [8, 9, 16, 99, 164, 264, 364, 400, 2**31, 2**32 - 1]
     for _ in range(rng.randint(5, 40)):
         k = rng.random()
         if k < 0.35:

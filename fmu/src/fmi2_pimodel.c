@@ -106,6 +106,14 @@ fmi2Status fmi2Terminate(fmi2Component comp)
     INST(comp);
     IN_MODES(PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) | PIM_IN(PIM_TERMINATED),
              "fmi2Terminate");
+#if PIM_MODEL == 2
+    /* the estimate's health report, once, as a warning (category logStatusWarning) */
+    char report[4096];
+    if (c->u.mode == PIM_STEP_MODE && unit_health_report(&c->u, report, sizeof report) &&
+        c->cb.logger)
+        c->cb.logger(c->cb.componentEnvironment, c->name, fmi2Warning, "logStatusWarning",
+                     report);
+#endif
     c->u.mode = PIM_TERMINATED;
     return fmi2OK;
 }

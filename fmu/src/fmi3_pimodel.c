@@ -124,6 +124,13 @@ fmi3Status fmi3Terminate(fmi3Instance inst)
     INST(inst);
     IN_MODES(PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) | PIM_IN(PIM_TERMINATED),
              "fmi3Terminate");
+#if PIM_MODEL == 2
+    /* the estimate's health report, once, as a warning (category logStatusWarning) */
+    char report[4096];
+    if (c->u.mode == PIM_STEP_MODE && unit_health_report(&c->u, report, sizeof report) &&
+        c->log)
+        c->log(c->env, fmi3Warning, "logStatusWarning", report);
+#endif
     c->u.mode = PIM_TERMINATED;
     return fmi3OK;
 }

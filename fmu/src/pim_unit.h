@@ -12,6 +12,11 @@
  * model-specific model.c, `pimodel fmu build --model`) sets the parameters' start values.
  * Functions return 0 on success, or -1 with the reason in u->msg.
  *
+ * RadiusEstimator: Integer parameter `law` (PIM_LAW_DATA 0, the default, or PIM_LAW_PAPER 1,
+ * pim_estimator.h) and Integer output `health`, the bit mask of the checks of pim_est_health.h
+ * on the samples processed so far (0 before the first one), evaluated after every doStep; the
+ * glue logs the report in words (unit_health_report) once at terminate when it is not 0.
+ *
  * Sampling rule: internal sample k (an int64 counter) happens at time k*Ts.  A step from t over
  * h processes every sample with k*Ts in [t, t+h) (tolerance 1e-9*Ts), each with the inputs set
  * before the call (held over the step); outputs are those of the last processed sample and hold
@@ -47,6 +52,7 @@
 #include "pim_core.h"
 #include "pim_creep.h"
 #include "pim_diagnosed.h"
+#include "pim_est_health.h"
 #include "pim_estimator.h"
 #include "pim_generalized.h"
 #include "pim_loops.h"
@@ -85,6 +91,8 @@ typedef enum {
     vr_out1 = 11, /* y (PIHysteresis, units 4-7), y_hat (RadiusEstimator), v (InversePI) */
     vr_in2 = 12,  /* y (RadiusEstimator) */
     vr_out2 = 13, /* e (RadiusEstimator) */
+    vr_law = 14,    /* RadiusEstimator: principal case from the data (0) or the estimate (1) */
+    vr_health = 15, /* RadiusEstimator: health bit mask (pim_est_health.h) */
     vr_in_kind = 20, /* GeneralizedPI input envelope; AsymmetricPI shape (kind, c0..c3) */
     vr_in_c0 = 21,
     vr_in_c1 = 22,
@@ -174,7 +182,12 @@ typedef struct {
     pim_asym asym;
     /* rate-dependent state: v[k-1], rate[k] */
     double hist[2];
-#if PIM_MODEL == 8
+    /* RadiusEstimator: law (PIM_LAW_DATA 0, PIM_LAW_PAPER 1, a parameter) and the health bit
+     * mask of the estimate so far (an output, 0 before the first sample) */
+    int law, health;
+#if PIM_MODEL == 2
+    pim_est_health est_health; /* rows v[k], rhat[k], y[k], e[k] of the samples processed */
+#elif PIM_MODEL == 8
     /* DiagnosedModel parameters (pim_diagnosed.h; weights w of plays 1..64 in p, radii in r,
      * plays 65..128 in p_hi, r_hi, w0_hi, rate_band_gain_hi; the creep poles exp(-Ts /
      * creep_tau) derived into a), the plays' arrays joined (derived) and the flat state */
@@ -207,7 +220,9 @@ static const pim_var unit_vars[] = {
     {"y_hat", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
     {"e", vr_out2, 'R', PIM_OUTPUT, 1, PIM_AT(out2)},
     {"r_hat", vr_r_hat, 'R', PIM_OUTPUT, PIM_NMAX, PIM_AT(rhat_out)},
+    {"health", vr_health, 'I', PIM_OUTPUT, 1, PIM_AT(health)},
     {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"law", vr_law, 'I', PIM_PARAMETER, 1, PIM_AT(law)},
     {"gain", vr_gain, 'R', PIM_PARAMETER, 1, PIM_AT(gain)},
     {"linear_play", vr_linear_play, 'B', PIM_PARAMETER, 1, PIM_AT(linear_play)},
     {"guard", vr_guard, 'R', PIM_PARAMETER, 1, PIM_AT(guard)},
@@ -639,6 +654,9 @@ static int unit_check_parameters(pim_unit *u)
                           u->slope_window, PIM_EST_WIN - 1);
     if (u->linear_play != 0 && u->linear_play != 1)
         return unit_error(u, "parameter linear_play = %d: must be a Boolean", u->linear_play);
+    if (u->law != PIM_LAW_DATA && u->law != PIM_LAW_PAPER)
+        return unit_error(u, "parameter law = %d out of range: 0 data (principal case from the "
+                             "measured branches, default), 1 paper (from the estimate)", u->law);
 #elif PIM_MODEL == 3
     if (u->adaptive != 0 && u->adaptive != 1)
         return unit_error(u, "parameter adaptive = %d: must be a Boolean", u->adaptive);
@@ -689,7 +707,71 @@ static int unit_init_estimator(pim_unit *u, pim_estimator *est)
     const char *msg = pim_est_init(est, (size_t)u->n, u->p, g, u->r, u->Ts, u->z0, 0.0, 0.0, 0.0,
                                    u->guard, u->linear_play);
     if (!msg) msg = pim_est_set_slope_check(est, u->slope_window, 0.5);
+    if (!msg) msg = pim_est_set_law(est, u->law);
     return msg ? unit_error(u, "bad parameters: %s", msg) : 0;
+}
+
+/* The checks of pim_est_health.h on the samples processed so far (reversals: the estimator's
+ * rule); merged and pinned (nullable) get the per-play flags. */
+static int unit_health(const pim_unit *u, double *drift, double *range, double *fit,
+                       int *merged, int *pinned)
+{
+    return pim_health_eval(&u->est_health, u->p, u->linear_play, u->est.have_rev > 0.0,
+                           drift, range, fit, merged, pinned);
+}
+
+/*
+ * The health report in words (no '%', hosts may use it as a format string) into buf; returns
+ * the bit mask of the failed checks (0: healthy or no sample yet, buf empty).
+ */
+static int unit_health_report(const pim_unit *u, char *buf, size_t size)
+{
+    int merged[PIM_NMAX], pinned[PIM_NMAX];
+    double drift, range, fit[2];
+    const int n = u->n;
+    buf[0] = '\0';
+    if (u->est_health.count == 0.0) return 0;
+    const int flags = unit_health(u, &drift, &range, fit, merged, pinned);
+    if (!flags) return 0;
+    const double *r = u->est_health.last;
+    double sp = 0.0, spr = 0.0;
+    for (int j = 0; j < n; ++j) {
+        sp += u->p[j];
+        spr += u->p[j] * r[j];
+    }
+    size_t len = 0;
+#define PIM_ADD(...) \
+    do { if (len < size) len += (size_t)snprintf(buf + len, size - len, __VA_ARGS__); } while (0)
+    PIM_ADD("radius estimate health after %.0f samples (health = %d):", u->est_health.count,
+            flags);
+    if (flags & PIM_HEALTH_EXCITATION)
+        PIM_ADD(" the record cannot excite every play (Lemma 2, Prop. 2): input range %g, "
+                "2 r_hat[%d] = %g, loop width rho = %g, %s;", range, n, 2.0 * r[n - 1],
+                2.0 * spr / sp, u->est.have_rev > 0.0 ? "reversals seen" : "no reversal");
+    if (flags & PIM_HEALTH_MERGED) {
+        PIM_ADD(" plays merged (equal estimates, the ordering constraint is active):");
+        for (int j = 0; j + 1 < n; ++j)
+            if (merged[j]) PIM_ADD(" r_hat[%d] = r_hat[%d]", j + 1, j + 2);
+        PIM_ADD(";");
+    }
+    if (flags & PIM_HEALTH_PINNED) {
+        PIM_ADD(" radius pinned at the projection bound 0:");
+        for (int j = 0; j < n; ++j)
+            if (pinned[j]) PIM_ADD(" r_hat[%d]", j + 1);
+        PIM_ADD(";");
+    }
+    if (flags & PIM_HEALTH_MOVING)
+        PIM_ADD(" estimate still moving at the end: drift %g between the last two quarters of "
+                "the record (above 1 percent of max r_hat = %g); use a longer record or larger "
+                "gains;", drift, r[n - 1]);
+    if (flags & PIM_HEALTH_FIT)
+        PIM_ADD(" the model does not fit the data: RMS error %g over the last quarter exceeds "
+                "the noise bound %g (a wrong fixed point, e.g. law = 1 from below, weights "
+                "that do not match the data, or dynamics the PI model lacks);", fit[0], fit[1]);
+#undef PIM_ADD
+    for (char *q = buf; *q; ++q)
+        if (*q == '%') *q = ' ';
+    return flags;
 }
 #endif
 
@@ -712,6 +794,8 @@ static int unit_setup(pim_unit *u)
 #if PIM_MODEL == 2
     if (unit_init_estimator(u, &u->est) != 0) return -1;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
+    (void)pim_health_init(&u->est_health, n, 1);
+    u->health = 0;
 #elif PIM_MODEL == 8
     memset(u->dstate, 0, sizeof u->dstate); /* not started; plays at z0 */
     for (size_t i = 0; i < n; ++i) u->dstate[PIM_DIAG_HEADER + i] = u->z0;
@@ -770,8 +854,10 @@ static void unit_sample(pim_unit *u)
 #if PIM_MODEL == 1
     u->out1 = pim_pi_step(n, u->p, u->r, u->z, u->in1);
 #elif PIM_MODEL == 2
-    double yh, e, ed;
+    double yh, e, ed, rhat[PIM_MAX_PLAYS];
+    memcpy(rhat, u->est.rhat, n * sizeof(double)); /* rhat[k], the estimate used at k */
     (void)pim_est_step(&u->est, u->in1, u->in2, NULL, &yh, &e, &ed);
+    pim_health_add(&u->est_health, 1, &u->in1, rhat, &u->in2, &e);
     u->out1 = yh;
     u->out2 = e;
     for (size_t i = 0; i < n; ++i) u->rhat_out[i] = u->est.rhat[i];
@@ -860,6 +946,7 @@ static int unit_do_step(pim_unit *u, double t, double h)
     const double out_saved[2] = {u->out1, u->out2};
 #if PIM_MODEL == 2
     const pim_estimator est_saved = u->est;
+    const pim_est_health health_saved = u->est_health;
 #elif PIM_MODEL != 8
     double z_saved[PIM_MAX_PLAYS];
     for (int i = 0; i < u->n; ++i) z_saved[i] = u->z[i];
@@ -880,6 +967,7 @@ static int unit_do_step(pim_unit *u, double t, double h)
             u->out2 = out_saved[1];
 #if PIM_MODEL == 2
             u->est = est_saved;
+            u->est_health = health_saved;
             for (int i = 0; i < u->n; ++i) u->rhat_out[i] = u->est.rhat[i];
 #elif PIM_MODEL != 8
             memcpy(u->z, z_saved, (size_t)u->n * sizeof(double));
@@ -895,6 +983,9 @@ static int unit_do_step(pim_unit *u, double t, double h)
                               (long long)u->k_next);
         }
     }
+#if PIM_MODEL == 2
+    u->health = unit_health(u, NULL, NULL, NULL, NULL, NULL);
+#endif
     u->time = t_end;
     return 0;
 }
@@ -1003,7 +1094,7 @@ static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 2u /* 2: units 4-7 fields */
+#define PIM_STATE_VERSION 3u /* 2: units 4-7 fields; 3: law, health */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {
@@ -1083,6 +1174,9 @@ static int unit_check_states(pim_unit *u, pim_unit *s)
     if (msg) return unit_error(u, "FMU state rejected: estimator %s", msg);
     s->est = fresh;
     for (size_t i = 0; i < n; ++i) s->rhat_out[i] = s->est.rhat[i];
+    msg = pim_health_check(&s->est_health, n);
+    if (msg) return unit_error(u, "FMU state rejected: %s", msg);
+    s->health = s->est_health.count > 0.0 ? unit_health(s, NULL, NULL, NULL, NULL, NULL) : 0;
 #elif PIM_MODEL != 8
     if (!unit_all_finite(s->z, n))
         return unit_error(u, "FMU state rejected: a play state z is not finite");

@@ -19,10 +19,12 @@ from xml.sax.saxutils import escape
 
 NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
 MAX_SUBSTEPS = 10_000_000  # samples per doStep; PIM_MAX_SUBSTEPS in fmu/src/pim_unit.h
-CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_loops.c", "pim_generalized.c",
-                "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c", "pim_diagnosed.c")
-HEADERS = ("pim_core.h", "pim_estimator.h", "pim_loops.h", "pim_generalized.h",
-           "pim_asymmetric.h", "pim_rate_dependent.h", "pim_creep.h", "pim_diagnosed.h",
+CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_est_health.c", "pim_loops.c",
+                "pim_generalized.c", "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c",
+                "pim_diagnosed.c")
+HEADERS = ("pim_core.h", "pim_estimator.h", "pim_est_health.h", "pim_loops.h",
+           "pim_generalized.h", "pim_asymmetric.h", "pim_rate_dependent.h", "pim_creep.h",
+           "pim_diagnosed.h",
            "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
 FMI_VERSIONS = tuple(GLUE)
@@ -167,6 +169,15 @@ def _io(inp: str, out: str) -> list[Var]:
     return [Var("u", 10, "Real", "input", "0", inp), Var("y", 11, "Real", "output", "0", out)]
 
 
+# The RadiusEstimator's health output (PIM_HEALTH_* in fmu/src/pim_est_health.h); the report in
+# words goes to the FMU log (category logStatusWarning) at terminate.
+HEALTH_BITS = ("health of the estimate so far, a bit mask: 1 the record cannot excite every "
+               "play (Lemma 2), 2 plays merged, 4 a radius pinned at 0, 8 still moving, "
+               "16 the model does not fit the data; 0 healthy (and before the first sample)")
+LOG_CATEGORIES = ('  <LogCategories><Category name="logStatusWarning" description="warnings (the '
+                  'radius estimate\'s health)"/><Category name="logStatusError" '
+                  'description="errors"/></LogCategories>')
+
 MODELS: dict[str, dict] = {
     "PIHysteresis": {
         "id": 1,
@@ -184,12 +195,16 @@ MODELS: dict[str, dict] = {
                      "the model has a linear play: hold r_hat[1] = 0"),
                  Var("guard", 6, "Real", "parameter", "0", "breakpoint guard band (input unit)"),
                  Var("slope_window", 7, "Integer", "parameter", "8",
-                     "slope check window in samples (0: off)"),
+                     "slope check window in samples (0: off; law = 1 only)"),
+                 Var("law", 14, "Integer", "parameter", "0",
+                     "principal case: 0 data (from the measured branches, the default), "
+                     "1 paper (from the estimate, the paper's rule)"),
                  Var("v", 10, "Real", "input", "0", "actuator input v"),
                  Var("y", 12, "Real", "input", "0", "measured output y"),
                  Var("y_hat", 11, "Real", "output", "0", "model output"),
                  Var("e", 13, "Real", "output", "0", "estimation error y_hat - y"),
-                 *_arrays("r_hat", 300, "output", "0", "radius estimate, play")],
+                 *_arrays("r_hat", 300, "output", "0", "radius estimate, play"),
+                 Var("health", 15, "Integer", "output", "0", HEALTH_BITS)],
     },
     "InversePI": {
         "id": 3,
@@ -482,7 +497,7 @@ def model_description(name: str) -> str:
         *[f'      <File name="{s}"/>' for s in CORE_SOURCES],
         "    </SourceFiles>",
         "  </CoSimulation>",
-        '  <LogCategories><Category name="logStatusError" description="errors"/></LogCategories>',
+        LOG_CATEGORIES,
         '  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>',
         "  <ModelVariables>",
     ]

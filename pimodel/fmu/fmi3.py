@@ -7,7 +7,7 @@ from __future__ import annotations
 import uuid
 from xml.sax.saxutils import escape
 
-from .build import MODEL_UNITS, NMAX, spec_of
+from .build import LOG_CATEGORIES, MODEL_UNITS, NMAX, spec_of
 
 TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
 PLATFORM = "x86_64-linux"
@@ -91,7 +91,7 @@ def model_description3(name: str) -> str:
         f'  <CoSimulation modelIdentifier="{name}" canHandleVariableCommunicationStepSize="true"'
         ' canGetAndSetFMUState="true" canSerializeFMUState="true" hasEventMode="false"'
         ' providesIntermediateUpdate="false" canReturnEarlyAfterIntermediateUpdate="false"/>',
-        '  <LogCategories><Category name="logStatusError" description="errors"/></LogCategories>',
+        LOG_CATEGORIES,
         '  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>',
         "  <ModelVariables>",
         '    <Float64 name="time" valueReference="9" causality="independent" '

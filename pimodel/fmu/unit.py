@@ -31,7 +31,9 @@ class FMUUnit:
 
     :meth:`set` / :meth:`get` take variable names; :meth:`step` calls ``doStep(t, h)`` and
     advances the unit's time. Errors from the FMU (fmi2Error) raise fmpy's
-    ``FMICallException``; the FMU's log lines are kept in :attr:`log`.
+    ``FMICallException``; the FMU's log lines are kept in :attr:`log`, and with their FMI
+    status and category in :attr:`log_entries` (``(status, category, message)``, e.g. the
+    RadiusEstimator's health warning ``(1, "logStatusWarning", ...)`` at :meth:`close`).
 
     Parameters
     ----------
@@ -82,6 +84,7 @@ class FMUUnit:
         self._dir = extract(str(self.path), tempfile.mkdtemp(prefix="pimodel_fmu_"))
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.log: list[str] = []
+        self.log_entries: list[tuple[int, str, str]] = []
         self.fmi3 = self.md.fmiVersion.startswith("3")
         ident = self.md.coSimulation.modelIdentifier
         if self.fmi3:
@@ -112,7 +115,10 @@ class FMUUnit:
         self.time = 0.0
 
     def _logger(self, env, instance, status, category, message) -> None:
-        self.log.append(message.decode(errors="replace") if message else "")
+        text = message.decode(errors="replace") if message else ""
+        self.log.append(text)
+        self.log_entries.append((int(status), category.decode(errors="replace") if category
+                                 else "", text))
 
     def _logger3(self, env, status, category, message) -> None:
         self._logger(env, None, status, category, message)
@@ -193,7 +199,7 @@ class FMUUnit:
                 raise TypeError(f"{name}: unsupported type {v.type}")
 
     def get(self, names) -> np.ndarray:
-        """Real values of the named variables (FMI 3 array elements as ``base[i]``).
+        """Values of the named Real or Integer variables (FMI 3 array elements as ``base[i]``).
 
         Parameters
         ----------
@@ -220,12 +226,22 @@ class FMUUnit:
         >>> unit.get(["p[2]", "r[2]"])  # doctest: +SKIP
         array([0.5, 0.3])
         """
-        if not self.fmi3:
-            return np.array(self.fmu.getReal([self._var(n)[0].valueReference for n in names]))
+        ints = [self._var(n)[0].type in ("Integer", "Int32") for n in names]
+        if not self.fmi3:  # one getReal and one getInteger call
+            vrs = np.array([self._var(n)[0].valueReference for n in names], dtype=np.int64)
+            mask = np.array(ints, dtype=bool)
+            out2 = np.empty(len(names))
+            if not mask.all():
+                out2[~mask] = self.fmu.getReal(vrs[~mask].tolist())
+            if mask.any():
+                out2[mask] = self.fmu.getInteger(vrs[mask].tolist())
+            return out2
         out, arrays = [], {}
-        for name in names:
+        for name, is_int in zip(names, ints, strict=True):
             v, i = self._var(name)
-            if v.dimensions:
+            if is_int:
+                out.append(float(self.fmu.getInt32([v.valueReference])[0]))
+            elif v.dimensions:
                 if v.name not in arrays:
                     arrays[v.name] = self._get_array(v)
                 out.extend(arrays[v.name] if i is None else [arrays[v.name][i]])
