@@ -21,9 +21,9 @@ from dataclasses import replace
 import numpy as np
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
-from .actuators import creep_per_decade, delay_samples, second_order_mode
+from .actuators import delay_samples, second_order_mode
 from .operator import PIOperator
-from .truth import RATE_REFERENCE, STEP_SHARE, Truth, zoh_coefficients
+from .truth import RATE_REFERENCE, STEP_SHARE, Truth, truth_creep, zoh_coefficients
 from .truth_alt import RATE_REF, TAU0, U_SAT, AltTruth
 
 __all__ = ["stage_stepper", "noise_free"]
@@ -114,6 +114,19 @@ class _Filter:
         return float(y[0])
 
 
+class _Creep:
+    """``truth_creep(...).simulate(x)`` one sample at a time, its lags starting on the first
+    sample (as the batch call's ``initial_state = x[0]``)."""
+
+    def __init__(self, percent_per_decade: float, dt: float):
+        self.percent, self.dt, self.creep = percent_per_decade, dt, None
+
+    def step(self, x: float) -> float:
+        if self.creep is None:
+            self.creep = truth_creep(self.percent, self.dt, x)
+        return self.creep.step(x)
+
+
 class _TruthStepper:
     """``Truth.simulate`` per sample: PI (rate) -> asymmetry -> creep -> mode -> delay -> drift."""
 
@@ -125,8 +138,7 @@ class _TruthStepper:
         self.z = np.zeros(self.r.size)
         self.filters = []
         if truth.creep_percent_per_decade is not None:
-            G = creep_per_decade(truth.creep_percent_per_decade, t_min=0.01, decades=4)
-            self.filters.append(_Filter(*zoh_coefficients(G, dt), around=True))
+            self.filters.append(_Creep(truth.creep_percent_per_decade, dt))
         if truth.mode_hz is not None:
             G = second_order_mode(truth.mode_hz, truth.mode_damping)
             self.filters.append(_Filter(*zoh_coefficients(G, dt), around=True))
