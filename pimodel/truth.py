@@ -249,7 +249,7 @@ def truth_creep(percent_per_decade: float, dt: float, initial_state: float = 0.0
     --------
     >>> cr = truth_creep(1.5, 1e-4)
     >>> y = cr.simulate(np.ones(30_001))  # a unit step held for 3 s at 10 kHz
-    >>> exact = 1 + np.sum(0.015 * (1 - np.exp(-3.0 / (0.01 * 10.0 ** np.arange(4))))
+    >>> exact = 1 + np.sum(0.015 * (1 - np.exp(-3.0 / (0.01 * 10.0 ** np.arange(4)))))
     >>> bool(abs(y[-1] - exact) < 1e-12)
     True
     """
