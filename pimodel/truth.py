@@ -17,7 +17,7 @@ import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
 from .actuators import delay_samples, second_order_mode
-from .creep import CreepOperator
+from .checks import positive_scalar
 from .data import Record
 from .operator import PIOperator
 
@@ -93,8 +93,8 @@ class Truth:
         The path ``v -> PI -> asymmetry -> creep -> mode -> delay -> + drift + noise``, plays
         and filters starting at rest (plays at 0, filters around the first sample). Creep and
         mode are zero-order-hold discretisations of their continuous systems: the creep
-        (:func:`truth_creep`) gives ``c[k] = x[k] + sum_i g_i L_i[k]`` of its input ``x`` (the
-        lags act from the next sample), the mode is a strictly proper filter of ``c`` (one
+        (:func:`creep_lag_filters`) gives ``c[k] = x[k] + sum_i l_i[k]`` of its input ``x``
+        (the lags act from the next sample), the mode is a strictly proper filter of ``c`` (one
         sample of ZOH lag).
 
         Parameters
@@ -128,7 +128,7 @@ class Truth:
             half = 0.5 * float(np.sum(self.weights)) * 1.0
             y = y + self.asymmetry * (y**2) / half
         if self.creep_percent_per_decade is not None:
-            y = truth_creep(self.creep_percent_per_decade, dt, y[0]).simulate(y)
+            y = _creep(y, self.creep_percent_per_decade, dt)
         if self.mode_hz is not None:
             y = _filter(second_order_mode(self.mode_hz, self.mode_damping), y, dt)
         if self.delay_s is not None:
@@ -211,20 +211,21 @@ def rate_dependent_pi(weights, radii, v: np.ndarray, dt: float, gain: float) -> 
     return y
 
 
-def truth_creep(percent_per_decade: float, dt: float, initial_state: float = 0.0) -> CreepOperator:
-    """The truth's creep, :func:`pimodel.actuators.creep_per_decade` with ``CREEP_DECADES``
-    lags from ``CREEP_T_MIN``, discretised exactly with a zero-order hold lag by lag.
+def creep_lag_filters(percent_per_decade: float, dt: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The truth's creep lags, one per decade from ``CREEP_T_MIN`` (``CREEP_DECADES`` of them,
+    as :func:`pimodel.actuators.creep_per_decade`), each discretised on its own with a
+    zero-order hold (:func:`zoh_coefficients`).
 
-    For the input ``x[k]`` (hysteresis output [um]), ``a_i = exp(-dt / tau_i)``::
+    For the input ``x[k]`` (hysteresis output [um]) the creep output is
+    ``c[k] = x[k] + sum_i l_i[k]``, lag ``i`` with gain ``g_i = percent_per_decade / 100``,
+    time constant ``tau_i`` and ``a_i = exp(-dt / tau_i)``::
 
-        c[k]     = x[k] + sum_i g_i L_i[k]
-        L_i[k+1] = a_i L_i[k] + (1 - a_i) x[k],      L_i[0] = initial_state
+        l_i[k] = a_i l_i[k-1] + g_i (1 - a_i) x[k-1]      (b = [0, g_i (1 - a_i)], a = [1, -a_i])
 
-    with ``g_i = percent_per_decade / 100`` (:class:`pimodel.creep.CreepOperator`). This is
-    the ZOH transfer function ``1 + sum_i g_i (1 - a_i) / (z - a_i)`` of ``creep_per_decade``
-    run as parallel first-order recursions: one polynomial of degree 4 in ``z``, with poles
-    between 0.99 and 0.99999 at 10 kHz, loses most of its digits (measured in
-    ``docs/notes/creep-discretization.md``).
+    so the lags act from the next sample. Run in parallel, these are the ZOH transfer function
+    ``1 + sum_i g_i (1 - a_i) / (z - a_i)`` of ``creep_per_decade``; multiplied out into one
+    polynomial of degree 4 in ``z`` (poles between 0.99 and 0.99999 at 10 kHz) they lose most
+    of their digits (measured in ``docs/notes/creep-discretization.md``).
 
     Parameters
     ----------
@@ -232,13 +233,11 @@ def truth_creep(percent_per_decade: float, dt: float, initial_state: float = 0.0
         Creep per decade of time [% of the move], finite, ``>= 0``.
     dt : float
         Sample time [s], ``> 0``.
-    initial_state : float, optional
-        The input held before the first sample (steady state), [um].
 
     Returns
     -------
-    CreepOperator
-        Its ``simulate`` (whole records) and ``step`` (per sample) run the recursion.
+    list of (numpy.ndarray, numpy.ndarray)
+        ``(b, a)`` of each lag, for :func:`scipy.signal.lfilter`, shortest time constant first.
 
     Raises
     ------
@@ -247,19 +246,28 @@ def truth_creep(percent_per_decade: float, dt: float, initial_state: float = 0.0
 
     Examples
     --------
-    >>> cr = truth_creep(1.5, 1e-4)
-    >>> y = cr.simulate(np.ones(30_001))  # a unit step held for 3 s at 10 kHz
+    >>> from scipy.signal import lfilter
+    >>> x = np.ones(30_001)  # a unit step held for 3 s at 10 kHz
+    >>> y = x + sum(lfilter(b, a, x) for b, a in creep_lag_filters(1.5, 1e-4))
     >>> exact = 1 + np.sum(0.015 * (1 - np.exp(-3.0 / (0.01 * 10.0 ** np.arange(4)))))
-    >>> bool(abs(y[-1] - exact) < 1e-12)
+    >>> bool(abs(y[-1] - exact) < 1e-12)  # y[30000]: 3 s after the step (and 1 sample)
     True
     """
     rate = float(percent_per_decade)
     if not np.isfinite(rate) or rate < 0:
         raise ValueError(f"percent_per_decade: expected a finite number >= 0, got "
                          f"{percent_per_decade!r}")
+    dt = positive_scalar(dt, "dt")
     tau = CREEP_T_MIN * 10.0 ** np.arange(CREEP_DECADES)
-    return CreepOperator(np.full(tau.size, rate / 100.0), tau, dt=dt,
-                         initial_state=initial_state)
+    return [zoh_coefficients(control.tf([rate / 100.0], [ti, 1.0]), dt) for ti in tau]
+
+
+def _creep(x: np.ndarray, percent_per_decade: float, dt: float) -> np.ndarray:
+    """The truth's creep of ``x`` (:func:`creep_lag_filters`), lags at rest around x[0]."""
+    y = x
+    for b, a in creep_lag_filters(percent_per_decade, dt):
+        y = y + lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])[0]
+    return y
 
 
 def zoh_coefficients(G, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -268,7 +276,7 @@ def zoh_coefficients(G, dt: float) -> tuple[np.ndarray, np.ndarray]:
 
     One polynomial transfer function: fit for low orders such as the truth's mode (equal to a
     state-space ZOH simulation to ~1e-14 at 5 and 10 kHz), not for lags spread over decades
-    (their poles crowd near ``z = 1``; see :func:`truth_creep`).
+    (their poles crowd near ``z = 1``; see :func:`creep_lag_filters`).
 
     Parameters
     ----------

@@ -23,7 +23,7 @@ from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from .actuators import delay_samples, second_order_mode
 from .operator import PIOperator
-from .truth import RATE_REFERENCE, STEP_SHARE, Truth, truth_creep, zoh_coefficients
+from .truth import RATE_REFERENCE, STEP_SHARE, Truth, creep_lag_filters, zoh_coefficients
 from .truth_alt import RATE_REF, TAU0, U_SAT, AltTruth
 
 __all__ = ["stage_stepper", "noise_free"]
@@ -115,16 +115,19 @@ class _Filter:
 
 
 class _Creep:
-    """``truth_creep(...).simulate(x)`` one sample at a time, its lags starting on the first
-    sample (as the batch call's ``initial_state = x[0]``)."""
+    """The truth's creep one sample at a time: ``x[k]`` plus its lag filters
+    (:func:`pimodel.truth.creep_lag_filters`), each around the first sample as in the batch
+    call, summed in the same order."""
 
     def __init__(self, percent_per_decade: float, dt: float):
-        self.percent, self.dt, self.creep = percent_per_decade, dt, None
+        self.lags = [_Filter(b, a, around=True)
+                     for b, a in creep_lag_filters(percent_per_decade, dt)]
 
     def step(self, x: float) -> float:
-        if self.creep is None:
-            self.creep = truth_creep(self.percent, self.dt, x)
-        return self.creep.step(x)
+        y = x
+        for lag in self.lags:
+            y = y + lag.step(x)
+        return y
 
 
 class _TruthStepper:

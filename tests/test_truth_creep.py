@@ -5,7 +5,7 @@ single polynomial transfer function failed both, docs/notes/creep-discretization
 import numpy as np
 import pytest
 
-from pimodel.truth import CREEP_DECADES, CREEP_T_MIN, Truth, truth_creep
+from pimodel.truth import CREEP_DECADES, CREEP_T_MIN, Truth, creep_lag_filters
 from pimodel.truth_steps import stage_stepper
 
 FS = 10_000.0
@@ -61,6 +61,6 @@ def test_stepper_equals_simulate_with_creep_at_10_khz():
 @pytest.mark.parametrize("percent", [-1.0, float("nan")])
 def test_bad_creep_rate_is_refused(percent):
     with pytest.raises(ValueError, match="percent_per_decade"):
-        truth_creep(percent, 1e-4)
+        creep_lag_filters(percent, 1e-4)
     with pytest.raises(ValueError, match="percent_per_decade"):
         _creep_only(percent).simulate(np.arange(3) * 1e-4, np.ones(3), np.random.default_rng(0))
