@@ -181,8 +181,12 @@ def stage_dynamics(dt: float, *, fn_hz: float | None = 1000.0, damping: float = 
     """Discrete-time stage dynamics ``G(z)`` from the hysteresis output ``h`` to ``y``.
 
     The mode, the creep factor and the delay are combined in continuous time and discretised
-    with a zero-order hold on ``h``; with a mode the result has ``D = 0`` (usable inside a
-    feedback loop).
+    with a zero-order hold on ``h``: ``x[k+1] = A x[k] + B h[k]``, ``y[k] = C x[k] + D h[k]``;
+    with a mode the result has ``D = 0`` (usable inside a feedback loop). The hold is applied
+    to a state-space realisation (``control.c2d`` of ``control.ss``, a matrix exponential), not
+    to the transfer-function polynomial in ``z``: with creep lags over 4 decades at 10 kHz its
+    step response agrees with a block-diagonal realisation to 3e-13 over 60 s, where one
+    polynomial transfer function would be off by several percent.
 
     Parameters
     ----------

@@ -16,13 +16,16 @@ import control
 import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
-from .actuators import creep_per_decade, delay_samples, second_order_mode
+from .actuators import delay_samples, second_order_mode
+from .checks import positive_scalar
 from .data import Record
 from .operator import PIOperator
 
 STAGE_WEIGHTS = (6.3460, 1.6735, 1.1552, 0.4477)
 STAGE_RADII = (0.0, 0.1945, 0.4826, 0.5707)
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
+CREEP_T_MIN = 0.01  # s: the first creep lag's time constant, one lag per decade from it
+CREEP_DECADES = 4  # lags at 10 ms, 100 ms, 1 s and 10 s
 RATE_REFERENCE = 250.0  # V/s: the fastest validate sine (1 V at 40 Hz)
 STEP_SHARE = 0.05  # a one-sample jump above this share of the input range is a step
 
@@ -88,7 +91,11 @@ class Truth:
         """Measured output ``y[k]`` [um] for input ``v[k]`` [V] at times ``t`` [s].
 
         The path ``v -> PI -> asymmetry -> creep -> mode -> delay -> + drift + noise``, plays
-        and filters starting at rest (plays at 0, filters around the first sample).
+        and filters starting at rest (plays at 0, filters around the first sample). Creep and
+        mode are zero-order-hold discretisations of their continuous systems: the creep
+        (:func:`creep_lag_filters`) gives ``c[k] = x[k] + sum_i l_i[k]`` of its input ``x``
+        (the lags act from the next sample), the mode is a strictly proper filter of ``c`` (one
+        sample of ZOH lag).
 
         Parameters
         ----------
@@ -121,8 +128,7 @@ class Truth:
             half = 0.5 * float(np.sum(self.weights)) * 1.0
             y = y + self.asymmetry * (y**2) / half
         if self.creep_percent_per_decade is not None:
-            y = _filter(creep_per_decade(self.creep_percent_per_decade, t_min=0.01, decades=4),
-                        y, dt)
+            y = _creep(y, self.creep_percent_per_decade, dt)
         if self.mode_hz is not None:
             y = _filter(second_order_mode(self.mode_hz, self.mode_damping), y, dt)
         if self.delay_s is not None:
@@ -205,9 +211,72 @@ def rate_dependent_pi(weights, radii, v: np.ndarray, dt: float, gain: float) -> 
     return y
 
 
+def creep_lag_filters(percent_per_decade: float, dt: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The truth's creep lags, one per decade from ``CREEP_T_MIN`` (``CREEP_DECADES`` of them,
+    as :func:`pimodel.actuators.creep_per_decade`), each discretised on its own with a
+    zero-order hold (:func:`zoh_coefficients`).
+
+    For the input ``x[k]`` (hysteresis output [um]) the creep output is
+    ``c[k] = x[k] + sum_i l_i[k]``, lag ``i`` with gain ``g_i = percent_per_decade / 100``,
+    time constant ``tau_i`` and ``a_i = exp(-dt / tau_i)``::
+
+        l_i[k] = a_i l_i[k-1] + g_i (1 - a_i) x[k-1]      (b = [0, g_i (1 - a_i)], a = [1, -a_i])
+
+    so the lags act from the next sample. Run in parallel, these are the ZOH transfer function
+    ``1 + sum_i g_i (1 - a_i) / (z - a_i)`` of ``creep_per_decade``; multiplied out into one
+    polynomial of degree 4 in ``z`` (poles between 0.99 and 0.99999 at 10 kHz) they lose most
+    of their digits (measured in ``docs/notes/creep-discretization.md``).
+
+    Parameters
+    ----------
+    percent_per_decade : float
+        Creep per decade of time [% of the move], finite, ``>= 0``.
+    dt : float
+        Sample time [s], ``> 0``.
+
+    Returns
+    -------
+    list of (numpy.ndarray, numpy.ndarray)
+        ``(b, a)`` of each lag, for :func:`scipy.signal.lfilter`, shortest time constant first.
+
+    Raises
+    ------
+    ValueError
+        If ``percent_per_decade`` or ``dt`` is out of range.
+
+    Examples
+    --------
+    >>> from scipy.signal import lfilter
+    >>> x = np.ones(30_001)  # a unit step held for 3 s at 10 kHz
+    >>> y = x + sum(lfilter(b, a, x) for b, a in creep_lag_filters(1.5, 1e-4))
+    >>> exact = 1 + np.sum(0.015 * (1 - np.exp(-3.0 / (0.01 * 10.0 ** np.arange(4)))))
+    >>> bool(abs(y[-1] - exact) < 1e-12)  # y[30000]: 3 s after the step (and 1 sample)
+    True
+    """
+    rate = float(percent_per_decade)
+    if not np.isfinite(rate) or rate < 0:
+        raise ValueError(f"percent_per_decade: expected a finite number >= 0, got "
+                         f"{percent_per_decade!r}")
+    dt = positive_scalar(dt, "dt")
+    tau = CREEP_T_MIN * 10.0 ** np.arange(CREEP_DECADES)
+    return [zoh_coefficients(control.tf([rate / 100.0], [ti, 1.0]), dt) for ti in tau]
+
+
+def _creep(x: np.ndarray, percent_per_decade: float, dt: float) -> np.ndarray:
+    """The truth's creep of ``x`` (:func:`creep_lag_filters`), lags at rest around x[0]."""
+    y = x
+    for b, a in creep_lag_filters(percent_per_decade, dt):
+        y = y + lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])[0]
+    return y
+
+
 def zoh_coefficients(G, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """``(b, a)`` of a continuous SISO system discretised with a zero-order hold, for
     :func:`scipy.signal.lfilter` (coefficients of ``z^0, z^-1, ...``).
+
+    One polynomial transfer function: fit for low orders such as the truth's mode (equal to a
+    state-space ZOH simulation to ~1e-14 at 5 and 10 kHz), not for lags spread over decades
+    (their poles crowd near ``z = 1``; see :func:`creep_lag_filters`).
 
     Parameters
     ----------
@@ -235,7 +304,8 @@ def zoh_coefficients(G, dt: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _filter(G, x: np.ndarray, dt: float) -> np.ndarray:
-    """Apply a continuous SISO system (ZOH-discretised) to ``x``, starting at rest around x[0]."""
+    """Apply a continuous SISO system (ZOH-discretised, :func:`zoh_coefficients`) to ``x``,
+    starting at rest around x[0]."""
     b, a = zoh_coefficients(G, dt)
     out, _ = lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])
     return out

@@ -21,9 +21,9 @@ from dataclasses import replace
 import numpy as np
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
-from .actuators import creep_per_decade, delay_samples, second_order_mode
+from .actuators import delay_samples, second_order_mode
 from .operator import PIOperator
-from .truth import RATE_REFERENCE, STEP_SHARE, Truth, zoh_coefficients
+from .truth import RATE_REFERENCE, STEP_SHARE, Truth, creep_lag_filters, zoh_coefficients
 from .truth_alt import RATE_REF, TAU0, U_SAT, AltTruth
 
 __all__ = ["stage_stepper", "noise_free"]
@@ -114,6 +114,22 @@ class _Filter:
         return float(y[0])
 
 
+class _Creep:
+    """The truth's creep one sample at a time: ``x[k]`` plus its lag filters
+    (:func:`pimodel.truth.creep_lag_filters`), each around the first sample as in the batch
+    call, summed in the same order."""
+
+    def __init__(self, percent_per_decade: float, dt: float):
+        self.lags = [_Filter(b, a, around=True)
+                     for b, a in creep_lag_filters(percent_per_decade, dt)]
+
+    def step(self, x: float) -> float:
+        y = x
+        for lag in self.lags:
+            y = y + lag.step(x)
+        return y
+
+
 class _TruthStepper:
     """``Truth.simulate`` per sample: PI (rate) -> asymmetry -> creep -> mode -> delay -> drift."""
 
@@ -125,8 +141,7 @@ class _TruthStepper:
         self.z = np.zeros(self.r.size)
         self.filters = []
         if truth.creep_percent_per_decade is not None:
-            G = creep_per_decade(truth.creep_percent_per_decade, t_min=0.01, decades=4)
-            self.filters.append(_Filter(*zoh_coefficients(G, dt), around=True))
+            self.filters.append(_Creep(truth.creep_percent_per_decade, dt))
         if truth.mode_hz is not None:
             G = second_order_mode(truth.mode_hz, truth.mode_damping)
             self.filters.append(_Filter(*zoh_coefficients(G, dt), around=True))
