@@ -34,8 +34,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..data import Record
+from .drift import drift_variants, level_report
 from .effects import (
-    DRIFT_CLOCKS,
     EFFECTS,
     RATE_BANDS,
     Model,
@@ -332,11 +332,6 @@ def _compressed(tr, va, nominal: Model):
     return tr, va, nominal, None
 
 
-def _variants(name: str) -> list[dict]:
-    """Discrete variants of an effect chosen on validate (the drift's clock)."""
-    return [{"clock": c} for c in DRIFT_CLOCKS] if name == "drift" else [{}]
-
-
 def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
               initial_state: str) -> DiagnosisReport:
     _check(train, "train")
@@ -372,12 +367,13 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     def fit(name, combo=(), fixed_=None):
         """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
         best = None
-        for var in _variants(name):
+        for var in drift_variants((*combo, name), fixed_ or {}, len(va)):
             fx = {**(fixed_ or {}), **var}
             key = (combo, name, tuple(sorted(fx.items())))
             if key not in cache:
                 m = fit_effect(name, tr, combo, fx, nominal)
                 cache[key] = (m, [m.predict(s) for s in va])
+                m.params.update(level_report(m, va, tr))
             m, o = cache[key]
             score = _bic(va, o, m.k)
             if best is None or score < best[0]:

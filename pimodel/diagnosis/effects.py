@@ -16,6 +16,7 @@ from scipy.optimize import minimize
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
+from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
@@ -25,7 +26,7 @@ MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Ny
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
-DRIFT_CLOCKS = ("record", "absolute")  # t - t[0] of each record, or t as given
+DRIFT_CLOCKS = DRIFT_VARIANTS  # t - t[0] of each record, t as given, or a level per record
 RATE_BANDS = 8  # the rate candidate's play groups (one column each)
 STEP_SHARE = 0.05  # rate candidate: a one-sample jump above this share of the range is a step
 
@@ -292,6 +293,9 @@ class Model:
         Fitted physical parameters (``mode_hz``, ``delay_samples``, ...).
     grid : dict
         The grid parameters the model was built with.
+    adjust : callable or None
+        ``adjust(seg, out)``: the prediction ``out`` of a record corrected by a nuisance
+        measured on the record itself (a drift's out-of-fold level, :mod:`.drift`); None: none.
 
     Examples
     --------
@@ -306,6 +310,7 @@ class Model:
     coef: np.ndarray = field(repr=False, default=None)
     params: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
+    adjust: object = field(repr=False, default=None)
 
     def predict(self, seg: Segment) -> np.ndarray:
         """Model output of a record.
@@ -318,7 +323,8 @@ class Model:
         Returns
         -------
         numpy.ndarray
-            ``features(seg) @ coef``: the model output at each sample, output units.
+            ``features(seg) @ coef`` (then ``adjust``, if set): the model output at each
+            sample, output units.
 
         Examples
         --------
@@ -326,7 +332,8 @@ class Model:
         >>> Model("nominal", 0, base_features, np.array([3.0, 0.0])).predict(seg).tolist()
         [0.0, 3.0]
         """
-        return self.features(seg) @ self.coef
+        out = self.features(seg) @ self.coef
+        return out if self.adjust is None else self.adjust(seg, out)
 
 
 def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
@@ -471,8 +478,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     """Joint fit; the nonlinear parameters (mode, delay, drift clock) by grid search on the
     train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
     the grid optimum, then refitted with every play column."""
-    name, k = "+".join(effects), _combo_k(effects)
-    static: dict = {}
+    name = "+".join(effects)
+    k = _combo_k(effects) + (drift_k(fixed) - 1 if "drift" in effects else 0)  # + levels
+    static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only
     ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
 
@@ -495,9 +503,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
-        elif e == "drift":
-            grids.append([{"clock": fixed["clock"]}] if "clock" in fixed else
-                         [{"clock": c} for c in DRIFT_CLOCKS])
+        elif e == "drift":  # the records' levels only on validate: variants chosen there
+            grids.append([{k_: fixed[k_] for k_ in ("clock", "levels") if k_ in fixed}]
+                         if "clock" in fixed else
+                         [{"clock": c} for c in DRIFT_CLOCKS if c != "levels"])
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
@@ -540,6 +549,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     model = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[0]
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
+    if "drift" in effects and p["clock"] == "levels":
+        model.params["drift_t0_train"] = float(train[0].t[0])
+        in_train = static["train"]
+
+        def with_level(seg, out):  # a record's own level, out of fold (not for train records)
+            return out if id(seg) in in_train else out + out_of_fold_level(seg.y - out,
+                                                                           seg.mask)
+        model.adjust = with_level
     return model
 
 
@@ -577,8 +594,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "delay" in effects:
             Z = shift(Z, p["d"])
         cols = [Z, static_columns(s)]
-        if "drift" in effects:
-            cols.append((s.t - s.t[0] if p["clock"] == "record" else s.t)[:, None])
+        if "drift" in effects:  # the trend column last
+            cols.append(drift_columns(s.t, p, static["train"].get(id(s)),
+                                      len(static["train"])))
         return np.hstack(cols)
 
     return feats
@@ -656,7 +674,9 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             i += RATE_BANDS
     if "drift" in effects:
         out["drift_per_s"] = float(model.coef[-1])
-        out["drift_clock"] = model.params["clock"]
+        clock = model.params["clock"]  # "levels": the clock is read from the levels later
+        out["drift_clock"] = "record" if clock == "levels" else clock
+        out["drift_variant"] = "levels" if clock == "levels" else "trend"
     if "fn" in model.params:
         out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
     if "d" in model.params:
