@@ -31,40 +31,41 @@ from __future__ import annotations
 import numpy as np
 
 DRIFT_VARIANTS = ("record", "absolute", "levels")
+DRIFT_KEYS = ("clock", "levels")  # the grid parameters of a drift variant
 LEVEL_FOLDS = 4  # contiguous blocks of a validate record for its out-of-fold level
 
-__all__ = ["DRIFT_VARIANTS", "LEVEL_FOLDS", "drift_variants", "drift_columns", "drift_k",
-           "out_of_fold_level", "record_levels", "describe_levels", "level_report",
+__all__ = ["DRIFT_VARIANTS", "DRIFT_KEYS", "LEVEL_FOLDS", "drift_variants", "drift_columns",
+           "drift_k", "out_of_fold_level", "record_levels", "describe_levels", "level_report",
            "drift_term"]
 
 
-def drift_variants(effects, fixed: dict, n_validate: int) -> list[dict]:
-    """The drift variants to score on validate, when ``effects`` hold a drift whose variant is
-    not yet fixed (a nuisance level per validate record cannot be chosen on train).
+def drift_variants(effects, n_validate: int) -> list[dict]:
+    """The drift variants to score on validate whenever ``effects`` hold a drift. A level per
+    validate record cannot be chosen on train, and the variant that fits best changes as other
+    effects join (a trend fitted beside an unmodelled asymmetry takes part of it), so the
+    variant is chosen anew for every combination, never carried over from an earlier round.
 
     Parameters
     ----------
     effects : tuple of str
         The effects of the model being fitted.
-    fixed : dict
-        Grid parameters fixed by earlier rounds (``clock`` once a drift is chosen).
     n_validate : int
         Number of validate records (one level each for ``"levels"``).
 
     Returns
     -------
     list of dict
-        ``[{}]`` when there is nothing to choose, else one dict per variant (``clock``, and
-        ``levels`` for ``"levels"``).
+        ``[{}]`` without a drift, else one dict per variant (``clock``, and ``levels`` for
+        ``"levels"``).
 
     Examples
     --------
-    >>> drift_variants(("creep",), {}, 1)
+    >>> drift_variants(("creep",), 1)
     [{}]
-    >>> [v["clock"] for v in drift_variants(("drift",), {}, 1)]
+    >>> [v["clock"] for v in drift_variants(("creep", "drift"), 1)]
     ['record', 'absolute', 'levels']
     """
-    if "drift" not in effects or "clock" in fixed:
+    if "drift" not in effects:
         return [{}]
     return [{"clock": c, **({"levels": n_validate} if c == "levels" else {})}
             for c in DRIFT_VARIANTS]
