@@ -459,7 +459,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
                "unexplained": unexplained, "alternatives": alternatives,
                "model": current.params, "evidence": evidence}
-    fitted = {"radii": radii, "projection": proj, "nominal": full_nominal, "reference": nominal,
+    fitted = {"radii": radii, "projection": proj, "nominal": full_nominal,
+              "reference": current.reference or nominal,
               "chosen": chosen,
               "model": current, "dt": dt}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
