@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import minimize, minimize_scalar
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
@@ -527,6 +527,15 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         best = search([{**best[0].params, "d": d0 + f} for f in (-0.75, -0.5, -0.25, 0.25,
                                                                   0.5, 0.75) if d0 + f >= 0],
                       best)
+        # and continuously between the quarter-sample neighbours: an eighth of a sample off
+        # leaves several noise floors on fast input
+        base, d1 = dict(best[0].params), float(best[0].params["d"])
+        r = minimize_scalar(lambda d: _fit(name, k, _combo_features(
+            effects, {**base, "d": float(d)}, nominal, static, ncols), train)[1],
+            bounds=(max(d1 - 0.25, 0.0), d1 + 0.25), method="bounded",
+            options={"xatol": 0.01})
+        if r.fun < best[1]:
+            best = search([{**base, "d": float(r.x)}], best)
     if "dynamics" in effects and "fn" not in fixed:
         # refine the mode around the grid optimum, then polish it continuously (a light
         # mode's resonance is narrower than the grid)
