@@ -12,7 +12,11 @@ it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lower
 than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the noise
 floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
 effect passes in the first round, every pair is fitted jointly and the best pair kept on the
-same terms (two effects can mask each other).
+same terms (two effects can mask each other). Then the choice is revised on the same terms: a
+chosen effect is swapped for an unchosen one while that passes, and an effect that no longer
+passes against the combination without it is dropped (an effect chosen early can stand in for
+one that only passes beside a later one). The drift's variant (its clock, or a level per
+record, :mod:`.drift`) is chosen on validate for every combination.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
