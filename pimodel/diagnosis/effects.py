@@ -627,7 +627,12 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             key = ("rows", id(s), ncols)
             if key not in static:
                 static[key] = (s, np.ascontiguousarray(Z.T))
-            Z = mode_rows(static[key][1], p["fn"], p["zeta"], s.dt).T
+            last = static.get(("mode", id(s), ncols))  # the last mode filtered, for a delay
+            if last is None or last[0] != (p["fn"], p["zeta"]):  # search at a fixed mode
+                last = ((p["fn"], p["zeta"]), mode_rows(static[key][1], p["fn"], p["zeta"],
+                                                        s.dt).T)
+                static[("mode", id(s), ncols)] = last
+            Z = last[1]
         if "delay" in effects:
             Z = shift(Z, p["d"])
         cols = [Z, static_columns(s)]
