@@ -102,6 +102,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.feedforward",
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",
+    "pimodel.diagnosis.drift",
     "pimodel.diagnosis.where",
     "pimodel.diagnosis.noise",
     "pimodel.diagnosis.plots",

@@ -7,6 +7,11 @@ exponential static map, coloured noise; also effects outside the vocabulary that
 back "unexplained"). The diagnosis never sees the effect's name. Full size: 10 seeds per case;
 ``--quick``: 1 seed, single effects only.
 
+A case ``offset`` adds a level of its own to each record (a sensor zeroed anew between
+records; train at 0, validate at +-0.05 to 0.2 um, seeded) to an otherwise clean stage: the
+right verdict is ``drift`` (the candidate that holds per-record levels,
+:mod:`pimodel.diagnosis.drift`).
+
 Each case is a plain picklable dict (``generator``, ``effects``, ``drift_clock``, ``seed``) and
 :func:`run_case` turns one into a verdict row, so the cases can be spread over workers.
 """
@@ -31,6 +36,7 @@ SINGLE = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 PAIRS = ((("rate", "creep"), "record"), (("delay", "drift"), "record"),
          (("asymmetry", "drift"), "absolute"))
 OUTSIDE = ("dead_zone", "second_input", "bouc_wen")  # truth_alt only: expect "unexplained"
+OFFSET = (("offset",), "record")  # a level per record (module docstring), found as "drift"
 
 
 def cases(quick: bool) -> list[dict]:
@@ -38,7 +44,7 @@ def cases(quick: bool) -> list[dict]:
     seeds = range(1 if quick else 10)
     groups = [((), "record")] + [((e,), "record") for e in SINGLE]
     if not quick:
-        groups += list(PAIRS) + [(("drift",), "absolute")]
+        groups += list(PAIRS) + [(("drift",), "absolute"), OFFSET]
     out = []
     for gen in ("truth", "truth_alt"):
         extra = [((e,), "record") for e in OUTSIDE] if gen == "truth_alt" else []
@@ -50,6 +56,16 @@ def cases(quick: bool) -> list[dict]:
 
 
 def _records(case: dict):
+    train, validate, initial_state = _stage_records({**case, "effects": [
+        e for e in case["effects"] if e != "offset"]})
+    if "offset" in case["effects"]:
+        rng = np.random.default_rng(7000 + case["seed"])
+        level = rng.uniform(0.05, 0.2) * rng.choice([-1, 1])
+        validate = [Record(r.t, r.v, r.y + level, source=r.source) for r in validate]
+    return train, validate, initial_state
+
+
+def _stage_records(case: dict):
     seed, effects, clock = case["seed"], case["effects"], case["drift_clock"]
     if case["generator"] == "truth":
         from pimodel.truth import excitation, random_truth
@@ -71,10 +87,10 @@ def _records(case: dict):
 
 def expected(case: dict) -> list[str]:
     """The right verdict: the withheld effects, "unexplained" for effects outside the
-    vocabulary, "none" for a clean stage."""
+    vocabulary, "none" for a clean stage, "drift" for levels that differ by record."""
     if set(case["effects"]) & set(OUTSIDE):
         return ["unexplained"]
-    return sorted(case["effects"]) or ["none"]
+    return sorted({"drift" if e == "offset" else e for e in case["effects"]}) or ["none"]
 
 
 def run_case(case: dict) -> dict:
@@ -92,7 +108,7 @@ def run_case(case: dict) -> dict:
 
 def group_name(row: dict) -> str:
     """Name of a case group: the withheld effects (and the drift's clock)."""
-    key = "+".join(row["effects"]) or "none (clean)"
+    key = "+".join(row["effects"]).replace("offset", "record offsets") or "none (clean)"
     if "drift" in row["effects"]:
         key += f" [{row['drift_clock']} clock]"
     return key

@@ -44,3 +44,25 @@ def test_alt_outside_library_is_unexplained(effect):
     assert v["unexplained"]["share"] > 0.1
     assert v["gap_after"] > 2 * v["noise_floor"]
     assert v["unexplained"]["where"]
+
+
+@pytest.mark.parametrize("pair,clock", [
+    (("delay", "drift"), "record"),  # a fractional delay; drift restarting with each record
+    (("asymmetry", "drift"), "absolute"),  # drift on the clock the records share
+])
+def test_alt_withheld_pair(pair, clock):
+    v = diagnose(*alt_records(pair, 0, clock), initial_state="unknown").verdict
+    assert sorted(v["effects"]) == sorted(pair)
+    assert v["shrink"] >= (0.7 if "asymmetry" in pair else 0.5)
+    assert v["model"]["drift_clock"] == clock
+
+
+def test_alt_record_offset_is_drift_with_a_level_of_its_own():
+    train, validate = alt_records([], 0)
+    level = -0.09  # the sensor zeroed anew before the validate record
+    validate = [Record(r.t, r.v, r.y + level, source=r.source) for r in validate]
+    v = diagnose(train, validate, initial_state="unknown").verdict
+    assert v["effects"] == ["drift"]
+    assert v["shrink"] >= 0.5
+    assert v["model"]["drift_variant"] == "levels"
+    assert abs(v["model"]["drift_record_offsets"][0] - level) < 0.2 * abs(level)

@@ -12,7 +12,11 @@ it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lower
 than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the noise
 floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
 effect passes in the first round, every pair is fitted jointly and the best pair kept on the
-same terms (two effects can mask each other).
+same terms (two effects can mask each other). Then the choice is revised on the same terms: a
+chosen effect is swapped for an unchosen one while that passes, and an effect that no longer
+passes against the combination without it is dropped (an effect chosen early can stand in for
+one that only passes beside a later one). The drift's variant (its clock, or a level per
+record, :mod:`.drift`) is chosen on validate for every combination.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
@@ -34,8 +38,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..data import Record
+from .drift import DRIFT_KEYS, drift_variants, level_report
 from .effects import (
-    DRIFT_CLOCKS,
     EFFECTS,
     RATE_BANDS,
     Model,
@@ -332,11 +336,6 @@ def _compressed(tr, va, nominal: Model):
     return tr, va, nominal, None
 
 
-def _variants(name: str) -> list[dict]:
-    """Discrete variants of an effect chosen on validate (the drift's clock)."""
-    return [{"clock": c} for c in DRIFT_CLOCKS] if name == "drift" else [{}]
-
-
 def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
               initial_state: str) -> DiagnosisReport:
     _check(train, "train")
@@ -372,12 +371,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     def fit(name, combo=(), fixed_=None):
         """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
         best = None
-        for var in _variants(name):
-            fx = {**(fixed_ or {}), **var}
+        for var in drift_variants((*combo, name), len(va)):
+            fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},
+                  **var}
             key = (combo, name, tuple(sorted(fx.items())))
             if key not in cache:
                 m = fit_effect(name, tr, combo, fx, nominal)
                 cache[key] = (m, [m.predict(s) for s in va])
+                m.params.update(level_report(m, va, tr))
             m, o = cache[key]
             score = _bic(va, o, m.k)
             if best is None or score < best[0]:
@@ -434,6 +435,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
         current, cur_out = m, o
+    chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
+                                       (nominal, out_va), noise)
     after = _errors(va, cur_out)
     regions = {r["region"]: r for r in where["regions"]}
     bands = {b["band"]: b["energy_share"] for b in where["spectrum"]}
@@ -460,11 +463,67 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
                "unexplained": unexplained, "alternatives": alternatives,
                "model": current.params, "evidence": evidence}
-    fitted = {"radii": radii, "projection": proj, "nominal": full_nominal, "reference": nominal,
+    fitted = {"radii": radii, "projection": proj, "nominal": full_nominal,
+              "reference": current.reference or nominal,
               "chosen": chosen,
               "model": current, "dt": dt}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
                            fitted)
+
+
+def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
+    """Revise the greedy choice on the terms it was made on (each effect must lower the
+    validate BIC by ``MIN_BIC_DROP`` and cut the validate RMS by ``MIN_RMS_CUT`` given the
+    others). Greedy rounds judge a candidate beside the effects chosen so far only, so an
+    effect chosen early can be a stand-in for one that would only pass beside a later one (a
+    mode for a fractional delay while an unmodelled drift dominates the validate gap). So:
+    first swap one chosen effect for an unchosen one while that passes the test against the
+    current combination, then drop every effect that no longer passes it against the
+    combination without it (or whose removal leaves the gap within ``NOISE_STOP`` times the
+    noise floor). Other effects keep their grid parameters; returns ``(chosen, model,
+    validate outputs)``."""
+    def keys_of(e):  # grid parameters of an effect, as its single fit reports them
+        return set(fit(e)[0].grid) | (set(DRIFT_KEYS) if e == "drift" else set())
+
+    def refit(effects):
+        if not effects:
+            return nominal
+        kept = {k: x for k, x in fixed.items() if any(k in keys_of(e) for e in effects)}
+        return fit(effects[-1], effects[:-1], kept or None)
+
+    def passes(new, old):
+        (m, o), (mb, ob) = new, old
+        return (_bic(va, o, m.k) - _bic(va, ob, mb.k) <= -MIN_BIC_DROP
+                and _errors(va, o)["rms"] <= (1 - MIN_RMS_CUT) * _errors(va, ob)["rms"])
+
+    cur = (current, cur_out)
+    for _ in range(len(EFFECTS)):  # swaps, the best first
+        best = None
+        for e in chosen:
+            rest = tuple(c for c in chosen if c != e)
+            for x in (x for x in EFFECTS if x not in chosen):
+                new = refit((*rest, x))
+                score = _bic(va, new[1], new[0].k)
+                if passes(new, cur) and (best is None or score < best[0]):
+                    best = (score, (*rest, x), new)
+        if best is None:
+            break
+        chosen, cur = best[1], best[2]
+        fixed.update(cur[0].grid)
+    while chosen:  # drops, the least needed first
+        worst = None
+        for e in chosen:
+            rest = tuple(c for c in chosen if c != e)
+            without = refit(rest)
+            if passes(cur, without) and _errors(va, without[1])["rms"] > NOISE_STOP * noise:
+                continue  # still needed
+            score = _bic(va, without[1], without[0].k)
+            if worst is None or score < worst[0]:
+                worst = (score, rest, without)
+        if worst is None:
+            break
+        chosen, cur = worst[1], worst[2]
+    return chosen, cur[0], cur[1]
 
 
 def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float) -> dict:

@@ -12,10 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import minimize, minimize_scalar
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
+from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
@@ -25,9 +26,10 @@ MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Ny
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
-DRIFT_CLOCKS = ("record", "absolute")  # t - t[0] of each record, or t as given
+DRIFT_CLOCKS = DRIFT_VARIANTS  # t - t[0] of each record, t as given, or a level per record
 RATE_BANDS = 8  # the rate candidate's play groups (one column each)
 STEP_SHARE = 0.05  # rate candidate: a one-sample jump above this share of the range is a step
+ASYMMETRY_ITERATIONS = 2  # refits of the asymmetry on the hysteresis part of the previous fit
 
 
 @dataclass
@@ -292,6 +294,12 @@ class Model:
         Fitted physical parameters (``mode_hz``, ``delay_samples``, ...).
     grid : dict
         The grid parameters the model was built with.
+    adjust : callable or None
+        ``adjust(seg, out)``: the prediction ``out`` of a record corrected by a nuisance
+        measured on the record itself (a drift's out-of-fold level, :mod:`.drift`); None: none.
+    reference : Model or None
+        The reference hysteresis ``h0`` the effect columns were built from, when it is not the
+        nominal model (an asymmetry's, see :func:`fit_effect`); None: the nominal.
 
     Examples
     --------
@@ -306,6 +314,8 @@ class Model:
     coef: np.ndarray = field(repr=False, default=None)
     params: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
+    adjust: object = field(repr=False, default=None)
+    reference: object = field(repr=False, default=None)
 
     def predict(self, seg: Segment) -> np.ndarray:
         """Model output of a record.
@@ -318,7 +328,8 @@ class Model:
         Returns
         -------
         numpy.ndarray
-            ``features(seg) @ coef``: the model output at each sample, output units.
+            ``features(seg) @ coef`` (then ``adjust``, if set): the model output at each
+            sample, output units.
 
         Examples
         --------
@@ -326,7 +337,8 @@ class Model:
         >>> Model("nominal", 0, base_features, np.array([3.0, 0.0])).predict(seg).tolist()
         [0.0, 3.0]
         """
-        return self.features(seg) @ self.coef
+        out = self.features(seg) @ self.coef
+        return out if self.adjust is None else self.adjust(seg, out)
 
 
 def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
@@ -429,7 +441,9 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
     -------
     Model
         Named by the effects joined by ``+``, with ``k`` added parameters, the grid optimum in
-        ``grid`` and the fitted physical parameters in ``params``.
+        ``grid`` and the fitted physical parameters in ``params``. With an asymmetry, the
+        effect columns are built from the hysteresis part of the joint fit, refitted
+        ``ASYMMETRY_ITERATIONS`` times, and ``reference`` holds it.
 
     Examples
     --------
@@ -471,8 +485,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     """Joint fit; the nonlinear parameters (mode, delay, drift clock) by grid search on the
     train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
     the grid optimum, then refitted with every play column."""
-    name, k = "+".join(effects), _combo_k(effects)
-    static: dict = {}
+    name = "+".join(effects)
+    k = _combo_k(effects) + (drift_k(fixed) - 1 if "drift" in effects else 0)  # + levels
+    static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only
     ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
 
@@ -495,9 +510,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
-        elif e == "drift":
-            grids.append([{"clock": fixed["clock"]}] if "clock" in fixed else
-                         [{"clock": c} for c in DRIFT_CLOCKS])
+        elif e == "drift":  # the records' levels only on validate: variants chosen there
+            grids.append([{k_: fixed[k_] for k_ in ("clock", "levels") if k_ in fixed}]
+                         if "clock" in fixed else
+                         [{"clock": c} for c in DRIFT_CLOCKS if c != "levels"])
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
@@ -511,6 +527,15 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         best = search([{**best[0].params, "d": d0 + f} for f in (-0.75, -0.5, -0.25, 0.25,
                                                                   0.5, 0.75) if d0 + f >= 0],
                       best)
+        # and continuously between the quarter-sample neighbours: an eighth of a sample off
+        # leaves several noise floors on fast input
+        base, d1 = dict(best[0].params), float(best[0].params["d"])
+        r = minimize_scalar(lambda d: _fit(name, k, _combo_features(
+            effects, {**base, "d": float(d)}, nominal, static, ncols), train)[1],
+            bounds=(max(d1 - 0.25, 0.0), d1 + 0.25), method="bounded",
+            options={"xatol": 0.01})
+        if r.fun < best[1]:
+            best = search([{**base, "d": float(r.x)}], best)
     if "dynamics" in effects and "fn" not in fixed:
         # refine the mode around the grid optimum, then polish it continuously (a light
         # mode's resonance is narrower than the grid)
@@ -538,9 +563,38 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                           best)
     p = best[0].params  # the grid optimum, refitted with every play column
     model = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[0]
+    if "asymmetry" in effects:
+        # the static map acts on the hysteresis output, not on the nominal (which took part
+        # of the asymmetry into its weights): rebuild the reference h0 from the hysteresis
+        # part of the joint fit and refit (a fixed-point iteration; measured on an
+        # exponential map, the validate RMS drops 3 to 10 times in two steps)
+        for _ in range(ASYMMETRY_ITERATIONS):
+            ref = _hysteresis_reference(model, train, nominal)
+            model = _fit(name, k, _combo_features(effects, p, ref, {"train": static["train"]}),
+                         train, p)[0]
+            model.reference = ref
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
+    if "drift" in effects and p["clock"] == "levels":
+        model.params["drift_t0_train"] = float(train[0].t[0])
+        in_train = static["train"]
+
+        def with_level(seg, out):  # a record's own level, out of fold (not for train records)
+            return out if id(seg) in in_train else out + out_of_fold_level(seg.y - out,
+                                                                           seg.mask)
+        model.adjust = with_level
     return model
+
+
+def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
+    """The hysteresis part ``Z w + c`` of a joint fit as a reference model (``center`` and
+    ``half_range`` of its train output, the nominal's other ``params``)."""
+    q = train[0].Z.shape[1]
+    ref = Model("reference", 0, base_features, model.coef[:q + 1].copy())
+    h = np.concatenate([ref.predict(s) for s in train])
+    ref.params = {**nominal.params, "center": float(np.mean(h)),
+                  "half_range": max(float(np.ptp(h)) / 2, 1e-12)}
+    return ref
 
 
 def _combo_k(effects) -> int:
@@ -573,12 +627,18 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             key = ("rows", id(s), ncols)
             if key not in static:
                 static[key] = (s, np.ascontiguousarray(Z.T))
-            Z = mode_rows(static[key][1], p["fn"], p["zeta"], s.dt).T
+            last = static.get(("mode", id(s), ncols))  # the last mode filtered, for a delay
+            if last is None or last[0] != (p["fn"], p["zeta"]):  # search at a fixed mode
+                last = ((p["fn"], p["zeta"]), mode_rows(static[key][1], p["fn"], p["zeta"],
+                                                        s.dt).T)
+                static[("mode", id(s), ncols)] = last
+            Z = last[1]
         if "delay" in effects:
             Z = shift(Z, p["d"])
         cols = [Z, static_columns(s)]
-        if "drift" in effects:
-            cols.append((s.t - s.t[0] if p["clock"] == "record" else s.t)[:, None])
+        if "drift" in effects:  # the trend column last
+            cols.append(drift_columns(s.t, p, static["train"].get(id(s)),
+                                      len(static["train"])))
         return np.hstack(cols)
 
     return feats
@@ -656,7 +716,9 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             i += RATE_BANDS
     if "drift" in effects:
         out["drift_per_s"] = float(model.coef[-1])
-        out["drift_clock"] = model.params["clock"]
+        clock = model.params["clock"]  # "levels": the clock is read from the levels later
+        out["drift_clock"] = "record" if clock == "levels" else clock
+        out["drift_variant"] = "levels" if clock == "levels" else "trend"
     if "fn" in model.params:
         out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
     if "d" in model.params:

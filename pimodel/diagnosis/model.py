@@ -10,7 +10,8 @@ effect columns are built from,
          + sum_i g_i (L_i[h0][k] - h0[k])                     creep: lags L_i, tau_i (s)
          + q u[k]^2 + c3 u[k]^3,  u = (h0 - center) / half    asymmetry (static output terms)
          + sum_b g_b R_b[k]                                   rate (first-order radius growth)
-         + s t_clock[k]                                       drift (record or shared clock)
+         + s t_clock[k] (+ c_j)                               drift (record or shared clock;
+                                                              or a level c_j per record)
 
 where ``D`` is the identity, the unit-gain mode (ZOH, ``(D Z)[k]`` depends on ``Z[0..k-1]``)
 and/or a delay of ``d`` samples (fractional: linear interpolation). ``L_i`` is the exact
@@ -53,6 +54,7 @@ import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
 from ..operator import PIOperator
+from .drift import drift_term
 from .effects import STEP_SHARE, lag, mode, rate_columns, shift
 
 if TYPE_CHECKING:
@@ -82,7 +84,8 @@ class DiagnosedModel:
     params : dict
         Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s``;
         ``asymmetry_quadratic``, ``asymmetry_cubic``, ``center``, ``half_range``;
-        ``rate_band_gains``, ``rate_scale``; ``drift_per_s``, ``drift_clock``;
+        ``rate_band_gains``, ``rate_scale``; ``drift_per_s``, ``drift_clock`` (and
+        ``drift_variant``, ``drift_t0_train`` for a level per record, :mod:`.drift`);
         ``mode_hz``, ``mode_damping``; ``delay_samples``.
 
     Examples
@@ -158,7 +161,8 @@ class DiagnosedModel:
             raise ValueError(f"t: expected {v.size} samples like v, got {t.shape}")
         return t
 
-    def simulate(self, v, t=None, *, input_range: float | None = None) -> np.ndarray:
+    def simulate(self, v, t=None, *, input_range: float | None = None,
+                 measured=None) -> np.ndarray:
         """Output ``y[k]`` for the input ``v[k]`` (plays at rest at 0 before ``v[0]``).
 
         Parameters
@@ -170,6 +174,11 @@ class DiagnosedModel:
         input_range : float, optional
             Rate effect: a one-sample jump above ``STEP_SHARE`` of this range counts as a step
             (no rate); default ``ptp(v)``, as the diagnosis.
+        measured : array_like, optional
+            The record's measured output: a drift with a level per record
+            (``drift_variant == "levels"``) takes the record's level from it out of fold, as
+            the diagnosis does on a validate record (:func:`.drift.drift_term`); without it,
+            the level the drift's clock predicts. Ignored by other models.
 
         Returns
         -------
@@ -208,7 +217,11 @@ class DiagnosedModel:
                              len(p["rate_band_gains"]), input_range=input_range)
             y = y + R @ np.asarray(p["rate_band_gains"])
         if "drift" in e:
-            y = y + p["drift_per_s"] * (tk - tk[0] if p["drift_clock"] == "record" else tk)
+            y_meas = None if measured is None else _signal(measured, "measured")
+            if y_meas is not None and y_meas.shape != v.shape:
+                raise ValueError(f"measured: expected {v.size} samples like v, got "
+                                 f"{y_meas.shape}")
+            y = y + drift_term(p, tk, y, y_meas)
         return y
 
     def inverse(self) -> DiagnosedInverse:

@@ -1,0 +1,320 @@
+"""The ``drift`` candidate: a linear trend on the records' clock and levels that differ from
+record to record.
+
+Discrete-time form, with ``t[k]`` the time of sample ``k`` of a record [s] as given (the
+records may share one clock) and ``t[0]`` its first sample; the term is added to the model
+output ``y[k]`` [output units]:
+
+``"record"``
+    ``s (t[k] - t[0])``: a trend that restarts with each record; one offset for all records
+    (the nominal's).
+``"absolute"``
+    ``s t[k]``: a trend on the clock the records share; one offset for all records.
+``"levels"``
+    ``s (t[k] - t[0]) + c_j``: the trend plus a level ``c_j`` of each record ``j`` (a sensor
+    zeroed anew, a thermal offset, or a drift on a clock the records do not show). With a level
+    per record, a trend on the shared clock and one that restarts with each record differ only
+    by these levels, so one variant covers both and the levels say which clock they follow.
+
+The levels of the train records are fitted jointly with everything else (one indicator column
+per train record after the first). A validate record's level cannot come from train; it is a
+nuisance measured on the record itself **out of fold**: the record's scored samples are cut
+into ``LEVEL_FOLDS`` contiguous blocks and every sample of block ``b`` gets the mean residual
+(measured output minus the model without the level) of the *other* blocks. No validate sample
+is predicted with a level computed from its own block, so the level cannot follow the noise or
+a local gap, only a constant that holds over the record; every other parameter still comes
+from train. The validate BIC counts one parameter per validate record for the levels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+DRIFT_VARIANTS = ("record", "absolute", "levels")
+DRIFT_KEYS = ("clock", "levels")  # the grid parameters of a drift variant
+LEVEL_FOLDS = 4  # contiguous blocks of a validate record for its out-of-fold level
+
+__all__ = ["DRIFT_VARIANTS", "DRIFT_KEYS", "LEVEL_FOLDS", "drift_variants", "drift_columns",
+           "drift_k", "out_of_fold_level", "record_levels", "describe_levels", "level_report",
+           "drift_term"]
+
+
+def drift_variants(effects, n_validate: int) -> list[dict]:
+    """The drift variants to score on validate whenever ``effects`` hold a drift. A level per
+    validate record cannot be chosen on train, and the variant that fits best changes as other
+    effects join (a trend fitted beside an unmodelled asymmetry takes part of it), so the
+    variant is chosen anew for every combination, never carried over from an earlier round.
+
+    Parameters
+    ----------
+    effects : tuple of str
+        The effects of the model being fitted.
+    n_validate : int
+        Number of validate records (one level each for ``"levels"``).
+
+    Returns
+    -------
+    list of dict
+        ``[{}]`` without a drift, else one dict per variant (``clock``, and ``levels`` for
+        ``"levels"``).
+
+    Examples
+    --------
+    >>> drift_variants(("creep",), 1)
+    [{}]
+    >>> [v["clock"] for v in drift_variants(("creep", "drift"), 1)]
+    ['record', 'absolute', 'levels']
+    """
+    if "drift" not in effects:
+        return [{}]
+    return [{"clock": c, **({"levels": n_validate} if c == "levels" else {})}
+            for c in DRIFT_VARIANTS]
+
+
+def drift_k(p: dict) -> int:
+    """Parameters the drift adds on validate: the slope, plus one level per validate record for
+    the ``"levels"`` variant (``p["levels"]``).
+
+    Parameters
+    ----------
+    p : dict
+        The variant: ``clock`` (one of ``DRIFT_VARIANTS``) and, for ``"levels"``, ``levels``
+        (number of validate records).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> drift_k({"clock": "record"}), drift_k({"clock": "levels", "levels": 2})
+    (1, 3)
+    """
+    return 1 + (int(p.get("levels", 0)) if p.get("clock") == "levels" else 0)
+
+
+def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
+                  n_train: int = 1) -> np.ndarray:
+    """Regressors of the drift for one record, the trend column last.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time ``t[k]`` of the record [s].
+    p : dict
+        The variant (``clock``: one of ``DRIFT_VARIANTS``).
+    train_record : int or None
+        Index of the record among the train records (None: not a train record).
+    n_train : int
+        Number of train records.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N, 1) (the trend ``t[k]`` or ``t[k] - t[0]`` [s]); for ``"levels"`` with
+        several train records, first one indicator column per train record after the first
+        (shape (N, n_train)).
+
+    Examples
+    --------
+    >>> t = np.array([2.0, 2.5, 3.0])
+    >>> drift_columns(t, {"clock": "record"})[:, 0].tolist()
+    [0.0, 0.5, 1.0]
+    >>> drift_columns(t, {"clock": "levels"}, train_record=1, n_train=2).tolist()
+    [[1.0, 0.0], [1.0, 0.5], [1.0, 1.0]]
+    """
+    trend = (t if p["clock"] == "absolute" else t - t[0])[:, None]
+    if p["clock"] != "levels" or n_train < 2:
+        return trend
+    ind = np.zeros((t.size, n_train - 1))
+    if train_record is not None and train_record >= 1:
+        ind[:, train_record - 1] = 1.0
+    return np.hstack((ind, trend))
+
+
+def out_of_fold_level(r: np.ndarray, used=None, folds: int = LEVEL_FOLDS) -> np.ndarray:
+    """The level of a residual, estimated out of fold (module docstring).
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        Residual ``r[k]`` of one record (measured output minus the model without the level).
+    used : numpy.ndarray or slice or None
+        Boolean mask of the scored samples (None or a slice: all).
+    folds : int
+        Contiguous blocks of the scored samples (at least 2).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``level[k]``: the mean of ``r`` over the scored samples outside the block of ``k``
+        (samples between blocks belong to the block after them; those after the last scored
+        sample to the last block), output units.
+
+    Raises
+    ------
+    ValueError
+        ``folds`` below 2, or fewer scored samples than ``folds``.
+
+    Examples
+    --------
+    >>> r = np.array([1.0, 1.0, 3.0, 3.0])
+    >>> out_of_fold_level(r, folds=2).tolist()  # each half gets the other half's mean
+    [3.0, 3.0, 1.0, 1.0]
+    """
+    idx = np.arange(r.size) if used is None or isinstance(used, slice) else np.flatnonzero(used)
+    if folds < 2 or idx.size < folds:
+        raise ValueError(f"folds: expected 2 <= folds <= {idx.size} scored samples, got {folds}")
+    blocks = np.array_split(idx, folds)
+    sums = np.array([np.sum(r[blk]) for blk in blocks])
+    level = np.empty(r.size)
+    for b, blk in enumerate(blocks):
+        start = 0 if b == 0 else int(blk[0])
+        end = r.size if b == folds - 1 else int(blocks[b + 1][0])
+        others = np.arange(folds) != b  # summed without block b (not total minus block b)
+        level[start:end] = np.sum(sums[others]) / (idx.size - blk.size)
+    return level
+
+
+def record_levels(model, segments) -> list[float]:
+    """Level of each record under a ``"levels"`` drift model: the mean of the measured output
+    minus the model without the level over the record's scored samples (the value the
+    out-of-fold levels scatter around).
+
+    Parameters
+    ----------
+    model : pimodel.diagnosis.effects.Model
+        A fitted model (its ``features`` and ``coef``; the level adjustment is not applied).
+    segments : list of Segment
+        The records.
+
+    Returns
+    -------
+    list of float
+        One level per record [output units].
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.effects import Model, make_segment, base_features
+    >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.0]),
+    ...                    np.array([0.5, 1.5, 0.5]), [0.0])
+    >>> record_levels(Model("nominal", 0, base_features, np.array([1.0, 0.0])), [seg])
+    [0.5]
+    """
+    return [float(np.mean((s.y - model.features(s) @ model.coef)[s.used])) for s in segments]
+
+
+def describe_levels(slope: float, levels, t0s, t0_train: float) -> dict:
+    """Which clock the validate levels follow, and the part no clock explains.
+
+    A trend ``s`` on the shared clock moves the level of a record starting at ``t0`` by
+    ``s (t0 - t0_train)`` from the train level; a trend that restarts with each record leaves
+    it at the train level. The clock whose prediction is closer (in total over the records) is
+    reported; what remains is the records' own offset.
+
+    Parameters
+    ----------
+    slope : float
+        Fitted trend ``s`` [output units / s].
+    levels : list of float
+        Level of each validate record relative to the train level [output units].
+    t0s : list of float
+        First time ``t[0]`` of each validate record [s].
+    t0_train : float
+        First time of the (first) train record [s].
+
+    Returns
+    -------
+    dict
+        ``drift_clock`` (``"record"`` or ``"absolute"``), ``drift_record_levels`` (the levels
+        as given) and ``drift_record_offsets`` (each level minus the clock's prediction), both
+        in output units.
+
+    Examples
+    --------
+    >>> d = describe_levels(0.1, [0.5], [5.0], 0.0)  # 0.1 um/s over 5 s: the shared clock
+    >>> d["drift_clock"], [round(x, 6) for x in d["drift_record_offsets"]]
+    ('absolute', [0.0])
+    >>> describe_levels(0.1, [0.02], [5.0], 0.0)["drift_clock"]  # a level of its own
+    'record'
+    """
+    lv = np.asarray(levels, float)
+    absolute = slope * (np.asarray(t0s, float) - t0_train)
+    clock = "absolute" if np.sum(np.abs(lv - absolute)) < np.sum(np.abs(lv)) else "record"
+    rest = lv - absolute if clock == "absolute" else lv
+    return {"drift_clock": clock, "drift_record_levels": lv.tolist(),
+            "drift_record_offsets": rest.tolist()}
+
+
+def level_report(model, validate, train) -> dict:
+    """The drift parameters read from the validate levels of a ``"levels"`` model
+    (:func:`describe_levels`); ``{}`` for any other model.
+
+    Parameters
+    ----------
+    model : pimodel.diagnosis.effects.Model
+        A fitted model.
+    validate, train : list of Segment
+        The validate and train records.
+
+    Returns
+    -------
+    dict
+        ``drift_clock``, ``drift_record_levels``, ``drift_record_offsets`` (output units).
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.effects import Model, base_features
+    >>> level_report(Model("creep", 4, base_features, np.zeros(2)), [], [])
+    {}
+    """
+    if model.params.get("drift_variant") != "levels":
+        return {}
+    return describe_levels(model.params["drift_per_s"], record_levels(model, validate),
+                           [float(s.t[0]) for s in validate], float(train[0].t[0]))
+
+
+def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
+               measured: np.ndarray | None = None) -> np.ndarray:
+    """The drift term ``params`` describe, on the time ``t`` of one record.
+
+    Parameters
+    ----------
+    params : dict
+        ``drift_per_s`` [output units / s], ``drift_clock`` and, for a model with a level per
+        record, ``drift_variant == "levels"`` and ``drift_t0_train`` (first time of the train
+        record whose level the model's offset is [s]).
+    t : numpy.ndarray
+        Time ``t[k]`` [s].
+    y_rest : numpy.ndarray, optional
+        The model output without the drift (needed with ``measured``).
+    measured : numpy.ndarray, optional
+        The record's measured output: with ``"levels"``, its level is estimated out of fold
+        from it, as the diagnosis does on a validate record (every sample scored). Without it,
+        the level the reported clock predicts: the train level (``"record"``) or the train
+        level moved by the trend since ``drift_t0_train`` (``"absolute"``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The term [output units], shape of ``t``.
+
+    Examples
+    --------
+    >>> p = {"drift_per_s": 0.5, "drift_clock": "record"}
+    >>> drift_term(p, np.array([1.0, 2.0])).tolist()
+    [0.0, 0.5]
+    >>> q = {**p, "drift_variant": "levels", "drift_t0_train": 0.0}
+    >>> y = np.full(4, 2.0) + 0.5 * np.arange(4.0)  # a record at a level of 2
+    >>> drift_term(q, np.arange(4.0), np.zeros(4), y).tolist()
+    [2.0, 2.5, 3.0, 3.5]
+    """
+    s = float(params["drift_per_s"])
+    if params.get("drift_variant") != "levels":
+        return s * (t - t[0] if params["drift_clock"] == "record" else t)
+    term = s * (t - t[0])
+    if measured is not None:
+        return term + out_of_fold_level(measured - y_rest - term)
+    if params["drift_clock"] == "absolute":
+        return term + s * (t[0] - float(params["drift_t0_train"]))
+    return term
