@@ -329,3 +329,21 @@ def test_real_record_model_as_block_and_fmu(real_record_path, tmp_path):
         got = cosimulate_chain([fmu], v, m.dt)
         assert np.max(np.abs(got - m.simulate(v, input_range=rng))) < 1e-12
     assert rep.model().effects and np.any(rep.model().weights < 0)
+
+
+@pytest.mark.parametrize("clock", ["record", "absolute"])
+def test_stream_follows_a_drift_with_a_level_per_record(clock):
+    """A drift with a level per record (``drift_variant == "levels"``) without the measured
+    output: the level the clock predicts, the trend since the train record's start
+    (``drift_term``); the stream and the FMU parameters carry it in the offset."""
+    from pimodel.diagnosis.stream import fmu_parameters
+
+    p = {"drift_per_s": 0.2, "drift_clock": clock, "drift_variant": "levels",
+         "drift_t0_train": 1.0}
+    m = DiagnosedModel([0.0, 0.2], [1.0, 0.5], 0.1, dt=1e-3, effects=("drift",), params=p)
+    t = 5.0 + np.arange(500) * 1e-3
+    v = np.sin(20 * t)
+    want = m.simulate(v, t)
+    assert np.max(np.abs(stream_simulate(m, v, t) - want)) < 1e-12
+    shift = 0.2 * 1.0 if clock == "absolute" else 0.0
+    assert fmu_parameters(m)[1]["offset"] == pytest.approx(0.1 - shift, abs=1e-15)

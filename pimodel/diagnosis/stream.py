@@ -156,6 +156,10 @@ class NativeModel:
                 raise ValueError(f"params: drift_clock = {p['drift_clock']!r}: expected one of "
                                  f"{sorted(CLOCKS)}")
             d.drift_clock, d.drift = CLOCKS[p["drift_clock"]], p["drift_per_s"]
+            if p.get("drift_variant") == "levels" and p["drift_clock"] == "absolute":
+                # a level per record, predicted by the clock: the trend since the train
+                # record's start, s (t - t0_train) (drift.drift_term without `measured`)
+                d.c = model.offset - p["drift_per_s"] * float(p["drift_t0_train"])
         self._keep = {k: np.ascontiguousarray(v, dtype=float) for k, v in keep.items()}
         for k, v in self._keep.items():
             setattr(d, k, _native.diag_pointer(v))
@@ -435,7 +439,7 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
                 for i, x in enumerate(values)}
 
     out = {"Ts": model.dt, "n": n, "z0": 0.0, **arr("p", model.weights), **arr("r", model.radii),
-           **arr("w0", model.reference_weights), "offset": model.offset,
+           **arr("w0", model.reference_weights), "offset": d.c,
            "reference_offset": model.reference_offset, "input_range": nm.input_range}
     if d.m:
         out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
