@@ -104,6 +104,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.where",
     "pimodel.diagnosis.noise",
     "pimodel.diagnosis.plots",
+    "pimodel.diagnosis.rate",
     "pimodel.truth",
     "pimodel.truth_alt",
 ]
