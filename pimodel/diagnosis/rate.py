@@ -174,7 +174,7 @@ class RateBasis:
     >>> v = np.r_[np.linspace(0.0, 1.0, 41), 1.0]  # a ramp at 0.025 per sample, then a hold
     >>> Z = np.maximum(v - 0.5, 0.0)[:, None]  # one play of radius 0.5, pushed from v = 0.5
     >>> basis = RateBasis(Z, [0.5], v, 1.0, 0.025, [1.0], 1)
-    >>> basis.columns(0.0, "radius")[[0, 20, 21, 41], 0].round(6).tolist()  # contact, hold
+    >>> (basis.columns(0.0, "radius")[[0, 20, 21, 41], 0].round(6) + 0.0).tolist()  # hold: 0
     [0.0, -0.5, -0.5, 0.0]
     >>> basis.columns(0.0, "weight")[[0, 20, 21, 41], 0].round(6).tolist()
     [0.0, 0.0, 0.025, 0.0]
@@ -186,7 +186,9 @@ class RateBasis:
         self.v, self.dt, self.rate_scale, self.input_range = v, dt, rate_scale, input_range
         self.bands = play_bands(self.radii.size, bands)
         self.weights = np.asarray(weights, float)
+        self._starts = [int(g[0]) for g in self.bands]
         self._contact = None  # (last contact sample, -s_i r_i there), built on first use
+        self._weighted = None  # band sums of w0_i z_i, built on first use
         self._cache: dict = {}
 
     def rate(self, tau: float) -> np.ndarray:
@@ -244,23 +246,31 @@ class RateBasis:
         if key not in self._cache:
             rho = self.rate(key[0])
             if family == "weight":
-                cols = [rho * (self.Z[:, g] @ self.weights[g]) for g in self.bands]
+                if self._weighted is None:
+                    member = np.zeros((self.radii.size, len(self.bands)))
+                    for b, g in enumerate(self.bands):
+                        member[g, b] = self.weights[g]
+                    self._weighted = self.Z @ member
+                self._cache[key] = rho[:, None] * self._weighted
             else:
                 last, signed = self._contacts()
-                per_play = rho[last] * signed
-                cols = [per_play[:, g].sum(axis=1) for g in self.bands]
-            self._cache[key] = np.column_stack(cols)
+                per_play = np.take(rho, last)
+                per_play *= signed
+                self._cache[key] = np.add.reduceat(per_play, self._starts, axis=1)
         return self._cache[key]
 
     def _contacts(self):
         if self._contact is None:
             r, Z = self.radii, self.Z
-            gap = self.v[:, None] - Z
-            contact = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
+            gap = self.v[:, None] - Z  # +-r_i while play i is in contact
+            contact = np.abs(gap) >= r * (1 - 1e-9)
+            contact &= r > 0
             k = np.arange(Z.shape[0], dtype=np.int32)[:, None]
-            last = np.maximum.accumulate(np.where(contact, k, -1), axis=0)
+            last = np.maximum.accumulate(np.where(contact, k, np.int32(-1)), axis=0)
             at = np.maximum(last, 0)
-            signed = np.where(last >= 0, -np.sign(np.take_along_axis(gap, at, axis=0)) * r, 0.0)
+            signed = np.take_along_axis(gap, at, axis=0)  # -(-s_i r_i) at the last contact
+            signed *= -1.0
+            signed[last < 0] = 0.0
             self._contact = (at, signed)
         return self._contact
 
