@@ -529,6 +529,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         best = search([{**best[0].params, "d": d0 + f} for f in (-0.75, -0.5, -0.25, 0.25,
                                                                   0.5, 0.75) if d0 + f >= 0],
                       best)
+        d0 = best[0].params["d"]  # and an eighth of a sample
+        best = search([{**best[0].params, "d": d0 + f} for f in (-0.125, 0.125) if d0 + f >= 0],
+                      best)
     if "dynamics" in effects and "fn" not in fixed:
         # refine the mode around the grid optimum, then polish it continuously (a light
         # mode's resonance is narrower than the grid)
