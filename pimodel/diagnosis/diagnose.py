@@ -375,8 +375,6 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         best = None
         for var in _variants(name):
             fx = {**(fixed_ or {}), **var}
-            if name == "rate" and combo:  # on top of other effects: the family and filter the
-                fx.update(cache[((), "rate", ())][0].grid)  # rate chose alone (speed)
             key = (combo, name, tuple(sorted(fx.items())))
             if key not in cache:
                 m = fit_effect(name, tr, combo, fx, nominal)
