@@ -106,6 +106,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.where",
     "pimodel.diagnosis.noise",
     "pimodel.diagnosis.plots",
+    "pimodel.diagnosis.rate",
     "pimodel.truth",
     "pimodel.truth_alt",
     "pimodel.truth_steps",

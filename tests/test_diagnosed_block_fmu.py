@@ -22,8 +22,8 @@ import pytest
 from fmpy.validation import validate_fmu
 
 from pimodel.blocks import initial_state
-from pimodel.diagnosis.effects import STEP_SHARE
 from pimodel.diagnosis.model import DiagnosedModel
+from pimodel.diagnosis.rate import STEP_SHARE
 from pimodel.diagnosis.stream import NativeModel, state_labels, stream_simulate
 from pimodel.fmu.block import fmu_block
 from pimodel.fmu.build import source_dir

@@ -41,15 +41,14 @@ from ..data import Record
 from .drift import DRIFT_KEYS, drift_variants, level_report
 from .effects import (
     EFFECTS,
-    RATE_BANDS,
     Model,
     Segment,
     fit_effect,
     fit_nominal,
     make_segment,
-    rate_columns,
 )
 from .noise import measure_noise_floor
+from .rate import RateBasis
 from .where import residual_breakdown, startup_length
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
@@ -326,12 +325,12 @@ def _compressed(tr, va, nominal: Model):
         if q >= n:
             return tr, va, nominal, None
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :q]))
-        ctr = [Segment(s.t, s.v, s.y, s.Z @ V, s.mask, s.rate_column) for s in tr]
+        ctr = [Segment(s.t, s.v, s.y, s.Z @ V, s.mask) for s in tr]
         m = fit_nominal(ctr)
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
         if rss <= 1.01 * rss_full:
             m.params = dict(nominal.params)
-            return (ctr, [Segment(s.t, s.v, s.y, s.Z @ V, s.mask, s.rate_column) for s in va],
+            return (ctr, [Segment(s.t, s.v, s.y, s.Z @ V, s.mask) for s in va],
                     m, V)
     return tr, va, nominal, None
 
@@ -357,12 +356,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                     "train": _errors(tr, out_tr), "validate": before,
                     "initial_state": initial_state}
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
-    for s in tr + va:
-        s.rate_column = rate_columns(s.Z, radii, s.v, s.dt, nominal.params["rate_scale"],
-                                     RATE_BANDS)
     full_nominal = nominal
+    full_segs = tr + va
     tr, va, nominal, proj = _compressed(tr, va, nominal)
     segs = tr + va
+    # the rate columns from the full play outputs, weighted as the model will hold them
+    w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
+    for s, f in zip(segs, full_segs, strict=True):
+        s.rate_basis = RateBasis(f.Z, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
 

@@ -17,6 +17,7 @@ from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
+from .rate import RATE_BANDS, RATE_FAMILIES, RATE_TAU_REFINE, RATE_TAU_START, RATE_TAUS
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
@@ -27,8 +28,6 @@ SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the fi
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 DRIFT_CLOCKS = DRIFT_VARIANTS  # t - t[0] of each record, t as given, or a level per record
-RATE_BANDS = 8  # the rate candidate's play groups (one column each)
-STEP_SHARE = 0.05  # rate candidate: a one-sample jump above this share of the range is a step
 ASYMMETRY_ITERATIONS = 2  # refits of the asymmetry on the hysteresis part of the previous fit
 
 
@@ -49,8 +48,9 @@ class Segment:
     mask : numpy.ndarray or None
         Boolean, the samples that are fitted and scored (False in a start-up region whose
         initial memory is unknown); None: all.
-    rate_column : numpy.ndarray or None
-        The rate candidate's columns (:func:`rate_columns`), set by the diagnosis.
+    rate_basis : pimodel.diagnosis.rate.RateBasis or None
+        The rate candidate's columns (:class:`~pimodel.diagnosis.rate.RateBasis`), set by the
+        diagnosis.
 
     Examples
     --------
@@ -65,7 +65,7 @@ class Segment:
     y: np.ndarray
     Z: np.ndarray
     mask: np.ndarray | None = None
-    rate_column: np.ndarray | None = None  # see rate_columns, set by the diagnosis
+    rate_basis: object = None  # a rate.RateBasis, set by the diagnosis
 
     @property
     def used(self) -> np.ndarray:
@@ -429,11 +429,12 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
     name : str
         The effect added, one of ``EFFECTS``.
     train : list of Segment
-        The train records (``rate_column`` set when ``"rate"`` is among the effects).
+        The train records (``rate_basis`` set when ``"rate"`` is among the effects).
     combo : tuple of str
         Effects chosen in earlier rounds.
     fixed : dict or None
-        Their grid parameters (``fn``, ``zeta``, ``d``, ``clock``).
+        Their grid parameters (``fn``, ``zeta``, ``d``, ``clock``, ``rate_family``,
+        ``rate_tau``).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -488,7 +489,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     name = "+".join(effects)
     k = _combo_k(effects) + (drift_k(fixed) - 1 if "drift" in effects else 0)  # + levels
     static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
-    # a mode search filters every column at every point: there, the leading columns only
+    # a mode search filters every column at every point: there, the leading columns only (not
+    # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
+    # then left a spurious second effect)
     ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
 
     def search(points, best=None):
@@ -514,10 +517,25 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             grids.append([{k_: fixed[k_] for k_ in ("clock", "levels") if k_ in fixed}]
                          if "clock" in fixed else
                          [{"clock": c} for c in DRIFT_CLOCKS if c != "levels"])
+        elif e == "rate":  # the filter is searched after the other grids (below)
+            grids.append([{"rate_family": fixed["rate_family"], "rate_tau": fixed["rate_tau"]}]
+                         if "rate_tau" in fixed else
+                         [{"rate_family": f, "rate_tau": RATE_TAU_START} for f in RATE_FAMILIES])
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
     best = search(points)
+    if "rate" in effects and "rate_tau" not in fixed:
+        # the rate family and filter (the other grid parameters held): the filter's grid,
+        # then geometric steps around the best positive time constant
+        best = search([{**best[0].params, "rate_family": f, "rate_tau": tau}
+                       for f in RATE_FAMILIES for tau in RATE_TAUS if tau != RATE_TAU_START],
+                      best)
+        for step in RATE_TAU_REFINE:
+            tau = best[0].params["rate_tau"]
+            if tau > 0:
+                best = search([{**best[0].params, "rate_tau": tau * f} for f in (1 / step, step)],
+                              best)
     if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
         i = int(np.searchsorted(dgrid, best[0].params["d"]))
         lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
@@ -599,12 +617,13 @@ def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
 
 def _combo_k(effects) -> int:
     return sum({"creep": len(CREEP_TAUS), "dynamics": 2, "delay": 1, "asymmetry": 2,
-                "drift": 1, "rate": RATE_BANDS}[e] for e in effects)
+                "drift": 1, "rate": RATE_BANDS + 2}[e] for e in effects)
 
 
 def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
     """Feature builder for the effects with grid parameters ``p``; the columns that do not
-    depend on ``p`` (offset, creep, asymmetry, drift) are memoised per segment in ``static``."""
+    depend on ``p`` (offset, creep, asymmetry) are memoised per segment in ``static`` (the rate
+    columns per filter in the segment's ``rate_basis``)."""
 
     def static_columns(s: Segment) -> np.ndarray:
         key = id(s)
@@ -616,8 +635,6 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 cols.append(np.column_stack((u**2, u**3)))
-            if "rate" in effects:
-                cols.append(s.rate_column)
             static[key] = (s, np.hstack(cols))  # keep s alive so its id stays unique
         return static[key][1]
 
@@ -636,66 +653,14 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "delay" in effects:
             Z = shift(Z, p["d"])
         cols = [Z, static_columns(s)]
+        if "rate" in effects:
+            cols.append(s.rate_basis.columns(p["rate_tau"], p["rate_family"]))
         if "drift" in effects:  # the trend column last
             cols.append(drift_columns(s.t, p, static["train"].get(id(s)),
                                       len(static["train"])))
         return np.hstack(cols)
 
     return feats
-
-
-def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
-                 bands: int = 4, *, input_range: float | None = None) -> np.ndarray:
-    """Output change per unit weight and unit ``c`` when the play radii grow with the input rate,
-    ``r_i[k] = r_i (1 + c rho[k])``, ``rho = |v[k] - v[k-1]| / dt / rate_scale`` (0 at a
-    sampled step, a one-sample jump of more than ``STEP_SHARE`` of the input range: no rate a
-    play can follow), to first order:
-    ``(-s_i) r_i rho[j_i]``, where ``j_i <= k`` is the last sample at which play ``i`` was
-    pushed (its output moved) and ``s_i`` the sign of that move (a wider play lags further
-    behind the input on the branch it was last pushed along), summed over ``bands`` contiguous
-    groups of plays (the fit gives each group its weight times ``c``).
-
-    Parameters
-    ----------
-    Z : numpy.ndarray
-        Play outputs ``z_i[k]``, shape (N, n).
-    radii : array_like
-        Play radii ``r_i`` [input units].
-    v : numpy.ndarray
-        Input ``v[k]``.
-    dt : float
-        Sample time [s].
-    rate_scale : float
-        Input rate [input units / s] that makes ``rho = 1``.
-    bands : int
-        Groups of plays.
-    input_range : float, optional
-        The range of the step rule (default ``ptp(v)``).
-
-    Returns
-    -------
-    numpy.ndarray
-        The columns, shape (N, min(bands, n)), input units.
-
-    Examples
-    --------
-    >>> v = np.r_[np.linspace(0.0, 1.0, 41), 1.0]  # a ramp at 0.025 per sample, then a hold
-    >>> Z = np.maximum(v - 0.5, 0.0)[:, None]  # one play of radius 0.5, pushed from v = 0.5
-    >>> np.round(rate_columns(Z, [0.5], v, 1.0, 0.025)[[0, 20, 21, 41], 0], 6).tolist()
-    [0.0, 0.0, -0.5, -0.5]
-    """
-    dv = np.abs(np.diff(v, prepend=v[0]))
-    span = float(np.ptp(v)) if input_range is None else float(input_range)
-    rho = np.where(dv <= STEP_SHARE * span, dv / dt / rate_scale, 0.0)
-    dz = np.diff(Z, axis=0, prepend=Z[:1])
-    pushed = dz != 0
-    k = np.arange(Z.shape[0])[:, None]
-    last = np.maximum.accumulate(np.where(pushed, k, -1), axis=0)
-    sign = np.sign(dz)[np.maximum(last, 0), np.arange(Z.shape[1])[None, :]]
-    per_play = np.where(last >= 0, -sign * rho[np.maximum(last, 0)], 0.0)
-    per_play = per_play * np.asarray(radii, float)
-    groups = np.array_split(np.arange(Z.shape[1]), min(bands, Z.shape[1]))
-    return np.column_stack([per_play[:, g].sum(axis=1) for g in groups])
 
 
 def _describe(effects, model: Model, nominal: Model) -> dict:
@@ -712,7 +677,9 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2
         elif e == "rate":
-            out["rate_band_gains"] = extra[i:i + RATE_BANDS].tolist()
+            out["rate_gains"] = extra[i:i + RATE_BANDS].tolist()
+            out["rate_family"] = model.params["rate_family"]
+            out["rate_time_constant_s"] = model.params["rate_tau"]
             i += RATE_BANDS
     if "drift" in effects:
         out["drift_per_s"] = float(model.coef[-1])

@@ -9,7 +9,7 @@ effect columns are built from,
     y[k] = (D Z)[k] w + c                                    hysteresis (weights w, offset c)
          + sum_i g_i (L_i[h0][k] - h0[k])                     creep: lags L_i, tau_i (s)
          + q u[k]^2 + c3 u[k]^3,  u = (h0 - center) / half    asymmetry (static output terms)
-         + sum_b g_b R_b[k]                                   rate (first-order radius growth)
+         + sum_b g_b R_b[k]                                   rate (radii or weights, .rate)
          + s t_clock[k] (+ c_j)                               drift (record or shared clock;
                                                               or a level c_j per record)
 
@@ -29,10 +29,11 @@ exact to rounding. Exact (round trip to 1e-9) for the nominal model and
 for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input.
 Approximations, by choice:
 
-* **rate**: the rate term of sample k is taken from sample k - 1 (each play's last push up to
-  k - 1). Solved exactly, the term ``-r g |v[k] - v[k-1]| / (dt rate_scale)`` makes ``F_k``
-  steep and non-monotone, and the feedforward follows wrong roots (measured: open-loop errors
-  6 to 9 times the nominal's).
+* **rate**: the filtered rate of sample k is taken from sample k - 1 (radius family: the terms
+  as held at each play's last contact up to k - 1; weight family: ``rho_f[k-1]`` times the play
+  outputs of sample k). Solved exactly, a term in ``|v[k] - v[k-1]| / (dt rate_scale)`` makes
+  ``F_k`` steep and non-monotone, and the feedforward follows wrong roots (measured with the
+  radius family: open-loop errors 6 to 9 times the nominal's).
 * **delay**: not inverted; the feedforward is advanced by the delay (``y_d[k + d]``, linear
   interpolation): it needs the reference ``d`` samples ahead (a known trajectory).
 * **dynamics**: the mode is replaced by a stable approximate inverse, ``M(s)^-1`` times the
@@ -55,7 +56,8 @@ from scipy.signal import lfilter, lfilter_zi
 
 from ..operator import PIOperator
 from .drift import drift_term
-from .effects import STEP_SHARE, lag, mode, rate_columns, shift
+from .effects import lag, mode, shift
+from .rate import RATE_FAMILIES, STEP_SHARE, play_bands, rate_columns
 
 if TYPE_CHECKING:
     import control
@@ -84,8 +86,9 @@ class DiagnosedModel:
     params : dict
         Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s``;
         ``asymmetry_quadratic``, ``asymmetry_cubic``, ``center``, ``half_range``;
-        ``rate_band_gains``, ``rate_scale``; ``drift_per_s``, ``drift_clock`` (and
-        ``drift_variant``, ``drift_t0_train`` for a level per record, :mod:`.drift`);
+        ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
+        (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,
+        ``drift_t0_train`` for a level per record, :mod:`.drift`);
         ``mode_hz``, ``mode_damping``; ``delay_samples``.
 
     Examples
@@ -172,8 +175,8 @@ class DiagnosedModel:
         t : array_like, optional
             Times [s] (for a drift on the shared clock); default ``k dt``.
         input_range : float, optional
-            Rate effect: a one-sample jump above ``STEP_SHARE`` of this range counts as a step
-            (no rate); default ``ptp(v)``, as the diagnosis.
+            Rate effect without a filter: a one-sample jump above ``STEP_SHARE`` of this range
+            counts as a step (no rate); default ``ptp(v)``, as the diagnosis.
         measured : array_like, optional
             The record's measured output: a drift with a level per record
             (``drift_variant == "levels"``) takes the record's level from it out of fold, as
@@ -213,9 +216,10 @@ class DiagnosedModel:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
         if "rate" in e:
-            R = rate_columns(Z, self.radii, v, self.dt, p["rate_scale"],
-                             len(p["rate_band_gains"]), input_range=input_range)
-            y = y + R @ np.asarray(p["rate_band_gains"])
+            gains, family, tau = _rate_params(p)
+            R = rate_columns(Z, self.radii, v, self.dt, p["rate_scale"], self.reference_weights,
+                             tau, family, gains.size, input_range=input_range)
+            y = y + R @ gains
         if "drift" in e:
             y_meas = None if measured is None else _signal(measured, "measured")
             if y_meas is not None and y_meas.shape != v.shape:
@@ -287,7 +291,7 @@ class DiagnosedModel:
     @property
     def is_exactly_invertible(self) -> bool:
         """True when no effect of the model is inverted approximately (drift aside)."""
-        return not {"dynamics", "delay"} & set(self.effects)
+        return not {"dynamics", "delay", "rate"} & set(self.effects)
 
     # -- JSON ---------------------------------------------------------------------------
     def to_dict(self) -> dict:
@@ -570,13 +574,17 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
     asym = "asymmetry" in e
     rate = "rate" in e
     if rate:
-        gains = np.asarray(p["rate_band_gains"])
-        groups = np.array_split(np.arange(n), min(gains.size, n))
-        rg = np.empty(n)
-        for g, idx in zip(gains, groups, strict=True):
-            rg[idx] = g * r[idx]
-        memory = np.zeros(n)  # -s_i rho at the last push of play i
+        gains, family, tau = _rate_params(p)
+        rg, rw = np.zeros(n), np.zeros(n)  # per play: g_b r_i (radius) or g_b w0_i (weight)
+        for g, idx in zip(gains, play_bands(n, gains.size), strict=True):
+            if family == "radius":
+                rg[idx] = g * r[idx]
+            else:
+                rw[idx] = g * w0[idx]
+        memory = np.zeros(n)  # -s_i rho_f at the last contact of play i
         step = STEP_SHARE * input_range
+        a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
+        rho_f = 0.0  # filtered rate of sample k - 1
     z = np.zeros(n)
     v_prev = 0.0
     out = np.empty(yd.size)
@@ -587,7 +595,7 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
         first = k == 0
 
         def F(vs, z=z, v_prev=v_prev, first=first, lags=lags if creep else None,
-              memory=memory if rate else None):
+              memory=memory if rate else None, rho_f=rho_f if rate else None):
             Zc = np.clip(z[None, :], vs[:, None] - r, vs[:, None] + r)
             y = Zc @ w + m.offset
             h0 = Zc @ w0 + m.reference_offset
@@ -596,8 +604,8 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
             if asym:
                 u = (h0 - p["center"]) / p["half_range"]
                 y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-            if rate and not first:  # held from sample k - 1 (see the module docstring)
-                y = y + memory @ rg
+            if rate and not first:  # the rate held from sample k - 1 (module docstring)
+                y = y + memory @ rg + rho_f * (Zc @ rw)
             return y
 
         b = np.concatenate((z - r, z + r, [v_prev]))
@@ -616,9 +624,11 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
             lags = h + 0 * lags if first else a_lag * lags + (1 - a_lag) * h
         if rate and not first:
             dv = abs(vk - v_prev)
-            rho = dv / m.dt / p["rate_scale"] if dv <= step else 0.0
-            dz = z_new - z
-            memory = np.where(dz != 0, -np.sign(dz) * rho, memory)
+            rho = dv / m.dt / p["rate_scale"] if dv <= step or tau > 0 else 0.0
+            rho_f = a_rate * rho_f + (1 - a_rate) * rho
+            gap = vk - z_new
+            contact = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
+            memory = np.where(contact, -np.sign(gap) * rho_f, memory)
         # the next sample takes the root nearest the extrapolated input (a smooth input's
         # branch), or nearest this one after a jump (a step)
         guess = vk if first or abs(vk - v_prev) > 0.01 * span else 2 * vk - v_prev
@@ -660,3 +670,20 @@ def _roots(F, b: np.ndarray, target: float, *, cubic: bool) -> np.ndarray:
         real = rts[np.abs(rts.imag) < 1e-9].real
         out.extend(lo[i] + x * width[i] for x in real[(real >= -1e-12) & (real <= 1 + 1e-12)])
     return np.asarray(out, float)
+
+
+def _rate_params(p: dict) -> tuple[np.ndarray, str, float]:
+    """Gains, family and filter time constant [s] of a rate effect."""
+    if "rate_band_gains" in p:
+        raise ValueError("params: 'rate_band_gains' is the rate effect of an earlier version "
+                         "(radii growing with the unfiltered rate, pushed plays); diagnose the "
+                         "records again for 'rate_gains', 'rate_family' and "
+                         "'rate_time_constant_s'")
+    missing = [k for k in ("rate_gains", "rate_family", "rate_time_constant_s") if k not in p]
+    if missing:
+        raise ValueError(f"params: the rate effect needs {missing}")
+    if p["rate_family"] not in RATE_FAMILIES:
+        raise ValueError(f"params: rate_family expected one of {RATE_FAMILIES}, got "
+                         f"{p['rate_family']!r}")
+    return (np.asarray(p["rate_gains"], float), str(p["rate_family"]),
+            float(p["rate_time_constant_s"]))

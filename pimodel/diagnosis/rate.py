@@ -1,0 +1,320 @@
+"""The ``rate`` candidate: hysteresis whose play radii or weights depend on a low-passed input
+rate, to first order, as columns that are linear in their gains.
+
+A rate-dependent PI model (as :class:`pimodel.rate_dependent.RateDependentPI`, generalised) has
+radii ``r_i (1 + a_b rho_f[k])`` or weights ``w_i (1 + c_b rho_f[k])`` for the plays ``i`` of
+band ``b``, where ``rho_f`` is the input rate, normalised by ``rate_scale`` and passed through a
+first-order low-pass with time constant ``tau`` (``tau = 0``: the rate of the last sample
+interval). Two families, one loop that widens with the rate and one that grows as a whole; to
+first order in the gains the output changes by
+
+* ``"radius"`` columns ``R_b[k] = sum_{i in b} (-s_i) r_i rho_f[j_i]``: play ``i`` lags further
+  behind the input on the branch it last touched; ``j_i <= k`` is the last sample at which the
+  nominal play was in contact (``|v[j] - z_i[j]| = r_i``, pushed or about to be) and ``s_i`` the
+  sign of ``v - z_i`` there: while in contact the column follows the current rate (a play whose
+  radius shrinks as the input slows down stays in contact), after it the play's output is held;
+* ``"weight"`` columns ``W_b[k] = rho_f[k] sum_{i in b} w0_i z_i[k]``: the band's contribution
+  scales with the current filtered rate (``w0`` the reference weights, so a uniform ``c_b``
+  scales the band's part of the loop as a whole).
+
+Fitted jointly, the two families share too much on a record of a few constant rates (while a
+play is in contact, ``R`` is ``rho_f (z_i - v)``, a weight column minus a linear one) and the fit
+then follows neither out of contact (measured: a validate RMS 2.2 times that of the radius
+family alone on ``pimodel.truth``). So the candidate fits one family's ``RATE_BANDS`` gains
+jointly with the hysteresis weights and chooses the family and ``tau`` by the train residual:
+``tau`` on the grid ``RATE_TAUS``, then by geometric steps (``RATE_TAU_REFINE``) around the best
+positive one. Without a filter (``tau = 0``) a sampled step, a one-sample jump above
+``STEP_SHARE`` of the input range, is no rate a play follows (its rate counts as 0); a low-pass
+spreads a step's rate over ``tau``, so with a filter it counts as moved.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import lfilter
+
+RATE_TAUS = (0.0, 1e-3, 3e-3, 10e-3, 30e-3)  # s: low-pass of the input rate, half decades
+RATE_TAU_START = 0.0  # the filter held while other grids (mode, delay, ...) are searched
+RATE_TAU_REFINE = (10**0.25, 10**0.125)  # then steps around the optimum: 1/4, 1/8 decade
+RATE_BANDS = 8  # play bands: the candidate has RATE_BANDS gains
+RATE_FAMILIES = ("radius", "weight")  # radii or weights growing with the rate
+STEP_SHARE = 0.05  # without a filter, a one-sample jump above this share of the range is a step
+
+__all__ = ["RATE_BANDS", "RATE_FAMILIES", "RATE_TAU_REFINE", "RATE_TAUS", "RateBasis",
+           "filtered_rate", "input_rate", "play_bands", "rate_columns"]
+
+
+def input_rate(v: np.ndarray, dt: float, rate_scale: float, tau: float,
+               input_range: float | None = None) -> np.ndarray:
+    """Normalised input rate ``rho_f[k]``, low-passed with time constant ``tau``.
+
+    ``rho[k] = |v[k] - v[k-1]| / dt / rate_scale`` (``rho[0] = 0``), then
+    ``rho_f[k] = a rho_f[k-1] + (1 - a) rho[k]``, ``a = exp(-dt / tau)``, from ``rho_f[-1] = 0``;
+    ``tau = 0``: ``rho_f = rho``, with a one-sample jump above ``STEP_SHARE`` of the input range
+    counted as 0 (a sampled step, no rate a play follows).
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        Input ``v[k]``.
+    dt : float
+        Sample time [s].
+    rate_scale : float
+        Input rate [input units / s] that makes ``rho = 1``.
+    tau : float
+        Time constant of the low-pass [s], ``>= 0``.
+    input_range : float, optional
+        The range of the step rule (default ``ptp(v)``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``rho_f[k]`` [-], shape of ``v``; ``rho_f[k]`` depends on ``v[0..k]``.
+
+    Raises
+    ------
+    ValueError
+        A negative or non-finite ``tau``, a non-positive ``rate_scale``.
+
+    Examples
+    --------
+    >>> v = np.r_[np.linspace(0.0, 0.1, 5), 1.0, 1.0]  # a ramp, then a jump and a hold
+    >>> input_rate(v, 1.0, 0.025, 0.0).round(3).tolist()  # the jump is a step: no rate
+    [0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0]
+    >>> input_rate(v, 1.0, 0.025, 1.0).round(3).tolist()  # a low-pass spreads the jump
+    [0.0, 0.632, 0.865, 0.95, 0.982, 23.117, 8.504]
+    """
+    if not np.isfinite(tau) or tau < 0:
+        raise ValueError(f"tau: expected a finite time constant >= 0 [s], got {tau!r}")
+    if not rate_scale > 0:
+        raise ValueError(f"rate_scale: expected > 0, got {rate_scale!r}")
+    dv = np.abs(np.diff(v, prepend=v[0]))
+    rho = dv / dt / rate_scale
+    if tau == 0:
+        span = float(np.ptp(v)) if input_range is None else float(input_range)
+        return np.where(dv <= STEP_SHARE * span, rho, 0.0)
+    return filtered_rate(rho, tau, dt)
+
+
+def filtered_rate(rho: np.ndarray, tau: float, dt: float) -> np.ndarray:
+    """``rho`` through the first-order low-pass of time constant ``tau > 0`` from rest at 0.
+
+    Parameters
+    ----------
+    rho : numpy.ndarray
+        Rate ``rho[k]``.
+    tau : float
+        Time constant [s].
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        ``rho_f[k] = a rho_f[k-1] + (1 - a) rho[k]``, ``a = exp(-dt / tau)``.
+
+    Examples
+    --------
+    >>> filtered_rate(np.array([0.0, 1.0, 1.0]), 1.0, 1.0).round(4).tolist()
+    [0.0, 0.6321, 0.8647]
+    """
+    a = np.exp(-dt / tau)
+    return lfilter([1 - a], [1, -a], rho)
+
+
+def play_bands(n: int, bands: int) -> list[np.ndarray]:
+    """Contiguous groups of the ``n`` plays (radii ascending), ``min(bands, n)`` of them.
+
+    Parameters
+    ----------
+    n : int
+        Number of plays.
+    bands : int
+        Groups wanted.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        Play indices of each group (none when ``bands`` is 0).
+
+    Examples
+    --------
+    >>> [b.tolist() for b in play_bands(5, 2)]
+    [[0, 1, 2], [3, 4]]
+    """
+    return np.array_split(np.arange(n), min(bands, n)) if bands > 0 else []
+
+
+class RateBasis:
+    """The parts of one record's rate columns that do not depend on the filter (each play's
+    contact sign and last contact sample, the band sums of the weighted play outputs);
+    :meth:`columns` builds (and keeps) the columns of one family and filter time constant.
+
+    Parameters
+    ----------
+    Z : numpy.ndarray
+        Play outputs ``z_i[k]``, shape (N, n).
+    radii : array_like
+        Play radii ``r_i`` [input units], ascending.
+    v : numpy.ndarray
+        Input ``v[k]``.
+    dt : float
+        Sample time [s].
+    rate_scale : float
+        Input rate [input units / s] that makes ``rho = 1``.
+    weights : array_like
+        Reference play weights ``w0_i`` of the weight columns.
+    bands : int
+        Bands of plays (one column each).
+    input_range : float, optional
+        The range of the step rule (default ``ptp(v)``).
+
+    Examples
+    --------
+    >>> v = np.r_[np.linspace(0.0, 1.0, 41), 1.0]  # a ramp at 0.025 per sample, then a hold
+    >>> Z = np.maximum(v - 0.5, 0.0)[:, None]  # one play of radius 0.5, pushed from v = 0.5
+    >>> basis = RateBasis(Z, [0.5], v, 1.0, 0.025, [1.0], 1)
+    >>> (basis.columns(0.0, "radius")[[0, 20, 21, 41], 0].round(6) + 0.0).tolist()  # hold: 0
+    [0.0, -0.5, -0.5, 0.0]
+    >>> basis.columns(0.0, "weight")[[0, 20, 21, 41], 0].round(6).tolist()
+    [0.0, 0.0, 0.025, 0.0]
+    """
+
+    def __init__(self, Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
+                 weights, bands: int = RATE_BANDS, *, input_range: float | None = None):
+        self.Z, self.radii = Z, np.asarray(radii, float)
+        self.v, self.dt, self.rate_scale, self.input_range = v, dt, rate_scale, input_range
+        self.bands = play_bands(self.radii.size, bands)
+        self.weights = np.asarray(weights, float)
+        self._starts = [int(g[0]) for g in self.bands]
+        self._contact = None  # (last contact sample, -s_i r_i there), built on first use
+        self._weighted = None  # band sums of w0_i z_i, built on first use
+        self._cache: dict = {}
+
+    def rate(self, tau: float) -> np.ndarray:
+        """The filtered rate ``rho_f`` of the record (:func:`input_rate`).
+
+        Parameters
+        ----------
+        tau : float
+            Time constant of the low-pass [s].
+
+        Returns
+        -------
+        numpy.ndarray
+            ``rho_f[k]`` [-].
+
+        Examples
+        --------
+        >>> v = np.array([0.0, 0.01, 0.02, 0.02])
+        >>> basis = RateBasis(v[:, None], [0.0], v, 1.0, 0.01, [1.0])
+        >>> basis.rate(0.0).tolist(), basis.rate(1.0).round(3).tolist()  # jumps; low-passed
+        ([0.0, 0.0, 0.0, 0.0], [0.0, 0.632, 0.865, 0.318])
+        """
+        return input_rate(self.v, self.dt, self.rate_scale, tau, self.input_range)
+
+    def columns(self, tau: float, family: str) -> np.ndarray:
+        """The columns of ``family`` for the filter ``tau`` (memoised).
+
+        Parameters
+        ----------
+        tau : float
+            Time constant of the low-pass [s].
+        family : {"radius", "weight"}
+            Radii or weights growing with the rate (module docstring).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (N, bands), output units per unit gain; row ``k`` depends on ``v[0..k]``.
+
+        Raises
+        ------
+        ValueError
+            An unknown ``family``.
+
+        Examples
+        --------
+        >>> v = np.array([0.0, 0.01, 0.02, 0.02])
+        >>> basis = RateBasis(v[:, None], [0.0], v, 1.0, 0.01, [2.0], 1)
+        >>> basis.columns(1.0, "weight").round(4).tolist()  # 2 v rho_f
+        [[0.0], [0.0126], [0.0346], [0.0127]]
+        """
+        if family not in RATE_FAMILIES:
+            raise ValueError(f"family: expected one of {RATE_FAMILIES}, got {family!r}")
+        key = (float(tau), family)
+        if key not in self._cache:
+            rho = self.rate(key[0])
+            if family == "weight":
+                if self._weighted is None:
+                    member = np.zeros((self.radii.size, len(self.bands)))
+                    for b, g in enumerate(self.bands):
+                        member[g, b] = self.weights[g]
+                    self._weighted = self.Z @ member
+                self._cache[key] = rho[:, None] * self._weighted
+            else:
+                last, signed = self._contacts()
+                per_play = np.take(rho, last)
+                per_play *= signed
+                self._cache[key] = np.add.reduceat(per_play, self._starts, axis=1)
+        return self._cache[key]
+
+    def _contacts(self):
+        if self._contact is None:
+            r, Z = self.radii, self.Z
+            gap = self.v[:, None] - Z  # +-r_i while play i is in contact
+            contact = np.abs(gap) >= r * (1 - 1e-9)
+            contact &= r > 0
+            k = np.arange(Z.shape[0], dtype=np.int32)[:, None]
+            last = np.maximum.accumulate(np.where(contact, k, np.int32(-1)), axis=0)
+            at = np.maximum(last, 0)
+            signed = np.take_along_axis(gap, at, axis=0)  # -(-s_i r_i) at the last contact
+            signed *= -1.0
+            signed[last < 0] = 0.0
+            self._contact = (at, signed)
+        return self._contact
+
+
+def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,
+                 tau: float, family: str, bands: int = RATE_BANDS, *,
+                 input_range: float | None = None) -> np.ndarray:
+    """The rate candidate's columns of one record (module docstring), for one family and filter.
+
+    Parameters
+    ----------
+    Z : numpy.ndarray
+        Play outputs ``z_i[k]``, shape (N, n).
+    radii : array_like
+        Play radii ``r_i`` [input units], ascending.
+    v : numpy.ndarray
+        Input ``v[k]``.
+    dt : float
+        Sample time [s].
+    rate_scale : float
+        Input rate [input units / s] that makes ``rho = 1``.
+    weights : array_like
+        Reference play weights ``w0_i`` (the weight family).
+    tau : float
+        Time constant of the rate's low-pass [s] (0: none).
+    family : {"radius", "weight"}
+        Radii or weights growing with the rate.
+    bands : int
+        Bands of plays (one column each).
+    input_range : float, optional
+        The range of the step rule (default ``ptp(v)``).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N, min(bands, n)); row ``k`` depends on ``v[0..k]``.
+
+    Examples
+    --------
+    >>> v = np.r_[np.linspace(0.0, 1.0, 41), np.linspace(0.975, 0.0, 40)]  # up and down
+    >>> Z = np.minimum(np.maximum(v - 0.5, 0.0), 0.5)[:, None]  # a play of radius 0.5
+    >>> R = rate_columns(Z, [0.5], v, 1.0, 0.025, [1.0], 0.0, "radius", 1)
+    >>> R[[10, 20, 40, 41, 80], 0].round(6).tolist()  # no contact yet, contact, then held
+    [0.0, -0.5, -0.5, -0.5, -0.5]
+    """
+    return RateBasis(Z, radii, v, dt, rate_scale, weights, bands,
+                     input_range=input_range).columns(tau, family)
