@@ -101,6 +101,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.feedforward",
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",
+    "pimodel.diagnosis.lti",
     "pimodel.diagnosis.where",
     "pimodel.diagnosis.noise",
     "pimodel.diagnosis.plots",

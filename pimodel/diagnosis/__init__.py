@@ -9,6 +9,8 @@ it returns a :class:`DiagnosisReport`. The submodules:
 - :mod:`pimodel.diagnosis.diagnose`: :func:`diagnose` and :class:`DiagnosisReport`;
 - :mod:`pimodel.diagnosis.effects`: the records as segments, the nominal model and the
   candidate effects, each fitted jointly with the hysteresis weights;
+- :mod:`pimodel.diagnosis.lti`: the linear part of the ``dynamics`` candidate (modes, a
+  low-pass, a direct term), its order chosen by the train BIC, and its approximate inverse;
 - :mod:`pimodel.diagnosis.noise`: the measurement-noise floor of the records;
 - :mod:`pimodel.diagnosis.where`: the regions, bands and correlations of the residual;
 - :mod:`pimodel.diagnosis.plots`: the figures of a report;

@@ -16,6 +16,7 @@ from scipy.optimize import minimize
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
+from .lti import describe_lti, lti_columns, lti_k, select_order
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
@@ -473,6 +474,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     the grid optimum, then refitted with every play column."""
     name, k = "+".join(effects), _combo_k(effects)
     static: dict = {}
+    lti_trace: list = []
     # a mode search filters every column at every point: there, the leading columns only
     ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
 
@@ -490,7 +492,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     for e in effects:
         if e == "dynamics":
             fgrid = [f for f in MODE_HZ if f <= fmax] or [fmax]
-            grids.append([{"fn": fixed["fn"], "zeta": fixed["zeta"]}] if "fn" in fixed else
+            grids.append([{"fn": fixed["fn"], "zeta": fixed["zeta"],
+                           "lti": fixed.get("lti", ())}] if "fn" in fixed else
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
@@ -536,10 +539,30 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
+        # the order of the linear part: further modes, a low-pass, a direct term (module lti)
+        p0 = dict(best[0].params)
+
+        def lti_point(fn, zeta, els):
+            return {**p0, "fn": float(fn), "zeta": float(zeta), "lti": tuple(els)}
+
+        def lti_regressors(fn, zeta, els):
+            feats = _combo_features(effects, lti_point(fn, zeta, els), nominal, static, ncols)
+            return [feats(s)[s.used] for s in train], [s.y[s.used] for s in train]
+
+        fn, zeta, elements, lti_trace = select_order(
+            lambda fn, zeta, els: search([lti_point(fn, zeta, els)])[1], lti_regressors,
+            lambda fn, zeta, el: [_lti_block(s, lti_point(fn, zeta, (el,)), nominal,
+                                             static)[s.used, 0] for s in train],
+            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE)
+        if elements:
+            best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
-    model = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[0]
+    model = _fit(name, k + lti_k(p.get("lti", ())),
+                 _combo_features(effects, p, nominal, static), train, p)[0]
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
+    if lti_trace:
+        model.params["dynamics_structures_tried"] = lti_trace
     return model
 
 
@@ -577,11 +600,23 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "delay" in effects:
             Z = shift(Z, p["d"])
         cols = [Z, static_columns(s)]
+        if p.get("lti"):  # the extra elements of the linear part
+            cols.append(_lti_block(s, p, nominal, static))
         if "drift" in effects:
             cols.append((s.t - s.t[0] if p["clock"] == "record" else s.t)[:, None])
         return np.hstack(cols)
 
     return feats
+
+
+def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
+    """The columns ``(E_j - M_1)[h0]`` of the elements ``p["lti"]`` (delayed by ``p["d"]`` when
+    the delay is fitted too); ``h0`` is memoised per segment in ``static``."""
+    key = ("h0", id(s))
+    if key not in static:
+        static[key] = (s, nominal.predict(s))
+    cols = lti_columns(static[key][1], p["fn"], p["zeta"], p["lti"], s.dt)
+    return shift(cols, p["d"]) if "d" in p else cols
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
@@ -659,6 +694,9 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
         out["drift_clock"] = model.params["clock"]
     if "fn" in model.params:
         out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
+        lti = model.params.get("lti", ())
+        out.update(describe_lti(model.params["fn"], model.params["zeta"], lti,
+                                extra[i:i + len(lti)]))
     if "d" in model.params:
         out["delay_samples"] = model.params["d"]
     return out
