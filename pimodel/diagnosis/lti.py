@@ -49,6 +49,7 @@ __all__ = ["MAX_MODES", "element_coefficients", "lti_columns", "lti_k", "describ
            "continuous_zpk", "approximate_inverse", "select_order", "polish_elements"]
 
 MAX_MODES = 3  # modes of the linear part, the base mode included
+BASE_MIN_HZ = 50.0  # the polish keeps the base mode above this (a pole at 1 would be singular)
 EXTRA_MODE_HZ = (200.0, 16)  # lowest frequency [Hz] and size of the extra modes' grid
 EXTRA_DAMPING = (0.02, 0.05, 0.1, 0.2, 0.4)
 LOWPASS_MIN_HZ = 160.0  # a low-pass is faster than 1 ms (the shortest creep lag is 3 ms)
@@ -566,7 +567,7 @@ def polish_elements(cost: Callable, fn: float, zeta: float, elements: tuple, fma
 
     def f(x):
         fn_, z_, els = _unpack(x, elements)
-        if not (fn_ <= fmax and damping_range[0] <= z_ <= damping_range[1] and
+        if not (BASE_MIN_HZ <= fn_ <= fmax and damping_range[0] <= z_ <= damping_range[1] and
                 all(_admissible(e, fmax, damping_range) for e in els)):
             return np.inf
         return cost(fn_, z_, els)
