@@ -539,8 +539,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
-        # the order of the linear part: further modes, a low-pass, a direct term (module lti)
-        p0 = dict(best[0].params)
+    if "dynamics" in effects:
+        # the order of the linear part: further modes, a low-pass, a direct term (module lti);
+        # chosen again beside effects added later (the base mode held, no polish)
+        p0 = {**best[0].params, "lti": ()}
 
         def lti_point(fn, zeta, els):
             return {**p0, "fn": float(fn), "zeta": float(zeta), "lti": tuple(els)}
@@ -553,9 +555,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             lambda fn, zeta, els: search([lti_point(fn, zeta, els)])[1], lti_regressors,
             lambda fn, zeta, el: [_lti_block(s, lti_point(fn, zeta, (el,)), nominal,
                                              static)[s.used, 0] for s in train],
-            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE)
-        if elements:
-            best = search([lti_point(fn, zeta, elements)])
+            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed)
+        best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
     model = _fit(name, k + lti_k(p.get("lti", ())),
                  _combo_features(effects, p, nominal, static), train, p)[0]
@@ -615,7 +616,12 @@ def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     key = ("h0", id(s))
     if key not in static:
         static[key] = (s, nominal.predict(s))
-    cols = lti_columns(static[key][1], p["fn"], p["zeta"], p["lti"], s.dt)
+    h0 = static[key][1]
+    base = static.get(("M1[h0]", id(s)))  # the base mode's response, for the last mode only
+    if base is None or base[0] != (p["fn"], p["zeta"]):
+        base = ((p["fn"], p["zeta"]), mode(h0, p["fn"], p["zeta"], s.dt))
+        static[("M1[h0]", id(s))] = base
+    cols = lti_columns(h0, p["fn"], p["zeta"], p["lti"], s.dt, base=base[1])
     return shift(cols, p["d"]) if "d" in p else cols
 
 

@@ -24,9 +24,11 @@ sum_j g_j c_j[k] + ...``, ``c_j = (E_j - M_1)[h0]``; ``c_j[k]`` depends on ``h0[
 
 The order (number of modes, 1 to ``MAX_MODES``; a low-pass; a direct term) is chosen by forward
 selection: starting from ``M_1`` alone, the element (of each kind the best on a grid, refined)
-that lowers the train BIC ``N ln(RSS / N) + k ln N`` most is added while one does; ``k`` counts
-3 per extra mode (frequency, damping, gain), 2 per low-pass and 1 for the direct term. Then
-every frequency and damping is polished jointly (Nelder-Mead on the train RSS).
+that lowers the train BIC ``N ln(RSS / N) + k ln N`` most is added while one does, at most
+``MAX_ELEMENTS``; ``k`` counts 3 per extra mode (frequency, damping, gain), 2 per low-pass and 1
+for the direct term. After each step every frequency and damping is polished jointly
+(Nelder-Mead on the train RSS), and the step is kept when the polished fit still lowers the BIC
+against the previous structure polished at the same point.
 """
 
 from __future__ import annotations
@@ -37,7 +39,6 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.signal import (
     bilinear_zpk,
-    cont2discrete,
     lfilter,
     lfilter_zi,
     sosfilt,
@@ -49,10 +50,13 @@ __all__ = ["MAX_MODES", "element_coefficients", "lti_columns", "lti_k", "describ
            "continuous_zpk", "approximate_inverse", "select_order", "polish_elements"]
 
 MAX_MODES = 3  # modes of the linear part, the base mode included
+MAX_ELEMENTS = 2  # extra elements at most (each step costs a joint polish)
 BASE_MIN_HZ = 50.0  # the polish keeps the base mode above this (a pole at 1 would be singular)
-EXTRA_MODE_HZ = (200.0, 16)  # lowest frequency [Hz] and size of the extra modes' grid
+EXTRA_MODE_HZ = (300.0, 14)  # lowest frequency [Hz] and size of the extra modes' grid
 EXTRA_DAMPING = (0.02, 0.05, 0.1, 0.2, 0.4)
-LOWPASS_MIN_HZ = 160.0  # a low-pass is faster than 1 ms (the shortest creep lag is 3 ms)
+EXTRA_DAMPING_MAX = 0.5
+MODE_SEPARATION = 1.25  # the modes' frequencies differ by this factor at least
+LOWPASS_MIN_HZ = 300.0  # a low-pass is faster than 0.5 ms (the shortest creep lag is 3 ms)
 LOWPASS_GRID = 10
 ELEMENT_K = {"mode": 3, "lowpass": 2, "direct": 1}  # parameters each element adds
 INVERSE_FILTER = 2.0  # the inverse's low-pass sits at this factor above the fastest pole
@@ -101,11 +105,10 @@ def element_coefficients(element: Sequence, dt: float) -> tuple[np.ndarray, np.n
     if kind == "lowpass":
         a1 = np.exp(-dt / float(element[1]))
         return np.array([0.0, 1.0 - a1]), np.array([1.0, -a1])
-    w = 2 * np.pi * float(element[1])
-    num, den, _ = cont2discrete(([w * w], [1.0, 2 * float(element[2]) * w, w * w]), dt,
-                                method="zoh")
-    b, a = np.ravel(num), np.ravel(den)
-    return b / a[0], a / a[0]
+    from .effects import mode_coefficients  # the base mode's ZOH (closed form); lazy: effects
+    # imports this module
+
+    return mode_coefficients(float(element[1]), float(element[2]), dt)
 
 
 def _at_rest(element, x: np.ndarray, dt: float) -> np.ndarray:
@@ -116,8 +119,8 @@ def _at_rest(element, x: np.ndarray, dt: float) -> np.ndarray:
     return lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])[0]
 
 
-def lti_columns(h0: np.ndarray, fn: float, zeta: float, elements: Sequence,
-                dt: float) -> np.ndarray:
+def lti_columns(h0: np.ndarray, fn: float, zeta: float, elements: Sequence, dt: float, *,
+                base: np.ndarray | None = None) -> np.ndarray:
     """The extra elements' columns ``c_j = (E_j - M_1)[h0]`` (module docstring).
 
     Parameters
@@ -130,6 +133,8 @@ def lti_columns(h0: np.ndarray, fn: float, zeta: float, elements: Sequence,
         The extra elements (module docstring).
     dt : float
         Sample time [s].
+    base : numpy.ndarray, optional
+        ``M_1[h0]`` when already computed.
 
     Returns
     -------
@@ -144,7 +149,8 @@ def lti_columns(h0: np.ndarray, fn: float, zeta: float, elements: Sequence,
     ((2001, 2), True)
     """
     h0 = np.asarray(h0, float)
-    base = _at_rest(("mode", fn, zeta), h0, dt)
+    if base is None:
+        base = _at_rest(("mode", fn, zeta), h0, dt)
     out = np.empty((h0.size, len(elements)))
     for j, el in enumerate(elements):
         out[:, j] = _at_rest(el, h0, dt) - base
@@ -361,19 +367,29 @@ class _Projection:
         return self.rss - rc * rc / s
 
 
-def _admissible(element, fmax: float, damping_range) -> bool:
+def _separated(freqs) -> bool:
+    """Modes at least ``MODE_SEPARATION`` apart in frequency (two close modes with opposite
+    gains act as a derivative that fits any systematic misfit)."""
+    f = np.sort(np.asarray(freqs, float))
+    return bool(np.all(f[1:] >= MODE_SEPARATION * f[:-1]))
+
+
+def _admissible(element, fmax: float, damping_range, modes=()) -> bool:
+    """Within the bounds; a mode also at least ``MODE_SEPARATION`` from the ``modes`` [Hz]."""
     kind = _kind(element)
     if kind == "mode":
-        # an extra mode is not lighter than the grid's lightest: a light mode at a harmonic
-        # of a periodic train input would fit the periodic misfit of the hysteresis
+        # an extra mode is a resonance: not lighter than the grid's lightest (a light mode at a
+        # harmonic of a periodic train input would fit the periodic misfit of the hysteresis),
+        # not heavier than EXTRA_DAMPING_MAX (heavy damping is the low-pass's part)
         return (EXTRA_MODE_HZ[0] <= element[1] <= fmax and
-                max(damping_range[0], EXTRA_DAMPING[0]) <= element[2] <= damping_range[1])
+                max(damping_range[0], EXTRA_DAMPING[0]) <= element[2] <= EXTRA_DAMPING_MAX and
+                _separated([element[1], *modes]))
     if kind == "lowpass":
         return LOWPASS_MIN_HZ <= 1.0 / (2 * np.pi * element[1]) <= fmax
     return True
 
 
-def _refine(rss_of, element, fmax: float, damping_range, maxfev: int = 30):
+def _refine(rss_of, element, fmax: float, damping_range, modes=(), maxfev: int = 30):
     """Local Nelder-Mead refinement of one element's parameters (log scale) on ``rss_of``."""
     kind = _kind(element)
     if kind == "direct":
@@ -386,7 +402,7 @@ def _refine(rss_of, element, fmax: float, damping_range, maxfev: int = 30):
 
     def cost(x):
         el = make(x)
-        return rss_of(el) if _admissible(el, fmax, damping_range) else np.inf
+        return rss_of(el) if _admissible(el, fmax, damping_range, modes) else np.inf
 
     simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(steps)]
     r = minimize(cost, x0, method="Nelder-Mead",
@@ -395,22 +411,27 @@ def _refine(rss_of, element, fmax: float, damping_range, maxfev: int = 30):
 
 
 def _best_addition(blocks: list, ys: list, column: Callable, chosen: tuple, fmax: float,
-                   damping_range) -> tuple | None:
+                   damping_range, base_hz: float) -> tuple | None:
     """The element that lowers the train BIC most when added to ``chosen`` with the base mode
     held (``blocks`` hold the regressors with the chosen elements' columns): of each kind the
     best on its grid, refined; ``(element, rss)`` or None when no kind is left."""
     n = sum(y.size for y in ys)
     proj = _Projection(blocks, ys)
+    modes = [base_hz] + [e[1] for e in chosen if _kind(e) == "mode"]
 
     def rss_of(el):
         return proj.rss_with(column(el))
 
     options = []
+    if len(chosen) >= MAX_ELEMENTS:
+        return None
     if 1 + sum(_kind(e) == "mode" for e in chosen) < MAX_MODES and EXTRA_MODE_HZ[0] < fmax:
         grid = [("mode", float(f), z) for f in np.geomspace(EXTRA_MODE_HZ[0], fmax,
                                                              EXTRA_MODE_HZ[1])
-                for z in EXTRA_DAMPING]
-        options.append(min(((e, rss_of(e)) for e in grid), key=lambda o: o[1]))
+                for z in EXTRA_DAMPING if _admissible(("mode", f, z), fmax, damping_range,
+                                                      modes)]
+        if grid:
+            options.append(min(((e, rss_of(e)) for e in grid), key=lambda o: o[1]))
     if not any(_kind(e) == "lowpass" for e in chosen) and LOWPASS_MIN_HZ < fmax:
         grid = [("lowpass", float(1 / (2 * np.pi * f)))
                 for f in np.geomspace(LOWPASS_MIN_HZ, fmax, LOWPASS_GRID)]
@@ -419,13 +440,13 @@ def _best_addition(blocks: list, ys: list, column: Callable, chosen: tuple, fmax
         options.append((("direct",), rss_of(("direct",))))
     if not options:
         return None
-    options = [_refine(rss_of, e, fmax, damping_range) for e, _ in options]
+    options = [_refine(rss_of, e, fmax, damping_range, modes) for e, _ in options]
     return min(options, key=lambda o: n * np.log(max(o[1], 1e-300)) + lti_k([o[0]]) * np.log(n))
 
 
 def select_order(fit: Callable, regressors: Callable, column: Callable, fn: float, zeta: float,
-                 fmax: float, damping_range: tuple[float, float]) -> tuple[float, float, tuple,
-                                                                          list]:
+                 fmax: float, damping_range: tuple[float, float], *,
+                 polish: bool = True) -> tuple[float, float, tuple, list]:
     """Forward selection of the extra elements by the train BIC (module docstring).
 
     Each step screens every kind of element with the base mode held (a rank-one update of the
@@ -448,6 +469,9 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
         Highest frequency of a mode or a low-pass [Hz].
     damping_range : tuple of float
         Bounds of a mode's damping ratio.
+    polish : bool
+        Polish jointly after each step; False: the base mode is held and each element keeps
+        its screened parameters (a cheaper reselection).
 
     Returns
     -------
@@ -491,18 +515,23 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
     trace = [{"structure": ["mode"], "train_bic": 0.0}]
     while True:
         found = _best_addition(blocks, ys, lambda el, f=fn, z=zeta: column(f, z, el),
-                               elements, fmax, damping_range)
+                               elements, fmax, damping_range, fn)
         if found is None:
             break
         trial = elements + (found[0],)
         k = lti_k(trial)
         if not bic(found[1], k) < current:
             break
-        fn2, zeta2, trial = polish_elements(fit, fn, zeta, trial, fmax, damping_range)
-        score = bic(fit(fn2, zeta2, trial), k)
+        if not polish:
+            fn2, zeta2, score = fn, zeta, bic(found[1], k)
+        else:
+            # to half a BIC unit: an RSS change of rss / n moves n ln(RSS / n) by one
+            fn2, zeta2, trial = polish_elements(fit, fn, zeta, trial, fmax, damping_range,
+                                                fatol=0.5 * found[1] / n)
+            score = bic(fit(fn2, zeta2, trial), k)
         # the polish may improve the elements already chosen as well: credit the new element
         # only with what it adds at the polished point
-        previous = bic(fit(fn2, zeta2, trial[:-1]), lti_k(elements))
+        previous = bic(fit(fn2, zeta2, trial[:-1]), lti_k(elements)) if polish else current
         if previous < current:
             fn, zeta, elements, current = fn2, zeta2, trial[:-1], previous
         if not score < current:
@@ -529,8 +558,8 @@ def _unpack(x, elements) -> tuple[float, float, tuple]:
 
 
 def polish_elements(cost: Callable, fn: float, zeta: float, elements: tuple, fmax: float,
-                    damping_range: tuple[float, float],
-                    maxfev: int = 100) -> tuple[float, float, tuple]:
+                    damping_range: tuple[float, float], maxfev: int = 150,
+                    fatol: float | None = None) -> tuple[float, float, tuple]:
     """Joint Nelder-Mead refinement (log scale) of the base mode and the elements' parameters.
 
     Parameters
@@ -547,6 +576,9 @@ def polish_elements(cost: Callable, fn: float, zeta: float, elements: tuple, fma
         Bounds of a damping ratio.
     maxfev : int
         Most cost evaluations.
+    fatol : float, optional
+        Stop when the costs of the simplex differ by less (and the parameters by less than
+        0.1 %); default ``1e-9`` times the starting cost.
 
     Returns
     -------
@@ -568,7 +600,8 @@ def polish_elements(cost: Callable, fn: float, zeta: float, elements: tuple, fma
     def f(x):
         fn_, z_, els = _unpack(x, elements)
         if not (BASE_MIN_HZ <= fn_ <= fmax and damping_range[0] <= z_ <= damping_range[1] and
-                all(_admissible(e, fmax, damping_range) for e in els)):
+                all(_admissible(e, fmax, damping_range) for e in els) and
+                _separated([fn_] + [e[1] for e in els if _kind(e) == "mode"])):
             return np.inf
         return cost(fn_, z_, els)
 
@@ -579,6 +612,7 @@ def polish_elements(cost: Callable, fn: float, zeta: float, elements: tuple, fma
     simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(steps)]
     f0 = f(x0)
     r = minimize(f, x0, method="Nelder-Mead",
-                 options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-4,
-                          "fatol": 1e-9 * f0 if np.isfinite(f0) else 0.0})
+                 options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-3,
+                          "fatol": (1e-9 * f0 if fatol is None else fatol)
+                          if np.isfinite(f0) else 0.0})
     return _unpack(r.x, elements) if r.fun < f0 else (float(fn), float(zeta), tuple(elements))
