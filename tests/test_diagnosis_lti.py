@@ -77,6 +77,7 @@ def test_approximate_inverse_is_stable_and_inverts_slow_signals(elements, gains)
     assert np.max(err) < (0.02 if gains[-1] > 0 else 0.5)
 
 
+@pytest.mark.slow
 def test_fit_recovers_two_modes_on_a_linear_stage():
     dt = 1e-4
     rng = np.random.default_rng(1)
