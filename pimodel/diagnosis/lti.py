@@ -59,6 +59,10 @@ MODE_SEPARATION = 1.25  # the modes' frequencies differ by this factor at least
 LOWPASS_MIN_HZ = 300.0  # a low-pass is faster than 0.5 ms (the shortest creep lag is 3 ms)
 LOWPASS_GRID = 10
 ELEMENT_K = {"mode": 3, "lowpass": 2, "direct": 1}  # parameters each element adds
+# the kinds the selection tries: a low-pass or a direct term beside the modes imitates a
+# fractional delay (a pure delay of 2.6 samples was taken for dynamics + low-pass), so the
+# selection adds modes only; the forward form and the inverse accept every kind
+SELECTED = ("mode",)
 INVERSE_FILTER = 2.0  # the inverse's low-pass sits at this factor above the fastest pole
 
 
@@ -432,11 +436,12 @@ def _best_addition(blocks: list, ys: list, column: Callable, chosen: tuple, fmax
                                                       modes)]
         if grid:
             options.append(min(((e, rss_of(e)) for e in grid), key=lambda o: o[1]))
-    if not any(_kind(e) == "lowpass" for e in chosen) and LOWPASS_MIN_HZ < fmax:
+    if ("lowpass" in SELECTED and not any(_kind(e) == "lowpass" for e in chosen) and
+            LOWPASS_MIN_HZ < fmax):
         grid = [("lowpass", float(1 / (2 * np.pi * f)))
                 for f in np.geomspace(LOWPASS_MIN_HZ, fmax, LOWPASS_GRID)]
         options.append(min(((e, rss_of(e)) for e in grid), key=lambda o: o[1]))
-    if not any(_kind(e) == "direct" for e in chosen):
+    if "direct" in SELECTED and not any(_kind(e) == "direct" for e in chosen):
         options.append((("direct",), rss_of(("direct",))))
     if not options:
         return None
