@@ -22,13 +22,14 @@ candidate does), so every fit stays linear in its coefficients: ``y[k] = (M_1[Z]
 sum_j g_j c_j[k] + ...``, ``c_j = (E_j - M_1)[h0]``; ``c_j[k]`` depends on ``h0[0..k]`` (on
 ``h0[0..k-1]`` for a mode or a low-pass).
 
-The order (number of modes, 1 to ``MAX_MODES``; a low-pass; a direct term) is chosen by forward
-selection: starting from ``M_1`` alone, the element (of each kind the best on a grid, refined)
-that lowers the train BIC ``N ln(RSS / N) + k ln N`` most is added while one does, at most
-``MAX_ELEMENTS``; ``k`` counts 3 per extra mode (frequency, damping, gain), 2 per low-pass and 1
-for the direct term. After each step every frequency and damping is polished jointly
-(Nelder-Mead on the train RSS), and the step is kept when the polished fit still lowers the BIC
-against the previous structure polished at the same point.
+The order is chosen by forward selection: starting from ``M_1`` alone, the further mode (the
+best on a grid, refined) that lowers the train BIC ``N ln(RSS / N) + k ln N`` is added while one
+does (``k``: 3 per mode: frequency, damping, gain), up to ``MAX_MODES`` modes. The kinds tried
+are ``SELECTED`` (modes only: a low-pass or a direct term beside the modes imitates a
+fractional delay); the form, :func:`lti_columns` and :func:`approximate_inverse` take every
+kind. After each step every frequency and damping is polished jointly (Nelder-Mead on the train
+RSS), and the step is kept when the polished fit still lowers the BIC against the previous
+structure polished at the same point.
 """
 
 from __future__ import annotations
