@@ -103,6 +103,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",
     "pimodel.diagnosis.drift",
+    "pimodel.diagnosis.lti",
     "pimodel.diagnosis.where",
     "pimodel.diagnosis.noise",
     "pimodel.diagnosis.plots",

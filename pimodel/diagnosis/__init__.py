@@ -11,6 +11,8 @@ it returns a :class:`DiagnosisReport`. The submodules:
   candidate effects, each fitted jointly with the hysteresis weights;
 - :mod:`pimodel.diagnosis.rate`: the ``rate`` candidate's columns (play radii and weights
   growing with a low-passed input rate, to first order);
+- :mod:`pimodel.diagnosis.lti`: the linear part of the ``dynamics`` candidate (modes, a
+  low-pass, a direct term), its order chosen by the train BIC, and its approximate inverse;
 - :mod:`pimodel.diagnosis.noise`: the measurement-noise floor of the records;
 - :mod:`pimodel.diagnosis.where`: the regions, bands and correlations of the residual;
 - :mod:`pimodel.diagnosis.plots`: the figures of a report;

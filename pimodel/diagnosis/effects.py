@@ -17,6 +17,7 @@ from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
+from .lti import describe_lti, lti_columns, lti_k, select_order
 from .rate import RATE_BANDS, RATE_FAMILIES, RATE_TAU_REFINE, RATE_TAU_START, RATE_TAUS
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
@@ -492,6 +493,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
     # then left a spurious second effect)
+    lti_trace: list = []
     ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
 
     def search(points, best=None):
@@ -508,7 +510,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     for e in effects:
         if e == "dynamics":
             fgrid = [f for f in MODE_HZ if f <= fmax] or [fmax]
-            grids.append([{"fn": fixed["fn"], "zeta": fixed["zeta"]}] if "fn" in fixed else
+            grids.append([{"fn": fixed["fn"], "zeta": fixed["zeta"],
+                           "lti": fixed.get("lti", ())}] if "fn" in fixed else
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
@@ -579,8 +582,27 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
+    if "dynamics" in effects:
+        # the order of the linear part: further modes, a low-pass, a direct term (module lti);
+        # chosen again beside effects added later (the base mode held, no polish)
+        p0 = {**best[0].params, "lti": ()}
+
+        def lti_point(fn, zeta, els):
+            return {**p0, "fn": float(fn), "zeta": float(zeta), "lti": tuple(els)}
+
+        def lti_regressors(fn, zeta, els):
+            feats = _combo_features(effects, lti_point(fn, zeta, els), nominal, static, ncols)
+            return [feats(s)[s.used] for s in train], [s.y[s.used] for s in train]
+
+        fn, zeta, elements, lti_trace = select_order(
+            lambda fn, zeta, els: search([lti_point(fn, zeta, els)])[1], lti_regressors,
+            lambda fn, zeta, el: [_lti_block(s, lti_point(fn, zeta, (el,)), nominal,
+                                             static)[s.used, 0] for s in train],
+            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed)
+        best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
-    model = _fit(name, k, _combo_features(effects, p, nominal, static), train, p)[0]
+    model = _fit(name, k + lti_k(p.get("lti", ())),
+                 _combo_features(effects, p, nominal, static), train, p)[0]
     if "asymmetry" in effects:
         # the static map acts on the hysteresis output, not on the nominal (which took part
         # of the asymmetry into its weights): rebuild the reference h0 from the hysteresis
@@ -588,11 +610,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         # exponential map, the validate RMS drops 3 to 10 times in two steps)
         for _ in range(ASYMMETRY_ITERATIONS):
             ref = _hysteresis_reference(model, train, nominal)
-            model = _fit(name, k, _combo_features(effects, p, ref, {"train": static["train"]}),
+            model = _fit(name, k + lti_k(p.get("lti", ())),
+                         _combo_features(effects, p, ref, {"train": static["train"]}),
                          train, p)[0]
             model.reference = ref
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
+    if lti_trace:
+        model.params["dynamics_structures_tried"] = lti_trace
     if "drift" in effects and p["clock"] == "levels":
         model.params["drift_t0_train"] = float(train[0].t[0])
         in_train = static["train"]
@@ -653,6 +678,8 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "delay" in effects:
             Z = shift(Z, p["d"])
         cols = [Z, static_columns(s)]
+        if p.get("lti"):  # the extra elements of the linear part
+            cols.append(_lti_block(s, p, nominal, static))
         if "rate" in effects:
             cols.append(s.rate_basis.columns(p["rate_tau"], p["rate_family"]))
         if "drift" in effects:  # the trend column last
@@ -661,6 +688,21 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         return np.hstack(cols)
 
     return feats
+
+
+def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
+    """The columns ``(E_j - M_1)[h0]`` of the elements ``p["lti"]`` (delayed by ``p["d"]`` when
+    the delay is fitted too); ``h0`` is memoised per segment in ``static``."""
+    key = ("h0", id(s))
+    if key not in static:
+        static[key] = (s, nominal.predict(s))
+    h0 = static[key][1]
+    base = static.get(("M1[h0]", id(s)))  # the base mode's response, for the last mode only
+    if base is None or base[0] != (p["fn"], p["zeta"]):
+        base = ((p["fn"], p["zeta"]), mode(h0, p["fn"], p["zeta"], s.dt))
+        static[("M1[h0]", id(s))] = base
+    cols = lti_columns(h0, p["fn"], p["zeta"], p["lti"], s.dt, base=base[1])
+    return shift(cols, p["d"]) if "d" in p else cols
 
 
 def _describe(effects, model: Model, nominal: Model) -> dict:
@@ -688,6 +730,9 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
         out["drift_variant"] = "levels" if clock == "levels" else "trend"
     if "fn" in model.params:
         out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
+        lti = model.params.get("lti", ())
+        out.update(describe_lti(model.params["fn"], model.params["zeta"], lti,
+                                extra[i:i + len(lti)]))
     if "d" in model.params:
         out["delay_samples"] = model.params["d"]
     return out

@@ -12,9 +12,12 @@ effect columns are built from,
          + sum_b g_b R_b[k]                                   rate (radii or weights, .rate)
          + s t_clock[k] (+ c_j)                               drift (record or shared clock;
                                                               or a level c_j per record)
+         + sum_j g_j (D' (E_j - M_1)[h0])[k]                  dynamics: further elements
 
-where ``D`` is the identity, the unit-gain mode (ZOH, ``(D Z)[k]`` depends on ``Z[0..k-1]``)
-and/or a delay of ``d`` samples (fractional: linear interpolation). ``L_i`` is the exact
+where ``D`` is the identity, the unit-gain base mode ``M_1`` (ZOH, ``(D Z)[k]`` depends on
+``Z[0..k-1]``) and/or a delay of ``d`` samples (fractional: linear interpolation); ``D'`` the
+delay alone. ``E_j`` are the further modes, low-pass and direct term of the linear part
+(:mod:`.lti`). ``L_i`` is the exact
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
 ``a = exp(-dt / tau)``. This class evaluates exactly that form, so :meth:`simulate` equals the
 diagnosis' own prediction. The same form, streamed sample by sample on the C core
@@ -36,10 +39,12 @@ Approximations, by choice:
   radius family: open-loop errors 6 to 9 times the nominal's).
 * **delay**: not inverted; the feedforward is advanced by the delay (``y_d[k + d]``, linear
   interpolation): it needs the reference ``d`` samples ahead (a known trajectory).
-* **dynamics**: the mode is replaced by a stable approximate inverse, ``M(s)^-1`` times the
-  low-pass ``1 / (s / (2 w) + 1)^2`` (``w`` the mode's angular frequency), discretised with
-  Tustin, and a one-sample advance for the zero-order hold; the reference is filtered by it,
-  then the static part is inverted.
+* **dynamics**: the linear part ``G`` is replaced by a stable approximate inverse
+  (:func:`.lti.approximate_inverse`): ``G(s)^-1`` with right-half-plane zeros mirrored, times
+  a low-pass ``(s / wf + 1)^-r`` (``r`` the relative degree, ``wf`` twice the fastest pole;
+  for one mode ``M(s)^-1 / (s / (2 w) + 1)^2``), discretised with Tustin, and a one-sample
+  advance for the zero-order hold; the reference is filtered by it, then the static part is
+  inverted.
 * **drift**: not inverted (an additive term in time; compensating it would extrapolate a
   fitted trend), the offset is.
 """
@@ -52,11 +57,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.signal import lfilter, lfilter_zi
 
 from ..operator import PIOperator
 from .drift import drift_term
 from .effects import lag, mode, shift
+from .lti import approximate_inverse, lti_columns
 from .rate import RATE_FAMILIES, STEP_SHARE, play_bands, rate_columns
 
 if TYPE_CHECKING:
@@ -89,7 +94,8 @@ class DiagnosedModel:
         ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
         (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,
         ``drift_t0_train`` for a level per record, :mod:`.drift`);
-        ``mode_hz``, ``mode_damping``; ``delay_samples``.
+        ``mode_hz``, ``mode_damping``, ``lti_elements``, ``lti_gains`` (:mod:`.lti`);
+        ``delay_samples``.
 
     Examples
     --------
@@ -209,6 +215,11 @@ class DiagnosedModel:
             Zp = shift(Zp, p["delay_samples"])
         y = Zp @ self.weights + self.offset
         h0 = Z @ self.reference_weights + self.reference_offset
+        if "dynamics" in e and p.get("lti_elements"):  # the linear part's further elements
+            cols = lti_columns(h0, p["mode_hz"], p["mode_damping"], p["lti_elements"], self.dt)
+            if "delay" in e:
+                cols = shift(cols, p["delay_samples"])
+            y = y + cols @ np.asarray(p["lti_gains"], float)
         if "creep" in e:
             for g, tau in zip(p["creep_lag_gains"], p["creep_time_constants_s"], strict=True):
                 y = y + g * (lag(h0, tau, self.dt) - h0)
@@ -498,7 +509,8 @@ class DiagnosedInverse:
         m, p = self.model, self.model.params
         x = y_d
         if "dynamics" in m.effects:
-            x = _approximate_mode_inverse(x, p["mode_hz"], p["mode_damping"], m.dt)
+            x = approximate_inverse(x, p["mode_hz"], p["mode_damping"],
+                                    p.get("lti_elements", ()), p.get("lti_gains", ()), m.dt)
         if "delay" in m.effects:
             x = _advance(x, float(p["delay_samples"]))
         return x
@@ -538,20 +550,6 @@ class DiagnosedInverse:
         self.model._clock(yd, t)
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
         return _solve(self.model.static_part(), self.prefilter(yd), rng)
-
-
-def _approximate_mode_inverse(x, fn, zeta, dt):
-    """``x`` through ``(s^2 + 2 zeta w s + w^2) / w^2 / (s / (2 w) + 1)^2`` (Tustin), one
-    sample advanced (the ZOH mode's output lags its input by one sample)."""
-    import control
-
-    w = 2 * np.pi * fn
-    wf = 2 * w
-    sys = control.tf([1 / w**2, 2 * zeta / w, 1.0], [1 / wf**2, 2 / wf, 1.0])
-    d = control.sample_system(sys, dt, method="tustin")
-    b, a = np.ravel(d.num[0][0]), np.ravel(d.den[0][0])
-    out = lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])[0]
-    return np.r_[out[1:], out[-1]]
 
 
 def _advance(x, d):

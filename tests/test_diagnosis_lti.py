@@ -1,0 +1,142 @@
+"""The ``dynamics`` candidate's linear part (``pimodel.diagnosis.lti``): its order chosen by the
+train BIC, on records of both generators; its forward form against an independent
+discretisation; its approximate inverse; the diagnosed model simulating what was fitted."""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+from scipy.signal import cont2discrete, lfilter, lfilter_zi, zpk2tf
+
+from pimodel import Record
+from pimodel.diagnosis import diagnose
+from pimodel.diagnosis.effects import fit_effect, make_segment
+from pimodel.diagnosis.lti import (
+    approximate_inverse,
+    continuous_zpk,
+    element_coefficients,
+    lti_columns,
+)
+from pimodel.diagnosis.model import load_diagnosed_model
+from pimodel.truth import excitation, random_truth
+from pimodel.truth_alt import excitations, random_alt_truth
+
+ONE_MODE_SHRINK_TODAY = 0.75  # truth_alt dynamics, seed 0, with the one-mode candidate
+
+
+def _g(x, fn, zeta, elements, gains, dt):
+    """The linear part applied to x, as the diagnosis models it (base mode + columns)."""
+    b, a = element_coefficients(("mode", fn, zeta), dt)
+    base = lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])[0]
+    return base + lti_columns(x, fn, zeta, elements, dt) @ np.asarray(gains, float)
+
+
+def test_forward_equals_the_zoh_of_the_continuous_system():
+    # ZOH discretisation is linear, so the sum of the discretised elements must equal the
+    # discretisation of G(s) built from its zeros and poles
+    fn, zeta, dt = 40.0, 0.1, 1e-3
+    elements, gains = [("mode", 90.0, 0.2), ("lowpass", 2e-3), ("direct",)], [0.3, 0.2, 0.1]
+    z, p, k = continuous_zpk(fn, zeta, elements, gains)
+    num, den = zpk2tf(z, p, k)
+    bd, ad, _ = cont2discrete((num, den), dt, method="zoh")
+    x = np.r_[np.zeros(5), np.ones(2000)]
+    ref = lfilter(np.ravel(bd), ad, x)
+    assert np.max(np.abs(_g(x, fn, zeta, elements, gains, dt) - ref)) < 1e-7
+    assert abs(ref[-1] - 1.0) < 1e-6  # static gain 1
+
+
+def test_one_mode_inverse_equals_the_python_control_form():
+    # M(s)^-1 / (s / (2 w) + 1)^2 built with python-control (the one-mode inverse)
+    fn, zeta, dt = 1200.0, 0.04, 1e-4
+    w = 2 * np.pi * fn
+    d = control.sample_system(control.tf([1 / w**2, 2 * zeta / w, 1.0],
+                                         [1 / (2 * w) ** 2, 1 / w, 1.0]), dt, method="tustin")
+    b, a = np.ravel(d.num[0][0]), np.ravel(d.den[0][0])
+    t = np.arange(3000) * dt
+    x = np.sin(2 * np.pi * 20 * t) + (t > 0.1)
+    ref = lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])[0]
+    ref = np.r_[ref[1:], ref[-1]]
+    assert np.max(np.abs(approximate_inverse(x, fn, zeta, [], [], dt) - ref)) < 1e-9
+
+
+@pytest.mark.parametrize("elements,gains", [
+    ([("mode", 1500.0, 0.1)], [0.25]),  # two modes
+    ([("mode", 1500.0, 0.1), ("lowpass", 1e-4)], [0.25, 0.1]),
+    ([("direct",)], [-0.5]),  # a zero in the right half plane: mirrored, stays stable
+])
+def test_approximate_inverse_is_stable_and_inverts_slow_signals(elements, gains):
+    dt = 1e-4
+    t = np.arange(20000) * dt
+    u = np.sin(2 * np.pi * 5 * t) + 0.3 * np.sin(2 * np.pi * 23 * t)
+    y = _g(u, 600.0, 0.05, elements, gains, dt)
+    u_hat = approximate_inverse(y, 600.0, 0.05, elements, gains, dt)
+    assert np.all(np.isfinite(u_hat)) and np.max(np.abs(u_hat)) < 2 * np.max(np.abs(u))
+    err = np.abs(u_hat - u)[2000:-2]
+    # a minimum-phase G is inverted at 5-23 Hz; the mirrored zero costs phase, not stability
+    assert np.max(err) < (0.02 if gains[-1] > 0 else 0.5)
+
+
+@pytest.mark.slow
+def test_fit_recovers_two_modes_on_a_linear_stage():
+    dt = 1e-4
+    rng = np.random.default_rng(1)
+    levels = rng.uniform(-1, 1, 12)
+    v = np.concatenate([np.full(800, lv) for lv in levels])
+    v = v + 0.3 * np.sin(2 * np.pi * 7 * np.arange(v.size) * dt)
+    h = 2.0 * v
+    y = _g(h, 500.0, 0.08, [("mode", 1300.0, 0.1)], [0.3], dt) + rng.normal(0, 1e-3, v.size)
+    seg = make_segment(np.arange(v.size) * dt, v, y, [0.0, 0.2])
+    m = fit_effect("dynamics", [seg])
+    modes = sorted(m.params["dynamics_modes"], key=lambda d: d["hz"])
+    assert m.params["dynamics_order"] == 2, m.params["dynamics_modes"]
+    assert abs(modes[0]["hz"] / 500.0 - 1) < 0.05 and abs(modes[1]["hz"] / 1300.0 - 1) < 0.05
+    assert abs(modes[1]["share"] - 0.3) < 0.05
+    assert m.k == 2 + 3
+
+
+def _alt(effects, seed):
+    (tt, vt), (tv, vv) = excitations(seed + 1)
+    truth = random_alt_truth(list(effects), seed)
+    rng = np.random.default_rng(3 + seed)
+    return ([Record(tt, vt, truth.simulate(tt, vt, rng), source="alt-train")],
+            [Record(tv, vv, truth.simulate(tv, vv, rng), source="alt-validate")])
+
+
+@pytest.fixture(scope="module")
+def alt_dynamics():
+    train, validate = _alt(["dynamics"], 0)
+    return diagnose(train, validate, initial_state="unknown"), validate[0]
+
+
+def test_two_mode_stage_gets_a_higher_order_and_a_larger_shrink(alt_dynamics):
+    rep, _ = alt_dynamics
+    v = rep.verdict
+    assert v["effects"] == ["dynamics"]
+    assert v["model"]["dynamics_order"] >= 2
+    assert v["shrink"] >= ONE_MODE_SHRINK_TODAY + 0.1
+    cand = next(c for c in rep.candidates if c["effect"] == "dynamics")
+    assert cand["k"] == 2 + sum({"mode": 3, "lowpass": 2, "direct": 1}[e[0]]
+                                for e in v["model"]["lti_elements"])
+
+
+def test_diagnosed_model_simulates_the_fitted_linear_part(alt_dynamics, tmp_path):
+    rep, rec = alt_dynamics
+    aug = rep.model()
+    assert aug.params["lti_elements"]
+    y = aug.simulate(rec.v, rec.t)
+    assert np.max(np.abs(y - rep.after[0])) < 1e-10 * np.ptp(rec.y)
+    again = load_diagnosed_model(aug.save(tmp_path / "m.json"))
+    assert np.array_equal(again.simulate(rec.v, rec.t), y)
+    v_ff = aug.inverse().simulate(y[:3000])
+    assert np.all(np.isfinite(v_ff)) and np.ptp(v_ff) < 2 * np.ptp(rec.v)
+
+
+def test_one_mode_stage_is_not_overfitted():
+    truth = random_truth(["dynamics"], 0)
+    tt, vt = excitation("train", seed=1)
+    tv, vv = excitation("validate", seed=2)
+    v = diagnose([truth.record(tt, vt, 1)], [truth.record(tv, vv, 2)]).verdict
+    assert v["effects"] == ["dynamics"] and v["shrink"] >= 0.9
+    assert v["model"]["dynamics_order"] == 1
+    assert len(v["model"]["lti_elements"]) <= 1
