@@ -118,6 +118,11 @@ class NativeModel:
 
     def __init__(self, model, input_range: float | None = None):
         e, p, r = model.effects, model.params, model.radii
+        if "dynamics" in e and p.get("lti_elements"):
+            raise ValueError(f"params: lti_elements = {list(p['lti_elements'])!r}: the further "
+                             "elements of the dynamics' linear part act on the reference "
+                             "hysteresis h0; the C stream (block, FMU) runs only the base mode "
+                             "or one LTI on the hysteresis term")
         n = r.size
         self.model = model
         self.input_range = float(2 * r[-1] if input_range is None else input_range)
