@@ -199,7 +199,8 @@ class DiagParams(ctypes.Structure):
                 ("c0", c_double), ("m", c_size), ("lag_a", _DP), ("lag_g", _DP),
                 ("asym", c_int), ("q", c_double), ("c3", c_double), ("center", c_double),
                 ("half", c_double), ("rate_w", _DP), ("dt", c_double),
-                ("rate_scale", c_double), ("input_range", c_double), ("order", c_size),
+                ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
+                ("rate_tau", c_double), ("order", c_size),
                 ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
                 ("drift", c_double)]
 

@@ -39,14 +39,19 @@ EFFECT_PARAMS = {
                                                                                   0.3]},
     "asymmetry": {"asymmetry_quadratic": 0.05, "asymmetry_cubic": -0.02, "center": 0.4,
                   "half_range": 1.1},
-    "rate": {"rate_band_gains": [0.3, -0.2, 0.1], "rate_scale": 5.0},
+    "rate": {"rate_gains": [0.3, -0.2, 0.1], "rate_family": "radius",
+             "rate_time_constant_s": 0.0, "rate_scale": 5.0},
     "drift": {"drift_per_s": 0.02, "drift_clock": "record"},
     "dynamics": {"mode_hz": 40.0, "mode_damping": 0.1},
     "delay": {"delay_samples": 3.25},
 }
+# the rate variants beside "rate" (radius family, no filter): family and filter time constant
+RATE_VARIANTS = {"rate_filtered": ("radius", 3e-3), "rate_weight": ("weight", 0.0),
+                 "rate_weight_filtered": ("weight", 3e-3)}
 CASES = {
     "nominal": (),
     **{e: (e,) for e in EFFECT_PARAMS},
+    **{case: ("rate",) for case in RATE_VARIANTS},
     "drift_absolute": ("drift",),
     "delay_whole": ("delay",),
     "all": tuple(EFFECT_PARAMS),
@@ -63,6 +68,8 @@ def model(case: str) -> DiagnosedModel:
         params["drift_clock"] = "absolute"
     if case == "delay_whole":
         params["delay_samples"] = 4
+    if case in RATE_VARIANTS:
+        params["rate_family"], params["rate_time_constant_s"] = RATE_VARIANTS[case]
     return DiagnosedModel(RADII, [1.2, -0.4, 0.8, -0.3, 0.25], 0.3, dt=DT, effects=effects,
                           reference_weights=[1.0, -0.2, 0.7, -0.2, 0.2], reference_offset=0.1,
                           params=params)
@@ -93,10 +100,12 @@ def test_stream_equals_simulate(case):
         assert np.max(np.abs(want - model("nominal").simulate(v, t))) > 1e-3
 
 
-def test_rate_step_rule_and_default_range():
-    """The one-sample jump counts as a step: with a range too small for the rule, every sample
-    is a step and the rate term vanishes; simulate's default range is ptp(v)."""
-    m = model("rate")
+@pytest.mark.parametrize("case", ["rate", "rate_weight"])
+def test_rate_step_rule_and_default_range(case):
+    """Without a filter the one-sample jump counts as a step: with a range too small for the
+    rule, every sample is a step and the rate term vanishes; simulate's default range is
+    ptp(v). With a filter the range is not used."""
+    m = model(case)
     t, v = signal()
     assert np.max(np.abs(stream_simulate(m, v, t, input_range=float(np.ptp(v)))
                          - m.simulate(v, t))) < 1e-12
@@ -104,6 +113,10 @@ def test_rate_step_rule_and_default_range():
     no_rate = replace(m, effects=())
     assert np.max(np.abs(stream_simulate(m, v, t, input_range=tiny)
                          - no_rate.simulate(v, t))) < 1e-12
+    filtered = model(f"{case}_filtered")
+    want = filtered.simulate(v, t)
+    assert np.max(np.abs(stream_simulate(filtered, v, t, input_range=tiny) - want)) < 1e-12
+    assert np.max(np.abs(want - no_rate.simulate(v, t))) > 1e-3
     assert STEP_SHARE == float(re.search(r"#define PIM_DIAG_STEP_SHARE ([\d.]+)", (
         source_dir() / "pim_diagnosed.h").read_text()).group(1))
 
@@ -159,6 +172,36 @@ def test_block_params_and_errors():
         NativeModel(replace(m, params={**m.params, "delay_samples": 5000.0}))
 
 
+@pytest.mark.parametrize(("change", "message"), [
+    ({"rate_time_constant_s": -1e-3}, "rate_tau must be finite and >= 0"),
+    ({"rate_time_constant_s": float("nan")}, "rate_tau must be finite and >= 0"),
+    ({"rate_family": "width"}, "rate_family expected one of"),
+    ({"rate_gains": [0.1] * 6}, "rate_gains: expected 1 to 5 gains"),
+    ({"rate_scale": 0.0}, "rate_scale must be finite and > 0"),
+    ({"rate_band_gains": [0.1]}, "'rate_band_gains' is the rate effect of an earlier version")])
+def test_bad_rate_parameters_are_named(change, message):
+    m = model("rate")
+    with pytest.raises(ValueError, match=re.escape(message)):
+        NativeModel(replace(m, params={**m.params, **change}))
+
+
+def test_rate_state_labels_and_a_family_change_in_the_block():
+    """The rate state: the filtered rate and, radius family, each play's held term; a block's
+    family can not change (another state layout)."""
+    radius, weight = model("rate_filtered"), model("rate_weight_filtered")
+    assert state_labels(radius)[4 + 5:] == ["rho_f", "m[1]", "m[2]", "m[3]", "m[4]", "m[5]"]
+    assert state_labels(weight)[4 + 5:] == ["rho_f"]
+    t, v = signal(300)
+    blk = radius.block(name="twin")
+    with pytest.raises(ValueError, match="state layout changed"):
+        control.input_output_response(blk, t, v, params={"twin.rate_family": "weight"},
+                                      initial_state=initial_state(blk))
+    res = control.input_output_response(blk, t, v, params={"twin.rate_time_constant_s": 0.01},
+                                        initial_state=initial_state(blk))
+    new = replace(radius, params={**radius.params, "rate_time_constant_s": 0.01})
+    assert np.max(np.abs(res.outputs - new.simulate(v, t, input_range=RANGE))) < 1e-12
+
+
 # ---- the FMU unit -------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -180,7 +223,8 @@ def run_unit(path: Path, params: dict, v: np.ndarray, h: float = DT) -> np.ndarr
 
 
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
-@pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "delay_whole", "rate"])
+@pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "delay_whole", "rate",
+                                  *RATE_VARIANTS])
 def test_unit_equals_simulate(fmus, fmi, case):
     """The generic unit with the model's values (FMU time k Ts from 0: the drift clocks read
     t = k Ts)."""
@@ -200,13 +244,37 @@ def test_unit_with_more_than_64_plays(fmus, fmi):
     radii = np.linspace(0, 1.2, n)
     m = DiagnosedModel(radii, rng.normal(0, 1, n), 0.2, dt=DT, effects=("rate", "creep"),
                        reference_weights=rng.normal(0, 1, n), reference_offset=-0.1,
-                       params={**EFFECT_PARAMS["rate"], **EFFECT_PARAMS["creep"]})
+                       params={**EFFECT_PARAMS["rate"], **EFFECT_PARAMS["creep"],
+                               "rate_time_constant_s": 3e-3})
     _, params = unit_parameters(m)
     assert params["p_hi[16]"] == m.weights[79] and "p_hi[17]" not in params
     t, v = signal(800, t0=0.0)
     got = run_unit(fmus / f"DiagnosedModel{'_fmi3' if fmi == '3.0' else ''}.fmu", params, v)
     want = m.simulate(v, t, input_range=2 * radii[-1])
     assert np.max(np.abs(got - want)) < 1e-12 * max(1.0, float(np.max(np.abs(want))))
+
+
+def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
+    """A rate model diagnosed on a ``pimodel.truth`` record (radii growing with the rate, 80
+    signed plays): the C stream on the whole validate record and the FMU unit on its first
+    1500 samples equal simulate to 1e-12 (relative to the output's size)."""
+    from pimodel.diagnosis import diagnose
+    from pimodel.truth import excitation, random_truth
+
+    truth = random_truth(["rate"], 0)
+    rec = truth.record(*excitation("validate", seed=2), 2)
+    rep = diagnose([truth.record(*excitation("train", seed=1), 1)], [rec])
+    m = rep.model()
+    assert m.effects == ("rate",) and np.any(m.params["rate_gains"])
+    rng = 2 * m.radii[-1]
+    want = m.simulate(rec.v, rec.t, input_range=rng)
+    scale = max(1.0, float(np.max(np.abs(want))))
+    assert np.max(np.abs(stream_simulate(m, rec.v, rec.t, input_range=rng) - want)) < 1e-12 * scale
+    rate_term = want - replace(m, effects=()).simulate(rec.v, rec.t)
+    assert np.max(np.abs(rate_term)) > 1e-3 * scale
+    _, params = unit_parameters(m)
+    got = run_unit(fmus / "DiagnosedModel.fmu", params, rec.v[:1500], h=m.dt)
+    assert np.max(np.abs(got - want[:1500])) < 1e-12 * scale
 
 
 @pytest.mark.parametrize(
@@ -222,6 +290,9 @@ def test_unit_with_more_than_64_plays(fmus, fmi):
      ({"n_lags": 65}, "parameter n_lags = 65 out of range"),
      ({"half_range": -1.0}, "parameter half_range = -1: must be finite and > 0"),
      ({"rate_scale": 0.0}, "parameter rate_scale = 0"),
+     ({"rate_family": 2}, "parameter rate_family = 2 out of range: 0 radius, 1 weight"),
+     ({"rate_tau": -0.001}, "parameter rate_tau = -0.001: must be finite and >= 0 s"),
+     ({"rate_tau": float("nan")}, "parameter rate_tau = nan: must be finite and >= 0 s"),
      ({"drift_clock": 3}, "parameter drift_clock = 3 out of range"),
      ({"lti_order": 2, "lti_a[1]": 2.0}, "lti_a[1] = 2: the LTI denominator must be normalised"),
      ({"lti_order": 1, "lti_b[2]": 1.0, "lti_a[2]": -1.0}, "pole at z = 1"),

@@ -53,7 +53,7 @@ VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "gua
       "in_c3": 24, "rate_gain": 40, "p": 100, "r": 200, "r_hat": 300, "n_lags": 52,
       "asymmetry_quadratic": 53, "rate_scale": 57, "drift_clock": 60, "lti_order": 61,
       "delay_samples": 62, "creep_gain": 500, "creep_tau": 600, "rate_band_gain": 700,
-      "lti_b": 800, "lti_a": 900}
+      "lti_b": 800, "lti_a": 900, "rate_family": 63, "rate_tau": 64}
 OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
 TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
 CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
@@ -419,7 +419,11 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
                                                      -1.2, 0.45], 0.0)]
         if rng.random() < 0.5:
             extra += [*set_array(fmi3, VR["rate_band_gain"], [0.1] * m, 0.0),
-                      ["set_real", VR["rate_scale"], _pick_float(rng, 2.0, 0.1 * hostile)]]
+                      ["set_real", VR["rate_scale"], _pick_float(rng, 2.0, 0.1 * hostile)],
+                      ["set_int", VR["rate_family"], rng.choice([0, 1]) if not hostile else
+                       rng.choice([0, 1, 2, -1])],
+                      ["set_real", VR["rate_tau"], _pick_float(rng, rng.choice([0.0, 3e-3]),
+                                                               0.1 * hostile)]]
     acts = init(name, fmi3, n=n, p=p, r=r, Ts=Ts, t0=t0, extra=extra)
     if hostile and rng.random() < 0.2:  # drop or repeat a life-cycle call
         acts.insert(rng.randrange(len(acts) + 1), rng.choice(

@@ -14,9 +14,15 @@ size_t pim_diag_delay_length(double delay)
     return delay > 0.0 ? (size_t)floor(delay) + 2 : 0;
 }
 
+size_t pim_diag_rate_size(const pim_diag *d)
+{
+    if (!d->rate_w) return 0;
+    return d->rate_family == PIM_DIAG_RATE_RADIUS ? 1 + d->n : 1;
+}
+
 size_t pim_diag_state_size(const pim_diag *d)
 {
-    return PIM_DIAG_HEADER + d->n + (d->rate_w ? d->n : 0) + d->m + d->order +
+    return PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
            pim_diag_delay_length(d->delay);
 }
 
@@ -52,7 +58,11 @@ const char *pim_diag_check(const pim_diag *d)
         if (!all_finite(d->rate_w, d->n)) return "a rate band gain is not finite";
         if (!(isfinite(d->rate_scale) && d->rate_scale > 0.0))
             return "rate_scale must be finite and > 0";
-        if (!(isfinite(d->input_range) && d->input_range > 0.0))
+        if (d->rate_family != PIM_DIAG_RATE_RADIUS && d->rate_family != PIM_DIAG_RATE_WEIGHT)
+            return "rate_family must be 0 (radius) or 1 (weight)";
+        if (!(isfinite(d->rate_tau) && d->rate_tau >= 0.0))
+            return "rate_tau must be finite and >= 0 s";
+        if (d->rate_tau == 0.0 && !(isfinite(d->input_range) && d->input_range > 0.0))
             return "input_range must be finite and > 0";
     }
     if (d->order > PIM_DIAG_MAX_ORDER) return "the LTI order is above 63";
@@ -73,28 +83,46 @@ const char *pim_diag_check(const pim_diag *d)
 
 double pim_diag_step(const pim_diag *d, double *x, double v, double t)
 {
-    const size_t n = d->n, nr = d->rate_w ? n : 0, q = d->order;
+    const size_t n = d->n, nr = pim_diag_rate_size(d), q = d->order;
     const size_t nbuf = pim_diag_delay_length(d->delay);
-    double *z = x + PIM_DIAG_HEADER, *mem = z + n, *lag = mem + nr, *s = lag + d->m,
-           *buf = s + q;
+    double *z = x + PIM_DIAG_HEADER, *rate = z + n, *mem = rate + 1, *lag = rate + nr,
+           *s = lag + d->m, *buf = s + q;
+    const int radius = nr && d->rate_family == PIM_DIAG_RATE_RADIUS;
     const int first = x[0] == 0.0;
     if (first) {
         x[1] = v;
         x[2] = t;
     }
-    /* plays, the hysteresis h and the reference h0; rate memory of the plays that moved */
-    double rho = 0.0;
-    if (nr && !first) {
-        const double dv = fabs(v - x[1]);
-        rho = dv <= PIM_DIAG_STEP_SHARE * d->input_range ? dv / d->dt / d->rate_scale : 0.0;
+    /* the filtered rate rho_f[k] (rate.input_rate) */
+    double rho_f = 0.0;
+    if (nr) {
+        double rho = 0.0;
+        if (!first) {
+            const double dv = fabs(v - x[1]);
+            rho = dv / d->dt / d->rate_scale;
+            if (d->rate_tau == 0.0 && !(dv <= PIM_DIAG_STEP_SHARE * d->input_range))
+                rho = 0.0; /* a sampled step */
+        }
+        if (d->rate_tau > 0.0) {
+            const double a = exp(-d->dt / d->rate_tau);
+            rho_f = (1.0 - a) * rho + a * rate[0];
+        } else {
+            rho_f = rho;
+        }
+        rate[0] = rho_f;
     }
+    /* plays, the hysteresis h and the reference h0; the radius family's term of each play in
+     * contact (rate.RateBasis: -(v - z_i) rho_f, held after the contact) */
     double h = 0.0, h0 = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        const double zo = z[i], zn = diag_clamp(zo, v - d->r[i], v + d->r[i]);
+        const double zn = diag_clamp(z[i], v - d->r[i], v + d->r[i]);
         z[i] = zn;
         h += d->w[i] * zn;
         h0 += d->w0[i] * zn;
-        if (nr && !first && zn != zo) mem[i] = zn > zo ? -rho : rho;
+        if (radius && d->r[i] > 0.0) {
+            const double gap = v - zn;
+            if (fabs(gap) >= d->r[i] * (1.0 - 1e-9)) mem[i] = -gap * rho_f;
+        }
     }
     h0 += d->c0;
     /* LTI, transposed direct form II, started at rest around h[0] */
@@ -147,10 +175,14 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         const double u = (h0 - d->center) / d->half;
         y += d->q * (u * u) + d->c3 * (u * u * u);
     }
-    if (nr) {
+    if (radius) {
         double acc = 0.0;
-        for (size_t i = 0; i < n; ++i) acc += d->rate_w[i] * (mem[i] * d->r[i]);
+        for (size_t i = 0; i < n; ++i) acc += d->rate_w[i] * mem[i];
         y += acc;
+    } else if (nr) {
+        double acc = 0.0;
+        for (size_t i = 0; i < n; ++i) acc += d->rate_w[i] * (d->w0[i] * z[i]);
+        y += rho_f * acc;
     }
     if (d->drift_clock == 1)
         y += d->drift * (t - x[2]);

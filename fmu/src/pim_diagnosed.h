@@ -16,18 +16,23 @@
  *            + sum_j g_j (L_j[k] - h0[k])     creep: L_j[k] = a_j L_j[k-1] + (1 - a_j) h0[k],
  *                                                    L_j[-1] = h0[0]
  *            + q u^2 + c3 u^3,  u = (h0[k] - center) / half            asymmetry
- *            + sum_i rw_i r_i m_i[k]                                   rate
+ *            + sum_i g_i m_i[k]                 rate, radius family       (g_i: the gain
+ *            + rho_f[k] sum_i g_i w0_i z_i[k]   or weight family           of play i's band)
  *            + s (t[k] - t[0])  or  s t[k]                              drift (record/absolute)
  *
- * Rate: m_i[k] = -sign(z_i[k] - z_i[k-1]) rho[k] when play i moved at sample k >= 1, else
- * m_i[k-1] (m_i = 0 at the start), with rho[k] = |v[k] - v[k-1]| / dt / rate_scale when
- * |v[k] - v[k-1]| <= PIM_DIAG_STEP_SHARE * input_range, else 0 (a sampled step has no rate).
+ * Rate (pimodel.diagnosis.rate): rho[k] = |v[k] - v[k-1]| / dt / rate_scale (rho[0] = 0);
+ * tau = rate_tau > 0: rho_f[k] = a rho_f[k-1] + (1 - a) rho[k], a = exp(-dt / tau), from
+ * rho_f[-1] = 0; tau = 0: rho_f[k] = rho[k], or 0 when |v[k] - v[k-1]| > PIM_DIAG_STEP_SHARE *
+ * input_range (a sampled step has no rate).  Radius family: m_i[k] = -(v[k] - z_i[k]) rho_f[k]
+ * while play i (r_i > 0) is in contact (|v[k] - z_i[k]| >= r_i (1 - 1e-9)), else m_i[k-1]
+ * (m_i = 0 before its first contact): the term held at the play's last contact.
  * A fractional delay part f <= 1e-12 counts as 0 (as pimodel.diagnosis.effects.shift).
  *
  * State (one flat array of pim_diag_state_size(d) doubles, so that python-control blocks and FMU
- * states hold it as is): [started, v_prev, t_start, head, z[n], m[n_rate], L[m], s[order],
- * buf[nbuf]]; all zero (except z = the initial play states) before the first sample.  `head` is
- * the ring position of x[k-1] in buf (nbuf = floor(d) + 2 when d > 0, else 0).  Units: v and r
+ * states hold it as is): [started, v_prev, t_start, head, z[n], rate[n_rate], L[m], s[order],
+ * buf[nbuf]] with rate = [rho_f[k-1], m[n]] (radius family), [rho_f[k-1]] (weight family) or
+ * none; all zero (except z = the initial play states) before the first sample.  `head` is the
+ * ring position of x[k-1] in buf (nbuf = floor(d) + 2 when d > 0, else 0).  Units: v and r
  * in the input unit, y, c, c0, center, half in the output unit, t in s, s in output unit / s.
  */
 #ifndef PIM_DIAGNOSED_H
@@ -39,13 +44,15 @@
 extern "C" {
 #endif
 
-#define PIM_DIAG_STEP_SHARE 0.05     /* pimodel.diagnosis.effects.STEP_SHARE */
+#define PIM_DIAG_STEP_SHARE 0.05     /* pimodel.diagnosis.rate.STEP_SHARE */
+#define PIM_DIAG_RATE_RADIUS 0       /* rate_family: radii growing with the rate */
+#define PIM_DIAG_RATE_WEIGHT 1       /* rate_family: weights growing with the rate */
 #define PIM_DIAG_MAX_DELAY 4096      /* longest delay line (samples), so d <= 4094 */
 #define PIM_DIAG_MAX_ORDER 63        /* LTI order: b[0..order], a[0..order] in 64 values */
 #define PIM_DIAG_HEADER 4            /* started, v_prev, t_start, head */
 #define PIM_DIAG_MAX_PLAYS (2 * PIM_MAX_PLAYS) /* plays of the FMU unit (a diagnosis: <= 80) */
 #define PIM_DIAG_MAX_LAGS PIM_MAX_PLAYS        /* creep lags of the FMU unit */
-#define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + PIM_DIAG_MAX_LAGS + \
+#define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + 1 + PIM_DIAG_MAX_LAGS + \
                             PIM_DIAG_MAX_ORDER + PIM_DIAG_MAX_DELAY)
 
 typedef struct {
@@ -59,8 +66,10 @@ typedef struct {
     const double *lag_g;   /* gains g_j */
     int asym;              /* 0: no asymmetry term */
     double q, c3, center, half;
-    const double *rate_w;  /* per play band gain rw_i, or NULL: no rate term (n_rate = 0) */
+    const double *rate_w;  /* per play the gain g_i of its band, or NULL: no rate term */
     double dt, rate_scale, input_range;
+    int rate_family;       /* PIM_DIAG_RATE_RADIUS or PIM_DIAG_RATE_WEIGHT */
+    double rate_tau;       /* low-pass time constant of the rate [s], >= 0 (0: none) */
     size_t order;          /* LTI order (0: none) */
     const double *b, *a;   /* b[0..order], a[0..order], a[0] = 1 */
     double delay;          /* d >= 0 [samples] */
@@ -71,14 +80,18 @@ typedef struct {
 /* Length of the flat state of d (the layout above). */
 PIM_API size_t pim_diag_state_size(const pim_diag *d);
 
+/* Length of the rate state: 1 + n (radius family), 1 (weight family) or 0 (no rate). */
+PIM_API size_t pim_diag_rate_size(const pim_diag *d);
+
 /* Delay line length for a delay of `delay` samples: floor(delay) + 2, or 0 for delay == 0. */
 PIM_API size_t pim_diag_delay_length(double delay);
 
 /*
- * NULL when the parameters are valid (finite; radii sorted >= 0; half > 0, rate_scale > 0 and
- * input_range > 0 where used; lags 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state
- * exists; 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2), else a static message naming
- * the first bad one (the FMU adds the value).
+ * NULL when the parameters are valid (finite; radii sorted >= 0; where used: half > 0,
+ * rate_scale > 0, rate_family 0 or 1, rate_tau >= 0, input_range > 0 when rate_tau = 0; lags
+ * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists; 0 <= delay <=
+ * PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2), else a static message naming the first bad one
+ * (the FMU adds the value).
  */
 PIM_API const char *pim_diag_check(const pim_diag *d);
 

@@ -33,7 +33,8 @@
  * type, causality, size) are the one source of truth in C; tests/test_fmu3.py holds every
  * built modelDescription.xml (FMI 2 and 3) equal to unit_vars.  In FMI 2 array element
  * p[i+1] has reference 100 + i (r 200 + i, r_hat 300 + i; DiagnosedModel: w0 400 + i,
- * creep_gain 500 + i, creep_tau 600 + i, rate_band_gain 700 + i, lti_b 800 + i,
+ * creep_gain 500 + i, creep_tau 600 + i, rate_band_gain 700 + i (per play the gain of its
+ * rate band; the rate term is on when one is non-zero), lti_b 800 + i,
  * lti_a 900 + i, and for plays 65..128 p_hi 1000 + i, r_hi 1100 + i, w0_hi 1200 + i,
  * rate_band_gain_hi 1300 + i); in FMI 3 an array is one variable.
  */
@@ -124,6 +125,8 @@ typedef enum {
     vr_drift_clock = 60,
     vr_lti_order = 61,
     vr_delay_samples = 62,
+    vr_rate_family = 63,
+    vr_rate_tau = 64,
     vr_p = 100,
     vr_r = 200,
     vr_r_hat = 300,
@@ -198,7 +201,8 @@ typedef struct {
         drb[PIM_DIAG_MAX_PLAYS];
     double offset, reference_offset, asym_q, asym_c3, center, half_range, rate_scale,
         input_range, drift_per_s, delay_samples;
-    int n_lags, lti_order, drift_clock;
+    int n_lags, lti_order, drift_clock, rate_family;
+    double rate_tau;
     double dstate[PIM_DIAG_STATE_MAX];
 #endif
     char msg[256]; /* reason of the last failure */
@@ -299,6 +303,8 @@ static const pim_var unit_vars[] = {
     {"half_range", vr_half_range, 'R', PIM_PARAMETER, 1, PIM_AT(half_range)},
     {"rate_band_gain", vr_rate_band_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain)},
     {"rate_scale", vr_rate_scale, 'R', PIM_PARAMETER, 1, PIM_AT(rate_scale)},
+    {"rate_family", vr_rate_family, 'I', PIM_PARAMETER, 1, PIM_AT(rate_family)},
+    {"rate_tau", vr_rate_tau, 'R', PIM_PARAMETER, 1, PIM_AT(rate_tau)},
     {"input_range", vr_input_range, 'R', PIM_PARAMETER, 1, PIM_AT(input_range)},
     {"drift_per_s", vr_drift_per_s, 'R', PIM_PARAMETER, 1, PIM_AT(drift_per_s)},
     {"drift_clock", vr_drift_clock, 'I', PIM_PARAMETER, 1, PIM_AT(drift_clock)},
@@ -458,6 +464,8 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->dt = u->Ts;
     d->rate_scale = u->rate_scale;
     d->input_range = u->input_range;
+    d->rate_family = u->rate_family;
+    d->rate_tau = u->rate_tau;
     d->order = (size_t)u->lti_order;
     d->b = u->lti_b;
     d->a = u->lti_a;
@@ -537,6 +545,12 @@ static int unit_check_diag(pim_unit *u)
         return unit_error(u, "parameter half_range = %g: must be finite and > 0", u->half_range);
     if (!isfinite(u->rate_scale) || !(u->rate_scale > 0.0))
         return unit_error(u, "parameter rate_scale = %g: must be finite and > 0", u->rate_scale);
+    if (u->rate_family != PIM_DIAG_RATE_RADIUS && u->rate_family != PIM_DIAG_RATE_WEIGHT)
+        return unit_error(u, "parameter rate_family = %d out of range: 0 radius, 1 weight",
+                          u->rate_family);
+    if (!isfinite(u->rate_tau) || u->rate_tau < 0.0)
+        return unit_error(u, "parameter rate_tau = %g: must be finite and >= 0 s",
+                          u->rate_tau);
     if (!isfinite(u->input_range) || !(u->input_range > 0.0))
         return unit_error(u, "parameter input_range = %g: must be finite and > 0",
                           u->input_range);
@@ -1195,6 +1209,9 @@ static int unit_check_states(pim_unit *u, pim_unit *s)
             return unit_error(u, "FMU state rejected: model state started = %g, head = %g "
                                  "(expected 0 or 1, and 0 <= head < %llu)", x[0], x[3],
                               (unsigned long long)(nbuf ? nbuf : 1));
+        if (pim_diag_rate_size(&d) && x[PIM_DIAG_HEADER + d.n] < 0.0)
+            return unit_error(u, "FMU state rejected: the filtered rate rho_f = %g must be "
+                                 ">= 0", x[PIM_DIAG_HEADER + d.n]);
     }
 #endif
 #if PIM_MODEL == 6

@@ -9,14 +9,16 @@ Discrete-time semantics (those of ``simulate``, written per sample): with the pl
 ``z_i[k-1]`` (at rest at 0 before the first sample) and the input ``v[k]``,
 ``y[k]`` depends on ``v[0..k]`` and ``t[k]`` only; the LTI part (the dynamics) and the delay act
 on the hysteresis term ``sum_i w_i z_i[k]`` and start at rest around its first value; the creep
-lags start at rest around ``h0[0]``; the rate memory of a play is the last rate at which it
-was pushed (a one-sample jump above ``STEP_SHARE * input_range`` counts as a step, no rate).
+lags start at rest around ``h0[0]``; the rate effect (:mod:`.rate`) low-passes the normalised
+input rate from rest at 0 (without a filter, a one-sample jump above ``STEP_SHARE *
+input_range`` counts as a step, no rate); the radius family holds each play's term from its
+last contact, the weight family scales the band's ``sum_i w0_i z_i[k]`` by the current rate.
 
 Two things ``simulate`` takes from the whole record are parameters here:
 
-* ``input_range`` (the rate effect's step rule): ``simulate`` defaults to ``ptp(v)``, the block
-  and the FMU to ``2 r_n`` (the diagnosis' grid span, as :meth:`DiagnosedInverse.simulate`);
-  pass the same value to compare.
+* ``input_range`` (the rate effect's step rule, used without a filter only): ``simulate``
+  defaults to ``ptp(v)``, the block and the FMU to ``2 r_n`` (the diagnosis' grid span, as
+  :meth:`DiagnosedInverse.simulate`); pass the same value to compare.
 * the drift clock: ``"record"`` counts from the first sample (``t[k] - t[0]``), ``"absolute"``
   uses ``t[k]`` as given; in a python-control block ``t[k]`` is python-control's time, in the
   FMU ``k Ts`` (its sample instants).
@@ -38,6 +40,7 @@ from .. import _native
 from ..blocks import _Block, _labels, _Settings
 from ..fmu.build import NMAX
 from .effects import mode_coefficients
+from .rate import RATE_FAMILIES, play_bands
 
 __all__ = ["NativeModel", "diagnosed_block", "fmu_parameters", "state_labels",
            "stream_simulate"]
@@ -82,11 +85,13 @@ def lti_coefficients(model) -> tuple[np.ndarray, np.ndarray] | None:
     return mode_coefficients(p["mode_hz"], p["mode_damping"], model.dt)
 
 
-def _band_gains(gains, n: int) -> np.ndarray:
-    """Per play, the gain of its rate band (the diagnosis' ``np.array_split`` groups)."""
-    gains = np.asarray(gains, float)
+def _band_gains(gains: np.ndarray, n: int) -> np.ndarray:
+    """Per play, the gain of its rate band (:func:`.rate.play_bands`, as ``simulate``)."""
+    if gains.ndim != 1 or not 1 <= gains.size <= n:
+        raise ValueError(f"params: rate_gains: expected 1 to {n} gains (one per band of the "
+                         f"{n} plays), got shape {gains.shape}")
     out = np.empty(n)
-    for g, idx in zip(gains, np.array_split(np.arange(n), min(gains.size, n)), strict=True):
+    for g, idx in zip(gains, play_bands(n, gains.size), strict=True):
         out[idx] = g
     return out
 
@@ -104,8 +109,9 @@ class NativeModel:
     Raises
     ------
     ValueError
-        A parameter the C core refuses (named), more than 64 play columns in a rate model, an
-        LTI order above 63 or a delay above 4094 samples.
+        A parameter the C core refuses (named), rate parameters of an earlier version
+        (``rate_band_gains``) or more rate gains than plays, an LTI order above 63 or a delay
+        above 4094 samples.
 
     Examples
     --------
@@ -117,6 +123,8 @@ class NativeModel:
     """
 
     def __init__(self, model, input_range: float | None = None):
+        from .model import _rate_params
+
         e, p, r = model.effects, model.params, model.radii
         if "dynamics" in e and p.get("lti_elements"):
             raise ValueError(f"params: lti_elements = {list(p['lti_elements'])!r}: the further "
@@ -141,7 +149,9 @@ class NativeModel:
             d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
             d.center, d.half = p["center"], p["half_range"]
         if "rate" in e:
-            keep["rate_w"] = _band_gains(p["rate_band_gains"], n)
+            gains, family, tau = _rate_params(p)
+            keep["rate_w"] = _band_gains(gains, n)
+            d.rate_family, d.rate_tau = RATE_FAMILIES.index(family), tau
             d.rate_scale, d.input_range = p["rate_scale"], self.input_range
         lti = lti_coefficients(model)
         if lti is not None:
@@ -296,7 +306,9 @@ def state_labels(model) -> list[str]:
     -------
     list of str
         ``started``, ``v_prev``, ``t_start``, ``head`` (delay line position), ``z[1..n]`` (play
-        states), ``m[1..n]`` (rate memory, with a rate effect), ``L[1..m]`` (creep lags),
+        states), ``rho_f`` (filtered rate of the last sample, with a rate effect) and
+        ``m[1..n]`` (the radius family's terms held from each play's last contact),
+        ``L[1..m]`` (creep lags),
         ``s[1..q]`` (LTI states), ``x_delay[1..nbuf]`` (delay line).
 
     Examples
@@ -308,8 +320,11 @@ def state_labels(model) -> list[str]:
     d = NativeModel(model).params
     n = model.radii.size
     nbuf = int(math.floor(d.delay)) + 2 if d.delay > 0 else 0
+    rate = []
+    if d.rate_w:
+        rate = ["rho_f"] + (_labels("m", n) if d.rate_family == 0 else [])
     return (["started", "v_prev", "t_start", "head"] + _labels("z", n)
-            + (_labels("m", n) if d.rate_w else []) + _labels("L", d.m)
+            + rate + _labels("L", d.m)
             + _labels("s", d.order) + _labels("x_delay", nbuf))
 
 
@@ -453,7 +468,8 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})
     if "rate_w" in k:
-        out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale})
+        out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
+                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
     if d.order:
         out.update({"lti_order": int(d.order), **arr("lti_b", k["b"]), **arr("lti_a", k["a"])})
     if d.delay:

@@ -291,11 +291,18 @@ MODELS: dict[str, dict] = {
                  Var("center", 55, "Real", "parameter", "0", "asymmetry center (output unit)"),
                  Var("half_range", 56, "Real", "parameter", "1", "asymmetry half range (> 0)"),
                  *_arrays("rate_band_gain", 700, "parameter", "0",
-                          "rate band gain (0: no rate term), play"),
+                          "rate gain of the play's band (all 0: no rate term), play"),
                  Var("rate_scale", 57, "Real", "parameter", "1",
                      "input rate [input unit / s] of rho = 1 (> 0)"),
+                 Var("rate_family", 63, "Integer", "parameter", "0",
+                     "rate family: 0 radius (terms held from each play's last contact), "
+                     "1 weight (rho_f times the band's sum of w0 z)"),
+                 Var("rate_tau", 64, "Real", "parameter", "0",
+                     "low-pass time constant of the normalised input rate [s] (>= 0; "
+                     "0: none, with the step rule)"),
                  Var("input_range", 58, "Real", "parameter", "1",
-                     "input range of the step rule: a jump above 5 % of it has no rate (> 0)"),
+                     "input range of the step rule (rate_tau = 0): a jump above 5 % of it "
+                     "has no rate (> 0)"),
                  Var("drift_per_s", 59, "Real", "parameter", "0", "drift [output unit / s]"),
                  Var("drift_clock", 60, "Integer", "parameter", "0",
                      "drift clock: 0 none, 1 record (t - t_start), 2 absolute (t = k Ts)"),
