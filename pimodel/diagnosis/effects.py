@@ -576,9 +576,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                         train, p)[1]
 
         x0 = np.log([base["fn"], base["zeta"]])
-        r = minimize(cost, x0, method="Nelder-Mead", options={
-            "initial_simplex": [x0, x0 + [0.03, 0], x0 + [0, 0.2]], "xatol": 1e-4,
-            "fatol": 1e-9 * best[1], "maxfev": 60})
+        with np.errstate(invalid="ignore"):  # inf - inf at inadmissible vertices
+            r = minimize(cost, x0, method="Nelder-Mead", options={
+                "initial_simplex": [x0, x0 + [0.03, 0], x0 + [0, 0.2]], "xatol": 1e-4,
+                "fatol": 1e-9 * best[1], "maxfev": 60})
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)

@@ -410,8 +410,9 @@ def _refine(rss_of, element, fmax: float, damping_range, modes=(), maxfev: int =
         return rss_of(el) if _admissible(el, fmax, damping_range, modes) else np.inf
 
     simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(steps)]
-    r = minimize(cost, x0, method="Nelder-Mead",
-                 options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-3})
+    with np.errstate(invalid="ignore"):  # inf - inf at inadmissible vertices
+        r = minimize(cost, x0, method="Nelder-Mead",
+                     options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-3})
     return make(r.x), float(r.fun)
 
 
@@ -617,8 +618,9 @@ def polish_elements(cost: Callable, fn: float, zeta: float, elements: tuple, fma
             steps[2 + sum(len(q) - 1 for q in elements[:i])] = 0.03
     simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(steps)]
     f0 = f(x0)
-    r = minimize(f, x0, method="Nelder-Mead",
-                 options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-3,
-                          "fatol": (1e-9 * f0 if fatol is None else fatol)
-                          if np.isfinite(f0) else 0.0})
+    with np.errstate(invalid="ignore"):  # inf - inf at inadmissible vertices
+        r = minimize(f, x0, method="Nelder-Mead",
+                     options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-3,
+                              "fatol": (1e-9 * f0 if fatol is None else fatol)
+                              if np.isfinite(f0) else 0.0})
     return _unpack(r.x, elements) if r.fun < f0 else (float(fn), float(zeta), tuple(elements))
