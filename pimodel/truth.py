@@ -225,7 +225,7 @@ def creep_lag_filters(percent_per_decade: float, dt: float) -> list[tuple[np.nda
     so the lags act from the next sample. Run in parallel, these are the ZOH transfer function
     ``1 + sum_i g_i (1 - a_i) / (z - a_i)`` of ``creep_per_decade``; multiplied out into one
     polynomial of degree 4 in ``z`` (poles between 0.99 and 0.99999 at 10 kHz) they lose most
-    of their digits (measured in ``docs/notes/creep-discretization.md``).
+    of their digits (measured in ``docs/design-notes.md``).
 
     Parameters
     ----------

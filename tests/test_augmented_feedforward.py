@@ -30,7 +30,8 @@ def _case(generator: str, effect: str, seed: int):
                                          "augmented": rep.model()})
 
 
-# measured figures: docs/notes/i19c.md; two truth_alt creep seeds miss the target (xfail;
+# measured figures: docs/studies.md (augmented_feedforward); two truth_alt creep seeds miss
+# the target (xfail;
 # strict where the miss is clear, so a fix shows)
 @pytest.mark.slow
 @pytest.mark.parametrize("generator,effect,seed", [

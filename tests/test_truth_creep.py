@@ -1,6 +1,6 @@
 """The truth's creep is the exact zero-order-hold discretisation of its four lags at 10 kHz:
 the step response equals the analytic lag sum and tiny input changes stay tiny (the former
-single polynomial transfer function failed both, docs/notes/creep-discretization.md)."""
+single polynomial transfer function failed both, docs/design-notes.md)."""
 
 import numpy as np
 import pytest
