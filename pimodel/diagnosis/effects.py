@@ -12,12 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize, minimize_scalar
+from scipy.optimize import minimize_scalar
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from ..operator import PIOperator
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
-from .lti import describe_lti, lti_columns, lti_k, select_order
+from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import RATE_BANDS, RATE_FAMILIES, RATE_TAU_REFINE, RATE_TAU_START, RATE_TAUS
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
@@ -576,10 +576,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                         train, p)[1]
 
         x0 = np.log([base["fn"], base["zeta"]])
-        with np.errstate(invalid="ignore"):  # inf - inf at inadmissible vertices
-            r = minimize(cost, x0, method="Nelder-Mead", options={
-                "initial_simplex": [x0, x0 + [0.03, 0], x0 + [0, 0.2]], "xatol": 1e-4,
-                "fatol": 1e-9 * best[1], "maxfev": 60})
+        r = nelder_mead(cost, x0, initial_simplex=[x0, x0 + [0.03, 0], x0 + [0, 0.2]],
+                        xatol=1e-4, fatol=1e-9 * best[1], maxfev=60)
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
@@ -602,8 +600,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed)
         best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
-    model = _fit(name, k + lti_k(p.get("lti", ())),
-                 _combo_features(effects, p, nominal, static), train, p)[0]
+    k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too
+    model = _fit(name, k_all, _combo_features(effects, p, nominal, static), train, p)[0]
     if "asymmetry" in effects:
         # the static map acts on the hysteresis output, not on the nominal (which took part
         # of the asymmetry into its weights): rebuild the reference h0 from the hysteresis
@@ -611,8 +609,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         # exponential map, the validate RMS drops 3 to 10 times in two steps)
         for _ in range(ASYMMETRY_ITERATIONS):
             ref = _hysteresis_reference(model, train, nominal)
-            model = _fit(name, k + lti_k(p.get("lti", ())),
-                         _combo_features(effects, p, ref, {"train": static["train"]}),
+            model = _fit(name, k_all, _combo_features(effects, p, ref, {"train": static["train"]}),
                          train, p)[0]
             model.reference = ref
     model.grid = dict(model.params)

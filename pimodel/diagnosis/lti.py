@@ -48,7 +48,8 @@ from scipy.signal import (
 )
 
 __all__ = ["MAX_MODES", "element_coefficients", "lti_columns", "lti_k", "describe_lti",
-           "continuous_zpk", "approximate_inverse", "select_order", "polish_elements"]
+           "continuous_zpk", "approximate_inverse", "select_order", "polish_elements",
+           "nelder_mead"]
 
 MAX_MODES = 3  # modes of the linear part, the base mode included
 MAX_ELEMENTS = 2  # extra elements at most (each step costs a joint polish)
@@ -66,6 +67,36 @@ ELEMENT_K = {"mode": 3, "lowpass": 2, "direct": 1}  # parameters each element ad
 SELECTED = ("mode",)
 INVERSE_FILTER = 2.0  # the inverse's low-pass sits at this factor above the fastest pole
 
+
+
+def nelder_mead(cost: Callable, x0: np.ndarray, **options):
+    """``scipy.optimize.minimize(cost, x0, method="Nelder-Mead", options=options)`` with NumPy's
+    invalid-value warnings off: the costs here are ``inf`` at inadmissible points, and SciPy's
+    convergence test then computes ``inf - inf``.
+
+    Parameters
+    ----------
+    cost : callable
+        ``cost(x) -> float`` (``inf`` where ``x`` is not admissible).
+    x0 : numpy.ndarray
+        Start point.
+    **options
+        Nelder-Mead options (``initial_simplex``, ``maxfev``, ``xatol``, ``fatol``).
+
+    Returns
+    -------
+    scipy.optimize.OptimizeResult
+        SciPy's result (``x``, ``fun``).
+
+    Examples
+    --------
+    >>> r = nelder_mead(lambda x: float((x[0] - 2.0) ** 2) if x[0] < 5 else np.inf,
+    ...                 np.array([0.0]), xatol=1e-8, fatol=1e-12)
+    >>> round(float(r.x[0]), 4)
+    2.0
+    """
+    with np.errstate(invalid="ignore"):
+        return minimize(cost, x0, method="Nelder-Mead", options=options)
 
 def _kind(element) -> str:
     kind = element[0]
@@ -410,9 +441,7 @@ def _refine(rss_of, element, fmax: float, damping_range, modes=(), maxfev: int =
         return rss_of(el) if _admissible(el, fmax, damping_range, modes) else np.inf
 
     simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(steps)]
-    with np.errstate(invalid="ignore"):  # inf - inf at inadmissible vertices
-        r = minimize(cost, x0, method="Nelder-Mead",
-                     options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-3})
+    r = nelder_mead(cost, x0, initial_simplex=simplex, maxfev=maxfev, xatol=1e-3)
     return make(r.x), float(r.fun)
 
 
@@ -618,9 +647,6 @@ def polish_elements(cost: Callable, fn: float, zeta: float, elements: tuple, fma
             steps[2 + sum(len(q) - 1 for q in elements[:i])] = 0.03
     simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(steps)]
     f0 = f(x0)
-    with np.errstate(invalid="ignore"):  # inf - inf at inadmissible vertices
-        r = minimize(f, x0, method="Nelder-Mead",
-                     options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": 1e-3,
-                              "fatol": (1e-9 * f0 if fatol is None else fatol)
-                              if np.isfinite(f0) else 0.0})
+    r = nelder_mead(f, x0, initial_simplex=simplex, maxfev=maxfev, xatol=1e-3,
+                    fatol=(1e-9 * f0 if fatol is None else fatol) if np.isfinite(f0) else 0.0)
     return _unpack(r.x, elements) if r.fun < f0 else (float(fn), float(zeta), tuple(elements))
