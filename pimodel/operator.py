@@ -50,7 +50,8 @@ def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarr
         )
     if np.any(r < 0):
         i = int(np.flatnonzero(r < 0)[0])
-        raise ValueError(f"radii: radius {i} is {float(r[i])!r}; radii must be >= 0")
+        raise ValueError(f"radii: radius {i + 1} (counted from 1) is {float(r[i])!r}; "
+                         "radii must be >= 0")
     if signed_weights:
         P = np.cumsum(p)
         if np.any(P <= 0):
@@ -61,7 +62,8 @@ def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarr
             )
     elif np.any(p <= 0):
         i = int(np.flatnonzero(p <= 0)[0])
-        raise ValueError(f"weights: weight {i} is {float(p[i])!r}; weights must be > 0")
+        raise ValueError(f"weights: weight {i + 1} (counted from 1) is {float(p[i])!r}; "
+                         "weights must be > 0")
     return p, r
 
 

@@ -247,7 +247,7 @@ def test_params_are_checked_by_name():
     t = np.arange(3) * 1e-3
     with pytest.raises(ValueError, match=r"unknown setting\(s\) \['plant.radius'\]"):
         control.input_output_response(pb, t, t, params={"plant.radius": [0, 1, 2, 3]})
-    with pytest.raises(ValueError, match="block 'plant'.*radius 1 is -0.1"):
+    with pytest.raises(ValueError, match="block 'plant'.*radius 2 .counted from 1. is -0.1"):
         control.input_output_response(pb, t, t, params={"plant.radii": [0, -0.1, 0.2, 0.3]})
     with pytest.raises(ValueError, match="weights: expected 4 plays"):
         control.input_output_response(pb, t, t, params={"plant.radii": [0, 0.1],

@@ -11,11 +11,11 @@ from pimodel import PIOperator, TimeDependentPI
 @pytest.mark.parametrize(
     ("weights", "radii", "match"),
     [
-        ([1, 1], [0, -0.1], "radii: radius 1 is -0.1"),
+        ([1, 1], [0, -0.1], "radii: radius 2 \\(counted from 1\\) is -0.1"),
         ([1, 1], [0, np.nan], "radii: sample 1 is nan"),
         ([1, 1], [0, np.inf], "radii: sample 1 is inf"),
-        ([1, 0], [0, 1], "weights: weight 1 is 0"),
-        ([1, -2], [0, 1], "weights: weight 1 is -2"),
+        ([1, 0], [0, 1], "weights: weight 2 \\(counted from 1\\) is 0"),
+        ([1, -2], [0, 1], "weights: weight 2 \\(counted from 1\\) is -2"),
         ([1, 2, 3], [0, 1], "same length, got 3 weights and 2 radii"),
         ([], [], "weights: expected at least 1"),
         ([[1, 2]], [[0, 1]], "expected a 1-D array"),

@@ -42,7 +42,7 @@ def test_generalized_errors():
         op.simulate([np.nan])
     with pytest.raises(TypeError, match="input_envelope: expected a pimodel.envelopes.Envelope"):
         GeneralizedPI([1.0], [0.0], input_envelope=np.tanh)
-    with pytest.raises(ValueError, match="radii: radius 1 is -0.1"):
+    with pytest.raises(ValueError, match=r"radii: radius 2 \(counted from 1\) is -0.1"):
         GeneralizedPI([1.0, 1.0], [0.0, -0.1])
     with pytest.raises(ValueError, match="smallest radius is 0.1"):
         GeneralizedPI([1.0], [0.1]).inverse()
