@@ -32,7 +32,11 @@ case "$cmd" in
         exec .venv/bin/pimodel demo "$@" ;;
     test)
         .venv/bin/ruff check .
-        exec .venv/bin/python -m pytest -q "$@" ;;
+        # one pytest worker per core, at most 4 (pytest-xdist); a test file stays on one worker
+        # so its module fixtures are built once. PIMODEL_TEST_WORKERS=0 runs in this process.
+        workers=${PIMODEL_TEST_WORKERS:-$(nproc 2>/dev/null || echo 1)}
+        [ "$workers" -gt 4 ] && workers=4
+        exec .venv/bin/python -m pytest -q -n "$workers" --dist loadfile "$@" ;;
     *)
         echo "usage: bash quickstart.sh {demo|test} [args...]" >&2; exit 2 ;;
 esac
