@@ -46,7 +46,12 @@ DEFAULT_MEMORY_LIMIT = "2GiB"
 # case's working arrays (up to 16 MiB) on the heap; memory still returns to the system above
 # 64 MiB of free heap top. glibc reads them once, at process start, so they must go into the
 # nanny's *pre-spawn* environment (``distributed.nanny.pre-spawn-environ``); LocalCluster's
-# ``env=`` is applied after the worker started and has no effect on them.
+# ``env=`` is applied after the worker started and has no effect on them. The nanny also prefers
+# a variable already in the parent's ``os.environ`` to that config, and writes its pre-spawn
+# environment into the parent's ``os.environ`` for good: after any earlier Dask cluster in the
+# process (Dask's default 65536 is then in ``os.environ``) the config alone is ignored. So the
+# local cluster is started with WORKER_ENV in ``os.environ`` too, and the parent's own values
+# are put back afterwards.
 WORKER_ENV = {"MALLOC_MMAP_THRESHOLD_": str(16 * 2**20), "MALLOC_TRIM_THRESHOLD_": str(64 * 2**20)}
 
 __all__ = ["CaseFailed", "DEFAULT_MEMORY_LIMIT", "WORKER_ENV", "available_cores", "case_key",
@@ -342,10 +347,19 @@ def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory
     if scheduler is None:
         # processes, one thread each: the Python glue of a case holds the GIL
         spawn_env = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), **WORKER_ENV}
-        with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn_env}):
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   memory_limit=memory_limit, dashboard_address=None,
-                                   silence_logs=logging.ERROR)
+        saved = {k: os.environ.get(k) for k in WORKER_ENV}
+        os.environ.update(WORKER_ENV)
+        try:
+            with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn_env}):
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                       memory_limit=memory_limit, dashboard_address=None,
+                                       silence_logs=logging.ERROR)
+        finally:
+            for k, old in saved.items():
+                if old is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = old
     client = Client(cluster if cluster is not None else scheduler)
     try:
         run = partial(_call_case, func)

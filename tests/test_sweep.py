@@ -304,12 +304,20 @@ def _start_environment(params: dict) -> dict:
 
 @pytest.mark.slow
 @pytest.mark.skipif(not Path("/proc/self/environ").exists(), reason="needs Linux /proc")
-def test_local_workers_start_with_the_malloc_settings(tmp_path):
+@pytest.mark.parametrize("parent_trim", [None, "65536"])
+def test_local_workers_start_with_the_malloc_settings(monkeypatch, parent_trim):
     """Dask's default MALLOC_TRIM_THRESHOLD_=65536 switches off glibc's dynamic mmap threshold
     (a case spent as much CPU in page faults as in its own code); the local cluster's workers
-    must be *started* with WORKER_ENV, not get it after start."""
+    must be *started* with WORKER_ENV, not get it after start, also when an earlier Dask
+    cluster left Dask's default in the parent's environment (the nanny prefers it to the
+    config); the parent's own value is put back."""
     import cloudpickle
 
+    if parent_trim is None:
+        monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
+    else:
+        monkeypatch.setenv("MALLOC_TRIM_THRESHOLD_", parent_trim)
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
     got = run_cases(_start_environment, [{"i": 0}, {"i": 1}], workers=2, progress=False)
     assert got == [WORKER_ENV, WORKER_ENV]
+    assert os.environ.get("MALLOC_TRIM_THRESHOLD_") == parent_trim
