@@ -205,7 +205,7 @@ class StaticInverse:
         --------
         >>> from pimodel.diagnosis.model import DiagnosedModel
         >>> inv = StaticInverse(DiagnosedModel([0.0], [2.0], 0.0, dt=1e-3))
-        >>> inv.step(inv.initial_state(), 1.0)
+        >>> round(inv.step(inv.initial_state(), 1.0), 12)
         0.5
         """
         m, p, r, w, w0, n = self.model, self.model.params, self.r, self.w, self.w0, self.n
