@@ -223,3 +223,16 @@ def test_cli_builds_a_multi_mode_fmu_that_validates_and_runs_in_the_masters(tmp_
                          timeout=120)
     assert chk.returncode == 0 and f"No semantic error against the FMI-{fmi[0]}" in \
         chk.stdout + chk.stderr, chk.stdout + chk.stderr
+
+
+def test_block_of_a_model_with_report_parameters():
+    """A diagnosed model's params also hold the report's plain data (``dynamics_modes``, a list
+    of dicts; ``dynamics_order``): the block keeps them as settings and still equals simulate."""
+    m = model("two_modes")
+    m = replace(m, params={**m.params, "dynamics_order": 2,
+                           "dynamics_modes": [{"hz": 40.0, "damping": 0.1, "share": 0.7},
+                                              {"hz": 130.0, "damping": 0.05, "share": 0.3}]})
+    t, v = signal(300)
+    blk = m.block()
+    res = control.input_output_response(blk, t, v, initial_state=initial_state(blk))
+    assert np.max(np.abs(res.outputs - m.simulate(v, t))) < 1e-12

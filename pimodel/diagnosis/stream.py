@@ -409,6 +409,19 @@ def state_labels(model) -> list[str]:
             + _labels("x_delay", nbuf))
 
 
+def _block_setting(value):
+    """A model parameter as a block setting: numeric lists stay lists (arrays in params); other
+    lists (``lti_elements``: kinds and numbers; a report's ``dynamics_modes``: dicts) become
+    tuples, which the block's settings keep as they are."""
+    if not isinstance(value, list):
+        return value
+    try:
+        np.asarray(value, dtype=float)
+        return value
+    except (TypeError, ValueError):
+        return tuple(tuple(x) if isinstance(x, list) else x for x in value)
+
+
 def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
                     input: str = "v", output: str = "y",
                     input_range: float | None = None) -> control.NonlinearIOSystem:
@@ -477,10 +490,7 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
                              f"{len(labels)}): build a new block for this model")
         return nm
 
-    params = dict(model.params)
-    if "lti_elements" in params:  # kinds and numbers: a tuple (a list would become an array)
-        params["lti_elements"] = tuple(tuple(el) if isinstance(el, (list, tuple)) else el
-                                       for el in params["lti_elements"])
+    params = {k: _block_setting(x) for k, x in model.params.items()}
     defaults = {"weights": model.weights.copy(), "offset": model.offset,
                 "reference_weights": model.reference_weights.copy(),
                 "reference_offset": model.reference_offset,
