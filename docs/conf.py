@@ -99,6 +99,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.diagnose",
     "pimodel.diagnosis.model",
     "pimodel.diagnosis.stream",
+    "pimodel.diagnosis.inverse_stream",
     "pimodel.diagnosis.feedforward",
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",

@@ -202,7 +202,8 @@ class DiagParams(ctypes.Structure):
                 ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
                 ("rate_tau", c_double), ("order", c_size),
                 ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
-                ("drift", c_double)]
+                ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
+                ("el_g", _DP)]
 
 
 lib.pim_diag_state_size.restype = c_size

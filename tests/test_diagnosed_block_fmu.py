@@ -418,13 +418,3 @@ def test_stream_follows_a_drift_with_a_level_per_record(clock):
     assert np.max(np.abs(stream_simulate(m, v, t) - want)) < 1e-12
     shift = 0.2 * 1.0 if clock == "absolute" else 0.0
     assert fmu_parameters(m)[1]["offset"] == pytest.approx(0.1 - shift, abs=1e-15)
-
-
-def test_dynamics_with_further_linear_elements_has_no_stream_yet():
-    """A dynamics model whose linear part has further elements (modes beyond the base one) is
-    refused by the C stream with a message naming ``lti_elements``, not run wrongly."""
-    p = {"mode_hz": 800.0, "mode_damping": 0.1, "lti_elements": [["mode", 2000.0, 0.05]],
-         "lti_gains": [0.2]}
-    m = DiagnosedModel([0.0, 0.2], [1.0, 0.5], 0.1, dt=1e-4, effects=("dynamics",), params=p)
-    with pytest.raises(ValueError, match="lti_elements"):
-        NativeModel(m)

@@ -53,10 +53,15 @@ VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "gua
       "in_c3": 24, "rate_gain": 40, "p": 100, "r": 200, "r_hat": 300, "n_lags": 52,
       "asymmetry_quadratic": 53, "rate_scale": 57, "drift_clock": 60, "lti_order": 61,
       "delay_samples": 62, "creep_gain": 500, "creep_tau": 600, "rate_band_gain": 700,
-      "lti_b": 800, "lti_a": 900, "rate_family": 63, "rate_tau": 64}
+      "lti_b": 800, "lti_a": 900, "rate_family": 63, "rate_tau": 64, "n_lti_elements": 65,
+      "lti_gain": 1400, "lti_element_b": 1500, "lti_element_a": 1600}
 OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
 TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
 CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
+# the DiagnosedModel's further LTI elements: sections M_1, E_1 (modes) and E_2 (a low-pass),
+# stable, a[0] = 1 each
+SECTIONS_B = [0.0, 0.0155, 0.0150, 0.0, 0.0689, 0.0617, 0.0, 0.3935, 0.0]
+SECTIONS_A = [1.0, -1.8779, 0.9084, 1.0, -1.6065, 0.7371, 1.0, -0.6065, 0.0]
 
 
 def bad_weight(name: str):
@@ -417,6 +422,15 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
                       *set_array(fmi3, VR["lti_b"], [0.0, 0.15, 0.1], 0.0),
                       *set_array(fmi3, VR["lti_a"], [_pick_float(rng, 1.0, 0.1 * hostile),
                                                      -1.2, 0.45], 0.0)]
+        if rng.random() < 0.5:  # the linear part's further elements
+            a = list(SECTIONS_A)
+            a[rng.choice([0, 3, 6])] = _pick_float(rng, 1.0, 0.1 * hostile)
+            extra += [["set_int", VR["n_lti_elements"], rng.choice([1, 2]) if not hostile else
+                       rng.choice([1, 2, 8, 9, -1, 2**31 - 1])],
+                      *set_array(fmi3, VR["lti_gain"],
+                                 [_pick_float(rng, 0.2, 0.1 * hostile), -0.1], 0.0),
+                      *set_array(fmi3, VR["lti_element_b"], SECTIONS_B, 0.0),
+                      *set_array(fmi3, VR["lti_element_a"], a, 0.0)]
         if rng.random() < 0.5:
             extra += [*set_array(fmi3, VR["rate_band_gain"], [0.1] * m, 0.0),
                       ["set_real", VR["rate_scale"], _pick_float(rng, 2.0, 0.1 * hostile)],
@@ -429,7 +443,7 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
         acts.insert(rng.randrange(len(acts) + 1), rng.choice(
             [["exit_init"], ["enter_init", 0.0], ["terminate"], ["reset"], ["step_next", 1e-3]]))
     h_base = Ts if isinstance(Ts, float) and 1e-6 < Ts < 10 else 1e-3
-    bad_vrs = [8, 9, 16, 99, 164, 264, 364, 400, 2**31, 2**32 - 1]
+    bad_vrs = [8, 9, 16, 99, 164, 264, 364, 400, 1664, 1700, 2**31, 2**32 - 1]
     for _ in range(rng.randint(5, 40)):
         k = rng.random()
         if k < 0.35:

@@ -23,7 +23,12 @@ size_t pim_diag_rate_size(const pim_diag *d)
 size_t pim_diag_state_size(const pim_diag *d)
 {
     return PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
-           pim_diag_delay_length(d->delay);
+           pim_diag_element_states(d) + pim_diag_delay_length(d->delay);
+}
+
+size_t pim_diag_element_states(const pim_diag *d)
+{
+    return d->ne ? 2 * (d->ne + 1) : 0;
 }
 
 static int all_finite(const double *x, size_t n)
@@ -31,6 +36,41 @@ static int all_finite(const double *x, size_t n)
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(x[i])) return 0;
     return 1;
+}
+
+/* 0 when b[0..q], a[0..q] are finite with a[0] = 1 and sum a != 0 (a rest state exists), else
+ * 1 (not finite), 2 (a[0] != 1) or 3 (a pole at z = 1). */
+static int lti_bad(const double *b, const double *a, size_t q)
+{
+    if (!all_finite(b, q + 1) || !all_finite(a, q + 1)) return 1;
+    if (a[0] != 1.0) return 2;
+    double sa = 0.0;
+    for (size_t j = 0; j <= q; ++j) sa += a[j];
+    return sa == 0.0 ? 3 : 0;
+}
+
+/* One sample of b(z^-1) / a(z^-1) (order q >= 1, a[0] = 1) in transposed direct form II, as
+ * scipy.signal.lfilter; on the first sample the states s[0..q-1] start at rest around x. */
+static double lti_step(const double *b, const double *a, size_t q, double *s, double x,
+                       int first)
+{
+    if (first) {
+        double sb = 0.0, sa = 0.0;
+        for (size_t j = 0; j <= q; ++j) {
+            sb += b[j];
+            sa += a[j];
+        }
+        const double gain = sb / sa;
+        double acc = 0.0;
+        for (size_t j = q; j >= 1; --j) {
+            acc += b[j] - a[j] * gain;
+            s[j - 1] = acc * x;
+        }
+    }
+    const double y = b[0] * x + s[0];
+    for (size_t j = 1; j < q; ++j) s[j - 1] = b[j] * x - a[j] * y + s[j];
+    s[q - 1] = b[q] * x - a[q] * y;
+    return y;
 }
 
 const char *pim_diag_check(const pim_diag *d)
@@ -66,13 +106,21 @@ const char *pim_diag_check(const pim_diag *d)
             return "input_range must be finite and > 0";
     }
     if (d->order > PIM_DIAG_MAX_ORDER) return "the LTI order is above 63";
-    if (d->order > 0) {
-        if (!all_finite(d->b, d->order + 1) || !all_finite(d->a, d->order + 1))
-            return "an LTI coefficient is not finite";
-        if (d->a[0] != 1.0) return "the LTI denominator must start with a[0] = 1";
-        double sa = 0.0;
-        for (size_t j = 0; j <= d->order; ++j) sa += d->a[j];
-        if (sa == 0.0) return "the LTI has a pole at z = 1 (sum of a is 0): no rest state";
+    switch (d->order > 0 ? lti_bad(d->b, d->a, d->order) : 0) {
+    case 1: return "an LTI coefficient is not finite";
+    case 2: return "the LTI denominator must start with a[0] = 1";
+    case 3: return "the LTI has a pole at z = 1 (sum of a is 0): no rest state";
+    }
+    if (d->ne > PIM_DIAG_MAX_ELEMENTS) return "more than 8 further LTI elements";
+    for (size_t j = 0; d->ne && j <= d->ne; ++j) {
+        switch (lti_bad(d->el_b + PIM_DIAG_SECTION * j, d->el_a + PIM_DIAG_SECTION * j,
+                        PIM_DIAG_SECTION - 1)) {
+        case 1: return "a coefficient of a further LTI element is not finite";
+        case 2: return "a further LTI element's denominator must start with a[0] = 1";
+        case 3: return "a further LTI element has a pole at z = 1 (sum of a is 0)";
+        }
+        if (j > 0 && !isfinite(d->el_g[j - 1]))
+            return "a further LTI element's gain is not finite";
     }
     if (!(isfinite(d->delay) && d->delay >= 0.0 && d->delay <= PIM_DIAG_MAX_DELAY - 2))
         return "the delay must be finite, >= 0 and <= 4094 samples";
@@ -86,7 +134,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     const size_t n = d->n, nr = pim_diag_rate_size(d), q = d->order;
     const size_t nbuf = pim_diag_delay_length(d->delay);
     double *z = x + PIM_DIAG_HEADER, *rate = z + n, *mem = rate + 1, *lag = rate + nr,
-           *s = lag + d->m, *buf = s + q;
+           *s = lag + d->m, *es = s + q, *buf = es + pim_diag_element_states(d);
     const int radius = nr && d->rate_family == PIM_DIAG_RATE_RADIUS;
     const int first = x[0] == 0.0;
     if (first) {
@@ -126,25 +174,16 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     }
     h0 += d->c0;
     /* LTI, transposed direct form II, started at rest around h[0] */
-    double xk = h;
-    if (q) {
-        const double *b = d->b, *a = d->a;
-        if (first) {
-            double sb = 0.0, sa = 0.0;
-            for (size_t j = 0; j <= q; ++j) {
-                sb += b[j];
-                sa += a[j];
-            }
-            const double gain = sb / sa;
-            double acc = 0.0;
-            for (size_t j = q; j >= 1; --j) {
-                acc += b[j] - a[j] * gain;
-                s[j - 1] = acc * h;
-            }
-        }
-        xk = b[0] * h + s[0];
-        for (size_t j = 1; j < q; ++j) s[j - 1] = b[j] * h - a[j] * xk + s[j];
-        s[q - 1] = b[q] * h - a[q] * xk;
+    double xk = q ? lti_step(d->b, d->a, q, s, h, first) : h;
+    /* the further elements on h0 (lti.lti_columns): sum_j g_j (E_j[h0] - M_1[h0]) */
+    if (d->ne) {
+        const size_t m = PIM_DIAG_SECTION, o = PIM_DIAG_SECTION - 1;
+        const double base = lti_step(d->el_b, d->el_a, o, es, h0, first);
+        double acc = 0.0;
+        for (size_t j = 1; j <= d->ne; ++j)
+            acc += d->el_g[j - 1] *
+                   (lti_step(d->el_b + m * j, d->el_a + m * j, o, es + o * j, h0, first) - base);
+        xk += acc;
     }
     /* delay line: buf[head] holds x[k] after the write */
     double y = xk;

@@ -11,6 +11,9 @@
  *     z_i[k] = max(v[k] - r_i, min(v[k] + r_i, z_i[k-1]))              plays (pim_core.h)
  *     h[k]   = sum_i w_i z_i[k],   h0[k] = sum_i w0_i z_i[k] + c0
  *     x[k]   = LTI[h][k]          b(z^-1) / a(z^-1), a_0 = 1, at rest around h[0]
+ *            + sum_j g_j (E_j[h0][k] - M_1[h0][k])   the linear part's further elements:
+ *                                     E_j, M_1 second-order sections (b, a of 3 values each,
+ *                                     a_0 = 1), at rest around h0[0] (pimodel.diagnosis.lti)
  *     y[k]   = (1 - f) x[k - d0] + f x[k - d0 - 1] + c               delay d = d0 + f samples,
  *                                                                    x[j < 0] = x[0]
  *            + sum_j g_j (L_j[k] - h0[k])     creep: L_j[k] = a_j L_j[k-1] + (1 - a_j) h0[k],
@@ -30,7 +33,8 @@
  *
  * State (one flat array of pim_diag_state_size(d) doubles, so that python-control blocks and FMU
  * states hold it as is): [started, v_prev, t_start, head, z[n], rate[n_rate], L[m], s[order],
- * buf[nbuf]] with rate = [rho_f[k-1], m[n]] (radius family), [rho_f[k-1]] (weight family) or
+ * e[n_e], buf[nbuf]] (e: two states per section M_1, E_1..E_ne, n_e = 2 (ne + 1), or 0 when
+ * ne = 0) with rate = [rho_f[k-1], m[n]] (radius family), [rho_f[k-1]] (weight family) or
  * none; all zero (except z = the initial play states) before the first sample.  `head` is the
  * ring position of x[k-1] in buf (nbuf = floor(d) + 2 when d > 0, else 0).  Units: v and r
  * in the input unit, y, c, c0, center, half in the output unit, t in s, s in output unit / s.
@@ -49,11 +53,14 @@ extern "C" {
 #define PIM_DIAG_RATE_WEIGHT 1       /* rate_family: weights growing with the rate */
 #define PIM_DIAG_MAX_DELAY 4096      /* longest delay line (samples), so d <= 4094 */
 #define PIM_DIAG_MAX_ORDER 63        /* LTI order: b[0..order], a[0..order] in 64 values */
+#define PIM_DIAG_MAX_ELEMENTS 8      /* further elements of the linear part (a diagnosis: <= 2) */
+#define PIM_DIAG_SECTION 3           /* coefficients per section: b[0..2], a[0..2] */
 #define PIM_DIAG_HEADER 4            /* started, v_prev, t_start, head */
 #define PIM_DIAG_MAX_PLAYS (2 * PIM_MAX_PLAYS) /* plays of the FMU unit (a diagnosis: <= 80) */
 #define PIM_DIAG_MAX_LAGS PIM_MAX_PLAYS        /* creep lags of the FMU unit */
 #define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + 1 + PIM_DIAG_MAX_LAGS + \
-                            PIM_DIAG_MAX_ORDER + PIM_DIAG_MAX_DELAY)
+                            PIM_DIAG_MAX_ORDER + 2 * (PIM_DIAG_MAX_ELEMENTS + 1) + \
+                            PIM_DIAG_MAX_DELAY)
 
 typedef struct {
     size_t n;              /* plays */
@@ -75,10 +82,17 @@ typedef struct {
     double delay;          /* d >= 0 [samples] */
     int drift_clock;       /* 0 none, 1 record (t - t[0]), 2 absolute (t) */
     double drift;          /* s */
+    size_t ne;             /* further elements E_j of the linear part (0: none) */
+    const double *el_b, *el_a; /* (ne + 1) sections of PIM_DIAG_SECTION coefficients: section 0
+                                  the base mode M_1 on h0, section j the element E_j */
+    const double *el_g;    /* gains g_j of E_1..E_ne */
 } pim_diag;
 
 /* Length of the flat state of d (the layout above). */
 PIM_API size_t pim_diag_state_size(const pim_diag *d);
+
+/* Length of the further elements' state: 2 (ne + 1), or 0 when ne = 0. */
+PIM_API size_t pim_diag_element_states(const pim_diag *d);
 
 /* Length of the rate state: 1 + n (radius family), 1 (weight family) or 0 (no rate). */
 PIM_API size_t pim_diag_rate_size(const pim_diag *d);
@@ -89,7 +103,8 @@ PIM_API size_t pim_diag_delay_length(double delay);
 /*
  * NULL when the parameters are valid (finite; radii sorted >= 0; where used: half > 0,
  * rate_scale > 0, rate_family 0 or 1, rate_tau >= 0, input_range > 0 when rate_tau = 0; lags
- * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists; 0 <= delay <=
+ * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists, for the LTI and for each
+ * section of the further elements; ne <= PIM_DIAG_MAX_ELEMENTS; 0 <= delay <=
  * PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2), else a static message naming the first bad one
  * (the FMU adds the value).
  */

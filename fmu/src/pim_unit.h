@@ -36,7 +36,8 @@
  * creep_gain 500 + i, creep_tau 600 + i, rate_band_gain 700 + i (per play the gain of its
  * rate band; the rate term is on when one is non-zero), lti_b 800 + i,
  * lti_a 900 + i, and for plays 65..128 p_hi 1000 + i, r_hi 1100 + i, w0_hi 1200 + i,
- * rate_band_gain_hi 1300 + i); in FMI 3 an array is one variable.
+ * rate_band_gain_hi 1300 + i; the linear part's further elements lti_gain 1400 + i,
+ * lti_element_b 1500 + i, lti_element_a 1600 + i); in FMI 3 an array is one variable.
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
@@ -127,6 +128,7 @@ typedef enum {
     vr_delay_samples = 62,
     vr_rate_family = 63,
     vr_rate_tau = 64,
+    vr_n_lti_elements = 65,
     vr_p = 100,
     vr_r = 200,
     vr_r_hat = 300,
@@ -139,7 +141,10 @@ typedef enum {
     vr_p_hi = 1000, /* DiagnosedModel plays 65..128 */
     vr_r_hi = 1100,
     vr_w0_hi = 1200,
-    vr_rate_band_gain_hi = 1300
+    vr_rate_band_gain_hi = 1300,
+    vr_lti_gain = 1400, /* DiagnosedModel: the linear part's further elements */
+    vr_lti_element_b = 1500,
+    vr_lti_element_a = 1600
 } ValueReference;
 
 typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
@@ -203,6 +208,11 @@ typedef struct {
         input_range, drift_per_s, delay_samples;
     int n_lags, lti_order, drift_clock, rate_family;
     double rate_tau;
+    /* the linear part's further elements (pim_diagnosed.h): n_lti_elements sections E_j with
+     * gains lti_gain[j], and section 0 the base mode M_1 on h0, PIM_DIAG_SECTION coefficients
+     * each in lti_element_b, lti_element_a */
+    int n_lti_elements;
+    double lti_gain[PIM_NMAX], lti_element_b[PIM_NMAX], lti_element_a[PIM_NMAX];
     double dstate[PIM_DIAG_STATE_MAX];
 #endif
     char msg[256]; /* reason of the last failure */
@@ -312,6 +322,10 @@ static const pim_var unit_vars[] = {
     {"lti_b", vr_lti_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_b)},
     {"lti_a", vr_lti_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_a)},
     {"delay_samples", vr_delay_samples, 'R', PIM_PARAMETER, 1, PIM_AT(delay_samples)},
+    {"n_lti_elements", vr_n_lti_elements, 'I', PIM_PARAMETER, 1, PIM_AT(n_lti_elements)},
+    {"lti_gain", vr_lti_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_gain)},
+    {"lti_element_b", vr_lti_element_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_element_b)},
+    {"lti_element_a", vr_lti_element_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_element_a)},
     {"p_hi", vr_p_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p_hi)},
     {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
     {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
@@ -379,6 +393,8 @@ static void unit_defaults(pim_unit *u)
         u->creep_tau[i] = 1.0;
     }
     u->lti_a[0] = 1.0; /* lti_order 0: no LTI */
+    for (int j = 0; j <= PIM_DIAG_MAX_ELEMENTS; ++j) /* each section's a[0] = 1 */
+        u->lti_element_a[PIM_DIAG_SECTION * j] = 1.0;
     u->half_range = u->rate_scale = u->input_range = 1.0;
 #endif
 #ifdef PIM_MODEL_DEFAULTS
@@ -472,6 +488,10 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->delay = u->delay_samples;
     d->drift_clock = u->drift_clock;
     d->drift = u->drift_per_s;
+    d->ne = u->n_lti_elements > 0 ? (size_t)u->n_lti_elements : 0;
+    d->el_b = u->lti_element_b;
+    d->el_a = u->lti_element_a;
+    d->el_g = u->lti_gain;
 }
 
 /* The plays' arrays joined: plays 1..64 from p, r, w0, rate_band_gain, 65..128 from the _hi
@@ -573,6 +593,26 @@ static int unit_check_diag(pim_unit *u)
     if (u->lti_order > 0 && u->lti_a[0] != 1.0)
         return unit_error(u, "parameter lti_a[1] = %g: the LTI denominator must be normalised "
                              "(lti_a[1] = 1)", u->lti_a[0]);
+    if (u->n_lti_elements < 0 || u->n_lti_elements > PIM_DIAG_MAX_ELEMENTS)
+        return unit_error(u, "parameter n_lti_elements = %d out of range: 0 <= n_lti_elements "
+                             "<= %d", u->n_lti_elements, PIM_DIAG_MAX_ELEMENTS);
+    for (int j = 0; u->n_lti_elements > 0 && j < PIM_DIAG_SECTION * (u->n_lti_elements + 1);
+         ++j) {
+        if (!isfinite(u->lti_element_b[j]))
+            return unit_error(u, "LTI element coefficient lti_element_b[%d] = %g is not finite",
+                              j + 1, u->lti_element_b[j]);
+        if (!isfinite(u->lti_element_a[j]))
+            return unit_error(u, "LTI element coefficient lti_element_a[%d] = %g is not finite",
+                              j + 1, u->lti_element_a[j]);
+        if (j % PIM_DIAG_SECTION == 0 && u->lti_element_a[j] != 1.0)
+            return unit_error(u, "parameter lti_element_a[%d] = %g: each section's denominator "
+                                 "must be normalised (lti_element_a[%d] = 1)", j + 1,
+                              u->lti_element_a[j], j + 1);
+    }
+    for (int j = 0; j < u->n_lti_elements; ++j)
+        if (!isfinite(u->lti_gain[j]))
+            return unit_error(u, "LTI element gain lti_gain[%d] = %g is not finite", j + 1,
+                              u->lti_gain[j]);
     if (!isfinite(u->delay_samples) || u->delay_samples < 0.0 ||
         u->delay_samples > PIM_DIAG_MAX_DELAY - 2)
         return unit_error(u, "parameter delay_samples = %g out of range: 0 <= delay_samples <= "
@@ -1010,8 +1050,8 @@ static int unit_do_step(pim_unit *u, double t, double h)
  * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
 static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
-    /* FMI 2 array elements: base 100, 200, ..., 1300 plus an index below PIM_NMAX */
-    const unsigned base = elements && vr >= 100 && vr < 1400 ? vr - vr % 100 : vr;
+    /* FMI 2 array elements: base 100, 200, ..., 1600 plus an index below PIM_NMAX */
+    const unsigned base = elements && vr >= 100 && vr < 1700 ? vr - vr % 100 : vr;
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
         if (v->vr != base) continue;

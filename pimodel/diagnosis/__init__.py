@@ -20,6 +20,8 @@ it returns a :class:`DiagnosisReport`. The submodules:
   report chose (:meth:`DiagnosisReport.model`), with its causal feedforward inverse;
 - :mod:`pimodel.diagnosis.stream`: that model streamed sample by sample on the C core, as a
   python-control block and as the DiagnosedModel FMU unit's values;
+- :mod:`pimodel.diagnosis.inverse_stream`: the model's feedforward inverse as a causal
+  python-control block;
 - :mod:`pimodel.diagnosis.feedforward`: open-loop feedforward with such a model, tried on a
   simulated true stage.
 

@@ -48,8 +48,8 @@ from scipy.signal import (
 )
 
 __all__ = ["MAX_MODES", "element_coefficients", "lti_columns", "lti_k", "describe_lti",
-           "continuous_zpk", "approximate_inverse", "select_order", "polish_elements",
-           "nelder_mead"]
+           "continuous_zpk", "approximate_inverse", "inverse_sos", "select_order",
+           "polish_elements", "nelder_mead"]
 
 MAX_MODES = 3  # modes of the linear part, the base mode included
 MAX_ELEMENTS = 2  # extra elements at most (each step costs a joint polish)
@@ -359,6 +359,42 @@ def approximate_inverse(x: np.ndarray, fn: float, zeta: float, elements: Sequenc
     >>> bool(np.max(np.abs(approximate_inverse(y, 800.0, 0.05, [], [], 1e-4) - u)[:-1]) < 0.01)
     True
     """
+    sos, advance = inverse_sos(fn, zeta, elements, gains, dt)
+    out = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])[0]
+    if not advance:
+        return out
+    return np.r_[out[1:], out[-1]]
+
+
+def inverse_sos(fn: float, zeta: float, elements: Sequence, gains: Sequence,
+                dt: float) -> tuple[np.ndarray, int]:
+    """The filter of :func:`approximate_inverse` as second-order sections, and its advance.
+
+    Parameters
+    ----------
+    fn, zeta : float
+        Base mode [Hz, -].
+    elements : sequence
+        The extra elements.
+    gains : sequence of float
+        Their gains.
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    sos : numpy.ndarray
+        Shape (sections, 6), for :func:`scipy.signal.sosfilt` (Tustin, static gain 1).
+    advance : int
+        1: the filter's output is advanced one sample (the zero-order hold; ``G`` has no direct
+        term), else 0.
+
+    Examples
+    --------
+    >>> sos, advance = inverse_sos(800.0, 0.05, [], [], 1e-4)
+    >>> sos.shape, advance
+    ((1, 6), 1)
+    """
     zeros, poles, _ = continuous_zpk(fn, zeta, elements, gains)
     mirrored = np.where(zeros.real > -1e-3 * np.abs(zeros), -np.abs(zeros.real) - 1e-3 *
                         np.abs(zeros) + 1j * zeros.imag, zeros)
@@ -369,11 +405,7 @@ def approximate_inverse(x: np.ndarray, fn: float, zeta: float, elements: Sequenc
     k = float(np.real(np.prod(-p_inv) / np.prod(-z_inv))) if z_inv.size else \
         float(np.real(np.prod(-p_inv)))
     zd, pd, kd = bilinear_zpk(z_inv, p_inv, k, fs=1.0 / dt)
-    sos = zpk2sos(zd, pd, kd)
-    out = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])[0]
-    if any(_kind(e) == "direct" for e in elements):
-        return out
-    return np.r_[out[1:], out[-1]]
+    return zpk2sos(zd, pd, kd), int(not any(_kind(e) == "direct" for e in elements))
 
 
 class _Projection:

@@ -551,6 +551,64 @@ class DiagnosedInverse:
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
         return _solve(self.model.static_part(), self.prefilter(yd), rng)
 
+    def block(self, dt: float | None = None, *, name: str = "inverse", input: str = "y_d",
+              output: str = "v", input_range: float | None = None,
+              reference_range: float | None = None) -> control.NonlinearIOSystem:
+        """The feedforward as a causal discrete python-control block, ``y_d -> v``.
+
+        :meth:`simulate` reads the reference ahead (one sample for the dynamics' approximate
+        inverse, ``d`` for a delay); the block cannot, so it delays ``v`` instead by ``A =
+        block.latency`` samples (:func:`~pimodel.diagnosis.inverse_stream.inverse_latency`,
+        0 without dynamics and delay): fed ``y_d[0..k]`` it outputs ``v[k] = simulate(y_d)[k -
+        A]`` for ``k >= A`` and the inverse of ``y_d[0]`` at rest before. A model driven by it
+        follows ``y_d[k - A]`` (for a reference at rest over its first ``A + 1`` samples,
+        exactly as the batch: ``y[k] = model.simulate(simulate(y_d))[k - A]``, drift aside).
+        To follow ``y_d[k]`` itself, feed the block ``y_d[k + A]`` (a known trajectory).
+
+        Parameters
+        ----------
+        dt : float, optional
+            Sample time [s]: the model's ``dt`` (default; another value raises).
+        name, input, output : str
+            Block name (prefix of its params) and signal names.
+        input_range : float, optional
+            Range of the rate effect's step rule; default ``2 r_n`` (as :meth:`simulate`).
+        reference_range : float, optional
+            The scale of the root rule, which :meth:`simulate` takes from the whole reference
+            (``ptp(self.prefilter(y_d))``); default 0 (scale ``max(2 r_n, 1)``). It matters
+            only where the static part has several roots.
+
+        Returns
+        -------
+        control.NonlinearIOSystem
+            Input ``y_d``, output ``v``; initial state all zeros
+            (``pimodel.blocks.initial_state``); attribute ``latency`` (samples).
+
+        Raises
+        ------
+        ValueError
+            ``dt`` other than the model's, or a bad model parameter.
+
+        Examples
+        --------
+        >>> import control
+        >>> from pimodel.blocks import initial_state
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3, effects=("delay",),
+        ...                    params={"delay_samples": 1})
+        >>> blk = m.inverse().block()
+        >>> y_d = np.array([0.1, 0.1, 1.35, 0.35, 0.35])
+        >>> res = control.input_output_response(blk, np.arange(5) * 1e-3, y_d,
+        ...                                     initial_state=initial_state(blk))
+        >>> blk.latency, res.outputs.round(9).tolist()
+        (1, [0.0, 0.0, 1.0, 0.0, 0.0])
+        >>> m.inverse().simulate(y_d).round(9).tolist()
+        [0.0, 1.0, 0.0, 0.0, 0.0]
+        """
+        from .inverse_stream import inverse_block
+
+        return inverse_block(self, dt, name=name, input=input, output=output,
+                             input_range=input_range, reference_range=reference_range)
+
 
 def _advance(x, d):
     """``x[k + d]`` (linear interpolation, the last sample held)."""

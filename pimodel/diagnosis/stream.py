@@ -25,7 +25,12 @@ Two things ``simulate`` takes from the whole record are parameters here:
 
 The dynamics is an LTI part ``b(z^-1) / a(z^-1)`` (``a[0] = 1``): the model's
 ``params["lti_b"]``, ``params["lti_a"]`` when given, else the unit-gain mode
-(:func:`~pimodel.diagnosis.effects.mode_coefficients` of ``mode_hz``, ``mode_damping``).
+(:func:`~pimodel.diagnosis.effects.mode_coefficients` of ``mode_hz``, ``mode_damping``). Its
+further elements (``params["lti_elements"]``, ``params["lti_gains"]``, :mod:`.lti`: a higher
+order chosen by the diagnosis, zeros from the parallel gains) run as second-order sections on
+``h0``: ``sum_j g_j (E_j - M_1)[h0]``, each started at rest around ``h0[0]``, added to the
+hysteresis term before the delay, as :func:`~pimodel.diagnosis.lti.lti_columns` (at most
+``MAX_ELEMENTS`` elements, :func:`element_sections`).
 """
 
 from __future__ import annotations
@@ -38,15 +43,18 @@ import numpy as np
 
 from .. import _native
 from ..blocks import _Block, _labels, _Settings
+from ..fmu.build import MAX_LTI_ELEMENTS as MAX_ELEMENTS
 from ..fmu.build import NMAX
 from .effects import mode_coefficients
+from .lti import ELEMENT_K, element_coefficients
 from .rate import RATE_FAMILIES, play_bands
 
-__all__ = ["NativeModel", "diagnosed_block", "fmu_parameters", "state_labels",
-           "stream_simulate"]
+__all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",
+           "state_labels", "stream_simulate"]
 
 MAX_DELAY = 4094  # samples: PIM_DIAG_MAX_DELAY - 2 (fmu/src/pim_diagnosed.h)
 MAX_ORDER = 63  # LTI order: PIM_DIAG_MAX_ORDER
+SECTION = 3  # coefficients per section of a further element: PIM_DIAG_SECTION
 CLOCKS = {"record": 1, "absolute": 2}
 
 
@@ -85,6 +93,77 @@ def lti_coefficients(model) -> tuple[np.ndarray, np.ndarray] | None:
     return mode_coefficients(p["mode_hz"], p["mode_damping"], model.dt)
 
 
+def _section(element, dt: float, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """ZOH ``(b, a)`` of one element padded to ``SECTION`` coefficients (ValueError naming
+    ``name`` for a malformed element)."""
+    expected = ("expected ('mode', fn > 0 [Hz], zeta > 0), ('lowpass', tau > 0 [s]) or "
+                "('direct',)")
+    try:
+        kind = str(element[0])
+        values = [float(x) for x in element[1:]]
+    except (TypeError, ValueError, IndexError):
+        raise ValueError(f"params: {name} = {element!r}: {expected}") from None
+    if (kind not in ELEMENT_K or len(values) != {"mode": 2, "lowpass": 1, "direct": 0}[kind]
+            or not all(math.isfinite(x) and x > 0 for x in values)):
+        raise ValueError(f"params: {name} = {element!r}: {expected}")
+    b, a = element_coefficients((kind, *values), dt)
+    return np.pad(b, (0, SECTION - b.size)), np.pad(a, (0, SECTION - a.size))
+
+
+def element_sections(model) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The linear part's further elements in the C core's form, or None (none, or no
+    ``"dynamics"``).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model (``params["lti_elements"]``, ``params["lti_gains"]``, ``mode_hz``,
+        ``mode_damping``).
+
+    Returns
+    -------
+    tuple of numpy.ndarray or None
+        ``b``, ``a`` of shape ``(ne + 1, 3)`` (powers of ``z^-1``, ``a[:, 0] = 1``): row 0 the
+        base mode ``M_1``, row ``j`` the element ``E_j``, ZOH at the model's ``dt``
+        (:func:`~pimodel.diagnosis.lti.element_coefficients`); and the gains ``g_j`` (``ne``).
+
+    Raises
+    ------
+    ValueError
+        More than ``MAX_ELEMENTS`` (8) elements, a malformed element (named
+        ``lti_elements[j]``), or not one gain per element.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0], [1.0], 0.0, dt=1e-4, effects=("dynamics",),
+    ...                    params={"mode_hz": 500.0, "mode_damping": 0.1,
+    ...                            "lti_elements": [["mode", 1500.0, 0.05], ["direct"]],
+    ...                            "lti_gains": [0.2, 0.01]})
+    >>> b, a, g = element_sections(m)
+    >>> b.shape, b[2].tolist(), g.tolist()
+    ((3, 3), [1.0, 0.0, 0.0], [0.2, 0.01])
+    """
+    p = model.params
+    if "dynamics" not in model.effects or not p.get("lti_elements"):
+        return None
+    elements = list(p["lti_elements"])
+    if len(elements) > MAX_ELEMENTS:
+        raise ValueError(f"params: lti_elements: {len(elements)} elements; the C stream and the "
+                         f"FMU take at most {MAX_ELEMENTS}")
+    try:
+        gains = np.asarray(p.get("lti_gains", ()), float)
+    except (TypeError, ValueError):
+        gains = np.empty(0)
+    if gains.shape != (len(elements),):
+        raise ValueError(f"params: lti_gains: expected {len(elements)} gains, one per element of "
+                         f"lti_elements, got {p.get('lti_gains')!r}")
+    rows = [_section(("mode", p["mode_hz"], p["mode_damping"]), model.dt,
+                     "mode_hz, mode_damping")]
+    rows += [_section(el, model.dt, f"lti_elements[{j}]") for j, el in enumerate(elements)]
+    return np.array([b for b, _ in rows]), np.array([a for _, a in rows]), gains
+
+
 def _band_gains(gains: np.ndarray, n: int) -> np.ndarray:
     """Per play, the gain of its rate band (:func:`.rate.play_bands`, as ``simulate``)."""
     if gains.ndim != 1 or not 1 <= gains.size <= n:
@@ -110,8 +189,9 @@ class NativeModel:
     ------
     ValueError
         A parameter the C core refuses (named), rate parameters of an earlier version
-        (``rate_band_gains``) or more rate gains than plays, an LTI order above 63 or a delay
-        above 4094 samples.
+        (``rate_band_gains``) or more rate gains than plays, an LTI order above 63, a malformed
+        further element of the linear part or more than 8 (:func:`element_sections`), or a
+        delay above 4094 samples.
 
     Examples
     --------
@@ -126,11 +206,6 @@ class NativeModel:
         from .model import _rate_params
 
         e, p, r = model.effects, model.params, model.radii
-        if "dynamics" in e and p.get("lti_elements"):
-            raise ValueError(f"params: lti_elements = {list(p['lti_elements'])!r}: the further "
-                             "elements of the dynamics' linear part act on the reference "
-                             "hysteresis h0; the C stream (block, FMU) runs only the base mode "
-                             "or one LTI on the hysteresis term")
         n = r.size
         self.model = model
         self.input_range = float(2 * r[-1] if input_range is None else input_range)
@@ -161,6 +236,10 @@ class NativeModel:
             keep["b"] = np.pad(lti[0], (0, order + 1 - lti[0].size))
             keep["a"] = np.pad(lti[1], (0, order + 1 - lti[1].size))
             d.order = order
+        sections = element_sections(model)
+        if sections is not None:
+            keep["el_b"], keep["el_a"], keep["el_g"] = sections
+            d.ne = sections[2].size
         if "delay" in e:
             d.delay = float(p["delay_samples"])
             if not 0 <= d.delay <= MAX_DELAY:
@@ -309,7 +388,8 @@ def state_labels(model) -> list[str]:
         states), ``rho_f`` (filtered rate of the last sample, with a rate effect) and
         ``m[1..n]`` (the radius family's terms held from each play's last contact),
         ``L[1..m]`` (creep lags),
-        ``s[1..q]`` (LTI states), ``x_delay[1..nbuf]`` (delay line).
+        ``s[1..q]`` (LTI states), ``e[1..2 (ne + 1)]`` (the sections of the linear part's
+        further elements and of its base mode on ``h0``), ``x_delay[1..nbuf]`` (delay line).
 
     Examples
     --------
@@ -325,7 +405,21 @@ def state_labels(model) -> list[str]:
         rate = ["rho_f"] + (_labels("m", n) if d.rate_family == 0 else [])
     return (["started", "v_prev", "t_start", "head"] + _labels("z", n)
             + rate + _labels("L", d.m)
-            + _labels("s", d.order) + _labels("x_delay", nbuf))
+            + _labels("s", d.order) + _labels("e", 2 * (d.ne + 1) if d.ne else 0)
+            + _labels("x_delay", nbuf))
+
+
+def _block_setting(value):
+    """A model parameter as a block setting: numeric lists stay lists (arrays in params); other
+    lists (``lti_elements``: kinds and numbers; a report's ``dynamics_modes``: dicts) become
+    tuples, which the block's settings keep as they are."""
+    if not isinstance(value, list):
+        return value
+    try:
+        np.asarray(value, dtype=float)
+        return value
+    except (TypeError, ValueError):
+        return tuple(tuple(x) if isinstance(x, list) else x for x in value)
 
 
 def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
@@ -396,10 +490,11 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
                              f"{len(labels)}): build a new block for this model")
         return nm
 
+    params = {k: _block_setting(x) for k, x in model.params.items()}
     defaults = {"weights": model.weights.copy(), "offset": model.offset,
                 "reference_weights": model.reference_weights.copy(),
                 "reference_offset": model.reference_offset,
-                "input_range": native.input_range, **model.params}
+                "input_range": native.input_range, **params}
     settings = _Settings(name, defaults, build)
 
     def run(t, x, u, params):
@@ -472,6 +567,10 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
                     "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
     if d.order:
         out.update({"lti_order": int(d.order), **arr("lti_b", k["b"]), **arr("lti_a", k["a"])})
+    if d.ne:
+        out.update({"n_lti_elements": int(d.ne), **arr("lti_gain", k["el_g"]),
+                    **arr("lti_element_b", k["el_b"].ravel()),
+                    **arr("lti_element_a", k["el_a"].ravel())})
     if d.delay:
         out["delay_samples"] = d.delay
     if d.drift_clock:

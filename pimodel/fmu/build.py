@@ -19,6 +19,8 @@ from xml.sax.saxutils import escape
 
 NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
 MAX_SUBSTEPS = 10_000_000  # samples per doStep; PIM_MAX_SUBSTEPS in fmu/src/pim_unit.h
+MAX_LTI_ELEMENTS = 8  # further elements of a DiagnosedModel's linear part; PIM_DIAG_MAX_ELEMENTS
+# in fmu/src/pim_diagnosed.h
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_est_health.c", "pim_loops.c",
                 "pim_generalized.c", "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c",
                 "pim_diagnosed.c")
@@ -271,7 +273,8 @@ MODELS: dict[str, dict] = {
         "id": 8,
         "description": "The model a diagnosis chose: PI hysteresis with signed weights and the "
                        "effect terms in parallel, creep, asymmetry, rate, drift, an LTI (b, a) "
-                       "and a delay (pimodel.diagnosis.model.DiagnosedModel, dt = Ts)",
+                       "with further elements on h0, and a delay "
+                       "(pimodel.diagnosis.model.DiagnosedModel, dt = Ts)",
         "vars": [*_common(z0="initial play state (input unit; a diagnosis starts at 0)",
                           weights=("p", "1", "weight w (any sign), play"),
                           n_max=2 * NMAX),
@@ -316,6 +319,18 @@ MODELS: dict[str, dict] = {
                  Var("delay_samples", 62, "Real", "parameter", "0",
                      "delay of the hysteresis term [samples] (0 <= d <= 4094, fractional: "
                      "linear interpolation)"),
+                 Var("n_lti_elements", 65, "Integer", "parameter", "0",
+                     f"further elements E_j of the linear part on h0, 0 <= n_lti_elements <= "
+                     f"{MAX_LTI_ELEMENTS} (0: none)"),
+                 *_arrays("lti_gain", 1400, "parameter", "0",
+                          "gain g_j of the term g_j (E_j - M_1)[h0], element"),
+                 *_arrays("lti_element_b", 1500, "parameter", "0",
+                          "second-order sections, 3 numerator coefficients each (z^0, z^-1, "
+                          "z^-2): M_1 in 1..3, E_j in 3j+1..3j+3, element"),
+                 *[Var(f"lti_element_a[{i + 1}]", 1600 + i, "Real", "parameter",
+                       "1" if i % 3 == 0 and i <= 3 * MAX_LTI_ELEMENTS else "0",
+                       "second-order sections, 3 denominator coefficients each (the first 1), "
+                       f"element {i + 1}") for i in range(NMAX)],
                  *_arrays("p_hi", 1000, "parameter", "1",
                           "weight w of play 64 + i (used when n > 64), element"),
                  *_arrays("r_hi", 1100, "parameter", "0",

@@ -1,0 +1,382 @@
+"""The feedforward of a :class:`~pimodel.diagnosis.model.DiagnosedInverse` as a causal
+python-control block (``DiagnosedInverse.block``).
+
+``DiagnosedInverse.simulate`` is not causal when the model has dynamics or a delay: its
+prefilter reads the reference ahead, by one sample for the zero-order hold of the dynamics'
+approximate inverse (none when the linear part has a direct term) and by the delay ``d``
+samples. The block runs the causal part and delays its output instead, by the latency
+
+    A = advance + floor(d) + (1 if the delay has a fractional part else 0)   samples,
+
+so that, fed ``y_d[0..k]``, it outputs ``v[k] = v_batch[k - A]`` for ``k >= A`` (``v_batch =
+DiagnosedInverse.simulate(y_d)``, exact to rounding, the last ``A`` batch samples aside, which
+``simulate`` computes with the reference held) and, for ``k < A``, ``v_rest``, the inverse of
+``y_d[0]`` at rest (``v_batch[0]`` when the reference rests at ``y_d[0]`` for its first
+``A + 1`` samples). A model driven by the block then follows the reference delayed by ``A``:
+with a reference at rest at its start, ``y[k] = y_batch[k - A]`` (``y_batch`` the model's
+response to ``v_batch``), except a drift term (a function of time, not inverted). To track
+``y_d`` itself, feed the block the reference ``A`` samples ahead (a known trajectory).
+
+Per sample ``k``: the reference goes through the prefilter's filter (second-order sections,
+:func:`~pimodel.diagnosis.lti.inverse_sos`, started at rest around ``y_d[0]``, as
+:func:`~pimodel.diagnosis.lti.approximate_inverse`), the advanced sample ``j = k - A`` is
+interpolated from its last two outputs (the delay's fraction), and the static part is inverted
+sample by sample (:class:`StaticInverse`, the per-sample form of the model module's solver).
+"""
+
+from __future__ import annotations
+
+import math
+
+import control
+import numpy as np
+from scipy.signal import sosfilt_zi
+
+from ..blocks import _Block, _labels, _Settings
+from .lti import inverse_sos
+from .model import _rate_params, _roots
+from .rate import STEP_SHARE, play_bands
+
+__all__ = ["StaticInverse", "inverse_block", "inverse_latency"]
+
+
+def inverse_latency(model) -> int:
+    """Samples by which :func:`inverse_block` delays the feedforward (module docstring).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model whose inverse the block runs.
+
+    Returns
+    -------
+    int
+        ``A = advance + floor(d) + (1 if d has a fractional part above 1e-12)``; 0 for a
+        model without dynamics and delay.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3, effects=("dynamics", "delay"),
+    ...                    params={"mode_hz": 50.0, "mode_damping": 0.5, "delay_samples": 2.5})
+    >>> inverse_latency(m), inverse_latency(m.static_part())
+    (4, 0)
+    """
+    d0, f = _delay(model)
+    return _advance_of(model) + d0 + (1 if f > 0 else 0)
+
+
+def _delay(model) -> tuple[int, float]:
+    """Whole and fractional parts of the model's delay (a fraction up to 1e-12 counts as 0)."""
+    d = float(model.params["delay_samples"]) if "delay" in model.effects else 0.0
+    if not (math.isfinite(d) and d >= 0):
+        raise ValueError(f"params: delay_samples = {d!r}: expected a finite delay >= 0")
+    d0 = math.floor(d)
+    f = d - d0
+    return d0, (f if f > 1e-12 else 0.0)
+
+
+def _filter(model) -> tuple[np.ndarray | None, int]:
+    """The prefilter's sections (None without dynamics) and its advance (0 or 1)."""
+    if "dynamics" not in model.effects:
+        return None, 0
+    p = model.params
+    return inverse_sos(p["mode_hz"], p["mode_damping"], p.get("lti_elements", ()),
+                       p.get("lti_gains", ()), model.dt)
+
+
+def _advance_of(model) -> int:
+    return _filter(model)[1]
+
+
+class StaticInverse:
+    """The exact inverse of a model's static part, one sample at a time: the per-sample form of
+    ``DiagnosedInverse.simulate``'s solver on an already prefiltered reference (the module
+    docstring of :mod:`pimodel.diagnosis.model` for the root and the approximations of the
+    rate effect).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model; its dynamics and delay are ignored (:meth:`DiagnosedModel.static_part`).
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n``.
+    reference_range : float, optional
+        Range of the (prefiltered) reference the root rule scales with: the jump that restarts
+        the branch guess (1 %) and the search bracket (10 times). ``simulate`` takes
+        ``ptp`` of the whole prefiltered reference; default 0 (the scale is then
+        ``max(2 r_n, 1)``). It matters only where ``F_k`` has several roots.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> inv = StaticInverse(m)
+    >>> x = inv.initial_state()
+    >>> [round(inv.step(x, y), 9) for y in (0.1, 1.35, 0.35)]
+    [0.0, 1.0, 0.0]
+    """
+
+    def __init__(self, model, input_range: float | None = None,
+                 reference_range: float | None = None):
+        m = model.static_part()
+        p, e, r = m.params, m.effects, m.radii
+        self.model, self.r, self.w, self.w0 = m, r, m.weights, m.reference_weights
+        n = self.n = r.size
+        self.input_range = float(2 * r[-1] if input_range is None else input_range)
+        rr = 0.0 if reference_range is None else float(reference_range)
+        if not (math.isfinite(rr) and rr >= 0):
+            raise ValueError(f"reference_range: expected a finite value >= 0, got {rr!r}")
+        self.span = max(2 * float(r[-1]), rr / max(abs(self.w.sum()), 1e-12), 1.0)
+        self.creep = "creep" in e
+        self.m = 0
+        if self.creep:
+            taus = np.asarray(p["creep_time_constants_s"], float)
+            self.a_lag = np.exp(-m.dt / taus)
+            self.ga = np.asarray(p["creep_lag_gains"], float) * self.a_lag
+            self.m = taus.size
+        self.asym = "asymmetry" in e
+        self.rate = "rate" in e
+        if self.rate:
+            gains, family, tau = _rate_params(p)
+            self.rg, self.rw = np.zeros(n), np.zeros(n)  # per play: g_b r_i or g_b w0_i
+            for g, idx in zip(gains, play_bands(n, gains.size), strict=True):
+                if family == "radius":
+                    self.rg[idx] = g * r[idx]
+                else:
+                    self.rw[idx] = g * self.w0[idx]
+            self.step_size = STEP_SHARE * self.input_range
+            self.tau = tau
+            self.a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
+        # state: started, v_prev, guess, z[n], L[m], (rate) rho_f, memory[n]
+        self.size = 3 + n + self.m + (1 + n if self.rate else 0)
+
+    def labels(self) -> list[str]:
+        """Names of the state values.
+
+        Returns
+        -------
+        list of str
+            ``started``, ``v_prev``, ``guess`` (the root rule's branch guess), ``z[1..n]``,
+            ``L[1..m]`` (creep lags) and, with a rate effect, ``rho_f``, ``m[1..n]``.
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> StaticInverse(DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)).labels()
+        ['started', 'v_prev', 'guess', 'z[1]', 'z[2]']
+        """
+        return (["started", "v_prev", "guess"] + _labels("z", self.n) + _labels("L", self.m)
+                + (["rho_f"] + _labels("m", self.n) if self.rate else []))
+
+    def initial_state(self) -> np.ndarray:
+        """The state before the first sample: not started, plays at rest at 0 (as
+        ``simulate``).
+
+        Returns
+        -------
+        numpy.ndarray
+            Zeros, ``size`` values (:meth:`labels`).
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> StaticInverse(DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3)).initial_state().tolist()
+        [0.0, 0.0, 0.0, 0.0]
+        """
+        return np.zeros(self.size)
+
+    def step(self, x: np.ndarray, yk: float) -> float:
+        """``v[k]`` for the (prefiltered) reference sample ``yk``; ``x`` advances in place.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The state after sample k - 1 (float64, :meth:`initial_state` at the start).
+        yk : float
+            The desired output of the static part at sample k.
+
+        Returns
+        -------
+        float
+            The input ``v[k]``.
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> inv = StaticInverse(DiagnosedModel([0.0], [2.0], 0.0, dt=1e-3))
+        >>> round(inv.step(inv.initial_state(), 1.0), 12)
+        0.5
+        """
+        m, p, r, w, w0, n = self.model, self.model.params, self.r, self.w, self.w0, self.n
+        first = x[0] == 0.0
+        v_prev, guess = float(x[1]), float(x[2])
+        z = x[3:3 + n].copy()
+        lags = x[3 + n:3 + n + self.m].copy()
+        rho_f = float(x[3 + n + self.m]) if self.rate else 0.0
+        memory = x[4 + n + self.m:].copy() if self.rate else None
+        span = self.span
+
+        def F(vs):
+            Zc = np.clip(z[None, :], vs[:, None] - r, vs[:, None] + r)
+            y = Zc @ w + m.offset
+            h0 = Zc @ w0 + m.reference_offset
+            if self.creep and not first:
+                y = y + (self.ga * lags).sum() - self.ga.sum() * h0
+            if self.asym:
+                u = (h0 - p["center"]) / p["half_range"]
+                y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
+            if self.rate and not first:
+                y = y + memory @ self.rg + rho_f * (Zc @ self.rw)
+            return y
+
+        b = np.concatenate((z - r, z + r, [v_prev]))
+        b = np.unique(np.concatenate((b, [b.min() - 10 * span, b.max() + 10 * span])))
+        roots = _roots(F, b, yk, cubic=self.asym)
+        gb = np.abs(F(b) - yk)
+        roots = np.concatenate((roots, b[gb <= 1e-10 * (1.0 + abs(yk))]))
+        if roots.size:
+            vk = float(roots[np.argmin(np.abs(roots - guess))])
+        else:  # out of reach: the breakpoint closest to the target
+            vk = float(b[np.argmin(gb)])
+        z_new = np.clip(z, vk - r, vk + r)
+        h = float(z_new @ w0 + m.reference_offset)
+        if self.creep:
+            lags = h + 0 * lags if first else self.a_lag * lags + (1 - self.a_lag) * h
+        if self.rate and not first:
+            dv = abs(vk - v_prev)
+            rho = dv / m.dt / p["rate_scale"] if dv <= self.step_size or self.tau > 0 else 0.0
+            rho_f = self.a_rate * rho_f + (1 - self.a_rate) * rho
+            gap = vk - z_new
+            contact = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
+            memory = np.where(contact, -np.sign(gap) * rho_f, memory)
+        x[2] = vk if first or abs(vk - v_prev) > 0.01 * span else 2 * vk - v_prev
+        x[0], x[1] = 1.0, vk
+        x[3:3 + n] = z_new
+        x[3 + n:3 + n + self.m] = lags
+        if self.rate:
+            x[3 + n + self.m] = rho_f
+            x[4 + n + self.m:] = memory
+        return vk
+
+
+class _InverseStream:
+    """The block's sample: prefilter sections, the delay's interpolation and the solver, on one
+    flat state ``[started, seen, v_rest, F_prev, sections (2 each), solver state]``."""
+
+    HEAD = 4
+
+    def __init__(self, model, input_range, reference_range):
+        self.solver = StaticInverse(model, input_range, reference_range)
+        self.sos, _ = _filter(model)
+        self.zi = None if self.sos is None else sosfilt_zi(self.sos)
+        self.ns = 0 if self.sos is None else self.sos.shape[0]
+        self.latency = inverse_latency(model)
+        self.frac = _delay(model)[1]
+        self.size = self.HEAD + 2 * self.ns + self.solver.size
+
+    def labels(self) -> list[str]:
+        return (["started", "seen", "v_rest", "F_prev"] + _labels("f", 2 * self.ns)
+                + [f"solver.{s}" for s in self.solver.labels()])
+
+    def step(self, x: np.ndarray, yd: float) -> float:
+        """``v`` output at this sample; ``x`` advances in place."""
+        s = x[self.HEAD:self.HEAD + 2 * self.ns].reshape(self.ns, 2)
+        solver_x = x[self.HEAD + 2 * self.ns:]
+        if x[0] == 0.0:
+            x[0] = 1.0
+            if self.ns:
+                s[:] = self.zi * yd
+            if self.latency:  # the inverse of y_d[0] at rest (output until the first solve)
+                x[2] = self.solver.step(self.solver.initial_state(), yd)
+        fk = yd
+        for i, (b0, b1, b2, _, a1, a2) in enumerate(self.sos if self.ns else ()):
+            y = b0 * fk + s[i, 0]  # transposed direct form II, as scipy.signal.sosfilt
+            s[i, 0] = b1 * fk - a1 * y + s[i, 1]
+            s[i, 1] = b2 * fk - a2 * y
+            fk = y
+        seen = int(x[1])
+        if seen >= self.latency:
+            ref = fk if self.frac == 0.0 else x[3] + (fk - x[3]) * self.frac
+            v = self.solver.step(solver_x, ref)
+        else:
+            v = float(x[2])
+            x[1] = seen + 1
+        x[3] = fk
+        return v
+
+
+def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
+                  input: str = "y_d", output: str = "v", input_range: float | None = None,
+                  reference_range: float | None = None) -> control.NonlinearIOSystem:
+    """The causal feedforward as a discrete python-control block (module docstring).
+
+    Parameters
+    ----------
+    inverse : DiagnosedInverse
+        The inverse.
+    dt : float, optional
+        Sample time [s]; must be the model's ``dt`` (default).
+    name, input, output : str
+        Block name (params prefix) and signal names.
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n`` (as ``simulate``).
+    reference_range : float, optional
+        :class:`StaticInverse`'s scale of the root rule; ``simulate`` uses
+        ``ptp(inverse.prefilter(y_d))``.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        ``v[k] = v_batch[k - A]`` (``A`` = :func:`inverse_latency`; ``v_rest`` before), direct
+        feedthrough when ``A = 0``; initial state all zeros; params ``"<name>.input_range"``,
+        ``"<name>.reference_range"``. The latency is also the block's attribute ``latency``.
+
+    Raises
+    ------
+    ValueError
+        ``dt`` other than the model's, a bad model parameter.
+
+    Examples
+    --------
+    >>> import control
+    >>> from pimodel.blocks import initial_state
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> blk = inverse_block(m.inverse())
+    >>> res = control.input_output_response(blk, np.arange(3) * 1e-3, [0.1, 1.35, 0.35],
+    ...                                     initial_state=initial_state(blk))
+    >>> res.outputs.round(9).tolist(), blk.latency
+    ([0.0, 1.0, 0.0], 0)
+    """
+    model = inverse.model
+    dt = model.dt if dt is None else float(dt)
+    if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
+        raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its filter "
+                         "and delay are per sample of that dt)")
+    stream = _InverseStream(model, input_range, reference_range)
+    defaults = {"input_range": stream.solver.input_range,
+                "reference_range": 0.0 if reference_range is None else float(reference_range)}
+    settings = _Settings(name, defaults, lambda s: _InverseStream(model, s["input_range"],
+                                                                  s["reference_range"]))
+    cache: dict = {}
+
+    def run(x, u, params):
+        key = (np.asarray(x, float).tobytes(), float(u[0]), id(settings.get(params)))
+        if key not in cache:
+            xs = np.array(x, dtype=float)
+            cache.clear()
+            cache[key] = (settings.get(params).step(xs, float(u[0])), xs)
+        return cache[key]
+
+    def upd(t, x, u, params):
+        return run(x, u, params)[1]
+
+    def out(t, x, u, params):
+        return np.array([run(x, u, params)[0]])
+
+    blk = _Block(upd, out, own_state=lambda params: np.zeros(stream.size), inputs=[input],
+                 outputs=[output], states=stream.labels(), dt=model.dt, name=name,
+                 params=settings.params)
+    blk.latency = stream.latency
+    return blk

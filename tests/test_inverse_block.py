@@ -1,0 +1,121 @@
+"""``DiagnosedInverse.block()`` (issue 19): the causal feedforward as a python-control block.
+
+It equals ``DiagnosedInverse.simulate`` delayed by its latency ``A`` (the samples the batch
+prefilter reads ahead: one for the dynamics' approximate inverse, the delay's whole samples and
+one more for a fractional delay) to 1e-9; its per-sample solver equals the batch solver; and
+``inverse.block() -> model.block()`` in ``control.interconnect`` tracks the reference delayed by
+``A`` with the batch's tracking error."""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+
+from pimodel.blocks import initial_state
+from pimodel.diagnosis.inverse_stream import StaticInverse, inverse_latency
+from pimodel.diagnosis.model import DiagnosedModel, _solve
+
+DT = 1e-3
+RADII = [0.0, 0.15, 0.4, 0.7, 1.0]
+PARAMS = {
+    "creep": {"creep_lag_gains": [0.04, 0.02], "creep_time_constants_s": [0.003, 0.03]},
+    "asymmetry": {"asymmetry_quadratic": 0.04, "asymmetry_cubic": 0.01, "center": 0.4,
+                  "half_range": 1.5},
+    "rate": {"rate_gains": [0.2, 0.1], "rate_family": "radius", "rate_time_constant_s": 0.0},
+    "dynamics": {"mode_hz": 40.0, "mode_damping": 0.3, "lti_elements": [["mode", 130.0, 0.1]],
+                 "lti_gains": [0.2]},
+    "delay": {"delay_samples": 2.5},
+}
+STATIC_CASES = {"nominal": {}, "creep": {}, "asymmetry": {}, "creep_asymmetry": {},
+                "rate_radius": {}, "rate_weight_filtered": {"rate_family": "weight",
+                                                            "rate_time_constant_s": 3e-3}}
+
+
+def model(effects, **extra) -> DiagnosedModel:
+    params = {"rate_scale": 5.0}
+    for e in effects:
+        params.update(PARAMS[e])
+    params.update(extra)
+    return DiagnosedModel(RADII, [1.0, 0.3, 0.25, 0.2, 0.1], 0.1, dt=DT, effects=tuple(effects),
+                          reference_weights=[0.9, 0.3, 0.3, 0.2, 0.1], reference_offset=0.05,
+                          params=params)
+
+
+def reference(m: DiagnosedModel, n: int = 700, rest: int = 12) -> np.ndarray:
+    """A reachable reference: the model's output for an input at rest over its first ``rest``
+    samples, with minor loops."""
+    t = np.arange(n) * DT
+    v = 0.8 * np.sin(2 * np.pi * 2.0 * t) + 0.2 * np.sin(2 * np.pi * 9.0 * t)
+    v[:rest] = 0.0
+    v[rest:] = v[rest:] - v[rest]
+    return m.simulate(v, input_range=2 * RADII[-1])
+
+
+@pytest.mark.parametrize("case", list(STATIC_CASES))
+def test_per_sample_solver_equals_the_batch_solver(case):
+    effects = {"nominal": (), "creep_asymmetry": ("creep", "asymmetry"),
+               "rate_radius": ("rate",), "rate_weight_filtered": ("rate",)}.get(case, (case,))
+    m = model(effects, **STATIC_CASES[case])
+    y_d = reference(m)
+    rng = 2 * RADII[-1]
+    want = _solve(m, y_d, rng)
+    inv = StaticInverse(m, rng, float(np.ptp(y_d)))
+    x = inv.initial_state()
+    got = np.array([inv.step(x, y) for y in y_d])
+    assert np.max(np.abs(got - want)) < 1e-12
+    assert inv.labels()[:3] == ["started", "v_prev", "guess"] and len(inv.labels()) == inv.size
+
+
+@pytest.mark.parametrize(("effects", "extra", "latency"), [
+    ((), {}, 0), (("creep",), {}, 0), (("dynamics",), {}, 1),
+    (("dynamics",), {"lti_elements": [["direct"]], "lti_gains": [0.1]}, 0),
+    (("delay",), {"delay_samples": 3}, 3), (("delay",), {}, 3),
+    (("dynamics", "delay"), {}, 4)])
+def test_latency_is_the_batch_prefilters_advance(effects, extra, latency):
+    assert inverse_latency(model(effects, **extra)) == latency
+
+
+@pytest.mark.parametrize("effects", [("dynamics", "delay", "creep"), ("delay",),
+                                     ("dynamics", "asymmetry"), ("creep", "rate")],
+                         ids=lambda e: "+".join(e))
+def test_block_equals_simulate_delayed_by_its_latency(effects):
+    m = model(effects)
+    inv = m.inverse()
+    y_d = reference(m)
+    want = inv.simulate(y_d)
+    blk = inv.block(reference_range=float(np.ptp(inv.prefilter(y_d))))
+    a = blk.latency
+    assert a == inverse_latency(m)
+    t = np.arange(y_d.size) * DT
+    res = control.input_output_response(blk, t, y_d, initial_state=initial_state(blk))
+    v = res.outputs
+    assert np.max(np.abs(v[a:] - want[:y_d.size - a])) < 1e-9
+    assert np.all(v[:a] == v[0]) and abs(v[0] - want[0]) < 1e-9  # at rest before
+    assert np.ptp(want) > 0.5
+
+
+def test_inverse_block_then_model_block_tracks_as_the_batch():
+    """control.interconnect(inverse.block -> model.block): the tracking error against the
+    reference delayed by the latency equals the batch error (simulate, then the model)."""
+    m = model(("dynamics", "delay", "creep"))
+    inv = m.inverse()
+    y_d = reference(m)
+    v_batch = inv.simulate(y_d)
+    e_batch = m.simulate(v_batch, input_range=2 * RADII[-1]) - y_d
+    ff = inv.block(reference_range=float(np.ptp(inv.prefilter(y_d))))
+    loop = control.interconnect([ff, m.block()], inputs=["y_d"], outputs=["y", "v"])
+    t = np.arange(y_d.size) * DT
+    res = control.input_output_response(loop, t, y_d, initial_state=initial_state(loop))
+    a = ff.latency
+    e_loop = res.outputs[0][a:] - y_d[:y_d.size - a]
+    assert np.max(np.abs(e_loop - e_batch[:y_d.size - a])) < 1e-9
+    assert np.sqrt(np.mean(e_batch**2)) < 0.1 * np.ptp(y_d)  # it does track
+
+
+def test_block_errors():
+    m = model(("dynamics",))
+    with pytest.raises(ValueError, match="dt: 0.002 differs"):
+        m.inverse().block(2e-3)
+    with pytest.raises(ValueError, match="reference_range: expected a finite value >= 0"):
+        m.inverse().block(reference_range=-1.0)
