@@ -100,7 +100,7 @@ def test_bad_rate_parameters():
 def test_model_inverse_of_rate_is_causal_and_close(family, gains):
     """The kept model's rate term (a family, filtered rate) and its causal inverse: ``v[k]`` of
     the inverse does not change when later references change, and the round trip stays close
-    to the input (the rate is held one sample)."""
+    to the input (the fresh rate of each sample from the rate-free inverse)."""
     v = _input()[:3000]
     params = {"rate_gains": gains, "rate_family": family, "rate_time_constant_s": 3e-3,
               "rate_scale": 60.0}
@@ -116,3 +116,29 @@ def test_model_inverse_of_rate_is_causal_and_close(family, gains):
     later = y.copy()
     later[2000:] += 0.3
     assert np.max(np.abs(inv.simulate(later)[:2000] - v_ff[:2000])) < 1e-12
+
+
+def test_inverse_of_an_instantaneous_rate_beats_ignoring_it():
+    """Radius family without a filter, gains as ``pimodel.truth``'s rate (linearised, the model
+    ``A v[k] + B' (v[k] - v[k-1])`` has its zero at ``z = B' / (A + B') = 2``, outside the unit
+    circle, so no exact causal inverse is stable): the inverse takes the fresh rate from the
+    rate-free inverse and recovers the input about 3x better than that inverse (measured 0.005
+    against 0.016 RMS; a rate held from sample k - 1 oscillated here, 0.031), and leaves about
+    a quarter of the rate term in the round trip (held: 1.1 times it)."""
+    v = _input()[:3000]
+    scale, span = 60.0, float(np.ptp(v))
+    gain = 2.0 * WEIGHTS.sum() * DT * scale / RADII.sum()  # B' = -2 A with every play pushed
+    params = {"rate_gains": [gain, gain], "rate_family": "radius",
+              "rate_time_constant_s": 0.0, "rate_scale": scale}
+    m = DiagnosedModel(RADII, WEIGHTS, 0.1, dt=DT, effects=("rate",), params=params)
+    rate_free = DiagnosedModel(RADII, WEIGHTS, 0.1, dt=DT)
+    y = m.simulate(v, input_range=span)
+    v_ff = m.inverse().simulate(y, input_range=span)
+    v0 = rate_free.inverse().simulate(y)
+
+    def rms(x):
+        return float(np.sqrt(np.mean(x**2)))
+
+    assert rms(v_ff - v) < 0.5 * rms(v0 - v)
+    miss = m.simulate(v_ff, input_range=span) - y
+    assert rms(miss) < 0.5 * rms(y - rate_free.simulate(v))

@@ -32,11 +32,25 @@ exact to rounding. Exact (round trip to 1e-9) for the nominal model and
 for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input.
 Approximations, by choice:
 
-* **rate**: the filtered rate of sample k is taken from sample k - 1 (radius family: the terms
-  as held at each play's last contact up to k - 1; weight family: ``rho_f[k-1]`` times the play
-  outputs of sample k). Solved exactly, a term in ``|v[k] - v[k-1]| / (dt rate_scale)`` makes
-  ``F_k`` steep and non-monotone, and the feedforward follows wrong roots (measured with the
-  radius family: open-loop errors 6 to 9 times the nominal's).
+* **rate**: the rate of sample k is not taken from the solution's own ``v[k]``. The model's
+  filtered rate is ``rho_f[k] = a rho_f[k-1] + (1 - a) rho[k]`` with the instantaneous
+  ``rho[k] = |v[k] - v[k-1]| / (dt rate_scale)`` (``a = 0`` without a filter). The inverse
+  keeps the model's own ``rho_f[k-1]`` (of its solution) and takes the fresh ``rho[k]`` from a
+  source that does not feed back: the rate of ``v0``, the inverse of the model without its rate
+  term (the same step rule); ``v0[k]`` depends on ``y_d[0..k]``, so the feedforward stays
+  causal. With that ``rho_f[k]``, ``F_k`` is again piecewise linear and solved exactly; the
+  plays' held terms take the solution's own rate at their last contact, as the model does. The
+  model's term then differs from the assumed one by ``(1 - a) (rho[k] - rho_v0[k])``: the
+  round trip is close, not exact. Why not exact: with the rate of ``v[k]`` itself the model is,
+  linearised on a branch, ``y[k] = A v[k] + B' (v[k] - v[k-1])`` with ``B' = -sum g_b r_i /
+  (dt rate_scale)``, a zero at ``z = B' / (A + B')``; on ``pimodel.truth`` (``tau = 0``)
+  ``z`` is 1.8 to 2.1 (the fitted models and the truth alike), so the exact inverse is unstable
+  (an error grows about 2x per sample). A rate held from sample k - 1 (the earlier choice,
+  ``A z^2 + B' z - B' = 0``: complex roots of modulus 1.4) makes the feedforward oscillate
+  from sample to sample (it tracked worse than the nominal inverse, 0.71x to 0.94x), and
+  repeated passes, each on the previous pass' rate, diverge after the first. Measured
+  open-loop cuts against the nominal inverse: ``pimodel.truth`` rate 8.9x to 9.3x,
+  ``pimodel.truth_alt`` rate 28x to 47x (``docs/notes/ff-rate.md``).
 * **delay**: not inverted; the feedforward is advanced by the delay (``y_d[k + d]``, linear
   interpolation): it needs the reference ``d`` samples ahead (a known trajectory).
 * **dynamics**: the linear part ``G`` is replaced by a stable approximate inverse
@@ -62,7 +76,7 @@ from ..operator import PIOperator
 from .drift import drift_term
 from .effects import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
-from .rate import RATE_FAMILIES, STEP_SHARE, play_bands, rate_columns
+from .rate import RATE_FAMILIES, STEP_SHARE, input_rate, play_bands, rate_columns
 
 if TYPE_CHECKING:
     import control
@@ -617,7 +631,8 @@ def _advance(x, d):
 
 
 def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
-    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring)."""
+    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring; the rate of sample k from
+    :func:`_source_rate`)."""
     p, e, r = m.params, m.effects, m.radii
     n = r.size
     w, w0 = m.weights, m.reference_weights
@@ -641,6 +656,7 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
         step = STEP_SHARE * input_range
         a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
         rho_f = 0.0  # filtered rate of sample k - 1
+        fresh = _source_rate(m, yd, input_range, tau)  # the rate of sample k, not fed back
     z = np.zeros(n)
     v_prev = 0.0
     out = np.empty(yd.size)
@@ -651,7 +667,8 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
         first = k == 0
 
         def F(vs, z=z, v_prev=v_prev, first=first, lags=lags if creep else None,
-              memory=memory if rate else None, rho_f=rho_f if rate else None):
+              memory=memory if rate else None,
+              rho_k=a_rate * rho_f + (1 - a_rate) * fresh[k] if rate else None):
             Zc = np.clip(z[None, :], vs[:, None] - r, vs[:, None] + r)
             y = Zc @ w + m.offset
             h0 = Zc @ w0 + m.reference_offset
@@ -660,8 +677,10 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
             if asym:
                 u = (h0 - p["center"]) / p["half_range"]
                 y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-            if rate and not first:  # the rate held from sample k - 1 (module docstring)
-                y = y + memory @ rg + rho_f * (Zc @ rw)
+            if rate and not first:  # the fresh rate from the source (module docstring)
+                gap = vs[:, None] - Zc
+                touch = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
+                y = y + np.where(touch, -np.sign(gap) * rho_k, memory) @ rg + rho_k * (Zc @ rw)
             return y
 
         b = np.concatenate((z - r, z + r, [v_prev]))
@@ -690,6 +709,18 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
         guess = vk if first or abs(vk - v_prev) > 0.01 * span else 2 * vk - v_prev
         z, v_prev = z_new, vk
     return out
+
+
+def _source_rate(m: DiagnosedModel, yd: np.ndarray, input_range: float,
+                 tau: float) -> np.ndarray:
+    """The normalised rate ``|v0[k] - v0[k-1]| / (dt rate_scale)`` of ``v0``, the inverse of
+    the model without its rate term (the step rule of ``tau = 0`` applied): the rate of sample
+    k the rate inverse assumes (module docstring). ``v0[k]`` depends on ``yd[0..k]``."""
+    v0 = _solve(replace(m, effects=tuple(e for e in m.effects if e != "rate")), yd,
+                input_range)
+    # a low-passed rate counts every jump (no step rule): an infinite range
+    return input_rate(v0, m.dt, m.params["rate_scale"], 0.0,
+                      input_range if tau == 0 else np.inf)
 
 
 _NODES = {False: np.array([0.25, 0.75]), True: np.array([0.125, 0.375, 0.625, 0.875])}
