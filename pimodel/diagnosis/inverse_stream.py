@@ -27,6 +27,7 @@ sample by sample (:class:`StaticInverse`, the per-sample form of the model modul
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import control
 import numpy as np
@@ -148,8 +149,14 @@ class StaticInverse:
             self.step_size = STEP_SHARE * self.input_range
             self.tau = tau
             self.a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
-        # state: started, v_prev, guess, z[n], L[m], (rate) rho_f, memory[n]
-        self.size = 3 + n + self.m + (1 + n if self.rate else 0)
+            # the fresh rate's source: the inverse of the model without its rate term, in
+            # lockstep (a low-passed rate counts every jump: no step rule)
+            self.source = StaticInverse(replace(m, effects=tuple(x for x in e if x != "rate")),
+                                        input_range, reference_range)
+            self.source_step = self.step_size if tau == 0 else math.inf
+        # state: started, v_prev, guess, z[n], L[m], (rate) rho_f, memory[n], v0_prev and the
+        # source's state
+        self.size = 3 + n + self.m + (2 + n + self.source.size if self.rate else 0)
 
     def labels(self) -> list[str]:
         """Names of the state values.
@@ -158,7 +165,8 @@ class StaticInverse:
         -------
         list of str
             ``started``, ``v_prev``, ``guess`` (the root rule's branch guess), ``z[1..n]``,
-            ``L[1..m]`` (creep lags) and, with a rate effect, ``rho_f``, ``m[1..n]``.
+            ``L[1..m]`` (creep lags) and, with a rate effect, ``rho_f``, ``m[1..n]``,
+            ``v0_prev`` and ``source.*`` (the rate-free inverse that gives the fresh rate).
 
         Examples
         --------
@@ -166,8 +174,9 @@ class StaticInverse:
         >>> StaticInverse(DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)).labels()
         ['started', 'v_prev', 'guess', 'z[1]', 'z[2]']
         """
-        return (["started", "v_prev", "guess"] + _labels("z", self.n) + _labels("L", self.m)
-                + (["rho_f"] + _labels("m", self.n) if self.rate else []))
+        rate = (["rho_f"] + _labels("m", self.n) + ["v0_prev"]
+                + [f"source.{s}" for s in self.source.labels()]) if self.rate else []
+        return ["started", "v_prev", "guess"] + _labels("z", self.n) + _labels("L", self.m) + rate
 
     def initial_state(self) -> np.ndarray:
         """The state before the first sample: not started, plays at rest at 0 (as
@@ -214,8 +223,15 @@ class StaticInverse:
         z = x[3:3 + n].copy()
         lags = x[3 + n:3 + n + self.m].copy()
         rho_f = float(x[3 + n + self.m]) if self.rate else 0.0
-        memory = x[4 + n + self.m:].copy() if self.rate else None
+        memory = x[4 + n + self.m:4 + 2 * n + self.m].copy() if self.rate else None
         span = self.span
+        if self.rate:  # the fresh rate of sample k from the rate-free inverse v0 (not fed back)
+            i0 = 4 + 2 * n + self.m
+            v0 = self.source.step(x[i0 + 1:], yk)  # advances the source's state in place
+            dv0 = 0.0 if first else abs(v0 - x[i0])
+            fresh = dv0 / m.dt / p["rate_scale"] if dv0 <= self.source_step else 0.0
+            x[i0] = v0
+            rho_k = self.a_rate * rho_f + (1 - self.a_rate) * fresh
 
         def F(vs):
             Zc = np.clip(z[None, :], vs[:, None] - r, vs[:, None] + r)
@@ -226,8 +242,11 @@ class StaticInverse:
             if self.asym:
                 u = (h0 - p["center"]) / p["half_range"]
                 y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-            if self.rate and not first:
-                y = y + memory @ self.rg + rho_f * (Zc @ self.rw)
+            if self.rate and not first:  # the fresh rate (model module docstring)
+                gap = vs[:, None] - Zc
+                touch = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
+                y = y + np.where(touch, -np.sign(gap) * rho_k, memory) @ self.rg \
+                    + rho_k * (Zc @ self.rw)
             return y
 
         b = np.concatenate((z - r, z + r, [v_prev]))
@@ -256,7 +275,7 @@ class StaticInverse:
         x[3 + n:3 + n + self.m] = lags
         if self.rate:
             x[3 + n + self.m] = rho_f
-            x[4 + n + self.m:] = memory
+            x[4 + n + self.m:4 + 2 * n + self.m] = memory
         return vk
 
 

@@ -76,7 +76,7 @@ from ..operator import PIOperator
 from .drift import drift_term
 from .effects import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
-from .rate import RATE_FAMILIES, STEP_SHARE, input_rate, play_bands, rate_columns
+from .rate import RATE_FAMILIES, rate_columns
 
 if TYPE_CHECKING:
     import control
@@ -631,96 +631,14 @@ def _advance(x, d):
 
 
 def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
-    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring; the rate of sample k from
-    :func:`_source_rate`)."""
-    p, e, r = m.params, m.effects, m.radii
-    n = r.size
-    w, w0 = m.weights, m.reference_weights
-    creep = "creep" in e
-    if creep:
-        ga = np.asarray(p["creep_lag_gains"]) * np.exp(-m.dt / np.asarray(
-            p["creep_time_constants_s"]))
-        a_lag = np.exp(-m.dt / np.asarray(p["creep_time_constants_s"]))
-        lags = np.zeros(ga.size)
-    asym = "asymmetry" in e
-    rate = "rate" in e
-    if rate:
-        gains, family, tau = _rate_params(p)
-        rg, rw = np.zeros(n), np.zeros(n)  # per play: g_b r_i (radius) or g_b w0_i (weight)
-        for g, idx in zip(gains, play_bands(n, gains.size), strict=True):
-            if family == "radius":
-                rg[idx] = g * r[idx]
-            else:
-                rw[idx] = g * w0[idx]
-        memory = np.zeros(n)  # -s_i rho_f at the last contact of play i
-        step = STEP_SHARE * input_range
-        a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
-        rho_f = 0.0  # filtered rate of sample k - 1
-        fresh = _source_rate(m, yd, input_range, tau)  # the rate of sample k, not fed back
-    z = np.zeros(n)
-    v_prev = 0.0
-    out = np.empty(yd.size)
-    span = max(2 * float(r[-1]), float(np.ptp(yd)) / max(abs(w.sum()), 1e-12), 1.0)
+    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring): the per-sample solver
+    :class:`~pimodel.diagnosis.inverse_stream.StaticInverse` over the record, its root rule
+    scaled by the reference's range."""
+    from .inverse_stream import StaticInverse  # it builds on this module's root finder
 
-    guess = 0.0
-    for k in range(yd.size):
-        first = k == 0
-
-        def F(vs, z=z, v_prev=v_prev, first=first, lags=lags if creep else None,
-              memory=memory if rate else None,
-              rho_k=a_rate * rho_f + (1 - a_rate) * fresh[k] if rate else None):
-            Zc = np.clip(z[None, :], vs[:, None] - r, vs[:, None] + r)
-            y = Zc @ w + m.offset
-            h0 = Zc @ w0 + m.reference_offset
-            if creep and not first:
-                y = y + (ga * lags).sum() - ga.sum() * h0
-            if asym:
-                u = (h0 - p["center"]) / p["half_range"]
-                y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-            if rate and not first:  # the fresh rate from the source (module docstring)
-                gap = vs[:, None] - Zc
-                touch = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
-                y = y + np.where(touch, -np.sign(gap) * rho_k, memory) @ rg + rho_k * (Zc @ rw)
-            return y
-
-        b = np.concatenate((z - r, z + r, [v_prev]))
-        b = np.unique(np.concatenate((b, [b.min() - 10 * span, b.max() + 10 * span])))
-        roots = _roots(F, b, yd[k], cubic=asym)
-        gb = np.abs(F(b) - yd[k])
-        roots = np.concatenate((roots, b[gb <= 1e-10 * (1.0 + abs(yd[k]))]))
-        if roots.size:
-            vk = float(roots[np.argmin(np.abs(roots - guess))])
-        else:  # out of reach: the breakpoint closest to the target
-            vk = float(b[np.argmin(gb)])
-        out[k] = vk
-        z_new = np.clip(z, vk - r, vk + r)
-        h = float(z_new @ w0 + m.reference_offset)
-        if creep:
-            lags = h + 0 * lags if first else a_lag * lags + (1 - a_lag) * h
-        if rate and not first:
-            dv = abs(vk - v_prev)
-            rho = dv / m.dt / p["rate_scale"] if dv <= step or tau > 0 else 0.0
-            rho_f = a_rate * rho_f + (1 - a_rate) * rho
-            gap = vk - z_new
-            contact = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
-            memory = np.where(contact, -np.sign(gap) * rho_f, memory)
-        # the next sample takes the root nearest the extrapolated input (a smooth input's
-        # branch), or nearest this one after a jump (a step)
-        guess = vk if first or abs(vk - v_prev) > 0.01 * span else 2 * vk - v_prev
-        z, v_prev = z_new, vk
-    return out
-
-
-def _source_rate(m: DiagnosedModel, yd: np.ndarray, input_range: float,
-                 tau: float) -> np.ndarray:
-    """The normalised rate ``|v0[k] - v0[k-1]| / (dt rate_scale)`` of ``v0``, the inverse of
-    the model without its rate term (the step rule of ``tau = 0`` applied): the rate of sample
-    k the rate inverse assumes (module docstring). ``v0[k]`` depends on ``yd[0..k]``."""
-    v0 = _solve(replace(m, effects=tuple(e for e in m.effects if e != "rate")), yd,
-                input_range)
-    # a low-passed rate counts every jump (no step rule): an infinite range
-    return input_rate(v0, m.dt, m.params["rate_scale"], 0.0,
-                      input_range if tau == 0 else np.inf)
+    inv = StaticInverse(m, input_range, float(np.ptp(yd)))
+    x = inv.initial_state()
+    return np.array([inv.step(x, float(y)) for y in yd])
 
 
 _NODES = {False: np.array([0.25, 0.75]), True: np.array([0.125, 0.375, 0.625, 0.875])}
