@@ -57,6 +57,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ..operator import PIOperator
 from .drift import drift_term
@@ -70,6 +71,7 @@ if TYPE_CHECKING:
 __all__ = ["DiagnosedModel", "DiagnosedInverse", "load_diagnosed_model"]
 
 KIND = "DiagnosedModel"
+INITIAL_STATES = ("rest", "unknown")  # as diagnose(initial_state=...)
 
 
 @dataclass(frozen=True)
@@ -96,6 +98,12 @@ class DiagnosedModel:
         ``drift_t0_train`` for a level per record, :mod:`.drift`);
         ``mode_hz``, ``mode_damping``, ``lti_elements``, ``lti_gains`` (:mod:`.lti`);
         ``delay_samples``.
+    initial_state : {"rest", "unknown"}
+        The diagnosis' assumption on the stage's memory at the start of a record
+        (:func:`~pimodel.diagnosis.diagnose`); the default of :meth:`DiagnosedInverse.simulate`
+        (``"unknown"``: the inverse starts from the memory that puts ``y_d[0]`` on the model's
+        output at rest, :meth:`DiagnosedInverse.initial_memory`). :meth:`simulate` starts at
+        rest either way (it has no output to match).
 
     Examples
     --------
@@ -113,6 +121,7 @@ class DiagnosedModel:
     reference_weights: np.ndarray | None = None
     reference_offset: float = 0.0
     params: dict = field(default_factory=dict)
+    initial_state: str = "rest"
 
     def __post_init__(self):
         r = np.asarray(self.radii, float)
@@ -136,6 +145,9 @@ class DiagnosedModel:
         object.__setattr__(self, "reference_offset", float(
             self.offset if self.reference_weights is None else self.reference_offset))
         object.__setattr__(self, "effects", tuple(self.effects))
+        if self.initial_state not in INITIAL_STATES:
+            raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got "
+                             f"{self.initial_state!r}")
 
     # -- construction -------------------------------------------------------------------
     @classmethod
@@ -150,7 +162,8 @@ class DiagnosedModel:
         if not augmented:
             nom = fitted["nominal"]
             return cls(radii, nom.coef[:n], float(nom.coef[n]), fitted["dt"], (),
-                       params={"rate_scale": nom.params["rate_scale"]})
+                       params={"rate_scale": nom.params["rate_scale"]},
+                       initial_state=fitted.get("initial_state", "rest"))
         model, ref = fitted["model"], fitted["reference"]
         q = n if V is None else V.shape[1]
         params = dict(model.params)
@@ -159,7 +172,7 @@ class DiagnosedModel:
             params["mode_hz"], params["mode_damping"] = model.grid["fn"], model.grid["zeta"]
         return cls(radii, play_weights(model.coef, q), float(model.coef[q]), fitted["dt"],
                    tuple(fitted["chosen"]), play_weights(ref.coef, q), float(ref.coef[q]),
-                   params)
+                   params, fitted.get("initial_state", "rest"))
 
     # -- forward ------------------------------------------------------------------------
     def _clock(self, v: np.ndarray, t) -> np.ndarray:
@@ -312,7 +325,8 @@ class DiagnosedModel:
         -------
         dict
             ``type``, ``radii``, ``weights``, ``offset``, ``dt``, ``effects``,
-            ``reference_weights``, ``reference_offset``, ``params`` (plain JSON values).
+            ``reference_weights``, ``reference_offset``, ``initial_state``, ``params``
+            (plain JSON values).
 
         Examples
         --------
@@ -326,7 +340,7 @@ class DiagnosedModel:
         return {"type": KIND, "radii": self.radii.tolist(), "weights": self.weights.tolist(),
                 "offset": self.offset, "dt": self.dt, "effects": list(self.effects),
                 "reference_weights": self.reference_weights.tolist(),
-                "reference_offset": self.reference_offset,
+                "reference_offset": self.reference_offset, "initial_state": self.initial_state,
                 "params": {k: (list(v) if isinstance(v, tuple) else v)
                            for k, v in self.params.items()}}
 
@@ -337,7 +351,8 @@ class DiagnosedModel:
             raise ValueError(f"model: expected a JSON object with type {KIND!r}")
         try:
             return cls(d["radii"], d["weights"], d["offset"], d["dt"], tuple(d["effects"]),
-                       d["reference_weights"], d["reference_offset"], dict(d["params"]))
+                       d["reference_weights"], d["reference_offset"], dict(d["params"]),
+                       d.get("initial_state", "rest"))
         except KeyError as err:
             raise ValueError(f"model: missing key {err.args[0]!r}") from None
 
@@ -515,7 +530,70 @@ class DiagnosedInverse:
             x = _advance(x, float(p["delay_samples"]))
         return x
 
-    def simulate(self, y_d, t=None, *, input_range: float | None = None) -> np.ndarray:
+    def initial_memory(self, y_0: float) -> np.ndarray:
+        """Play states before the first sample when the stage's memory is unknown: those of one
+        reversal at ``u`` (from rest, the input went to ``u`` and back to 0), with ``u`` chosen
+        so that the model's output at the input 0 is ``y_0`` (a ``y_0`` out of reach gives the
+        memory closest to it).
+
+        Play ``i`` then holds ``z_i = max(min(u + r_i, 0), -r_i)`` for ``u <= 0`` (an ascending
+        branch from a minimum, as after negative saturation) and ``min(max(u - r_i, 0), r_i)``
+        for ``u >= 0``; ``u = 0`` is the memory at rest. Only the static part counts (creep,
+        rate and dynamics act from the next sample; the output is that of :meth:`simulate`'s
+        model at its first sample with the input 0).
+
+        When several ``u`` reach ``y_0``, the largest ``|u|`` is taken: the weights of the
+        plays with large radii are the least determined by a fit, so the model's output along
+        this family can wiggle about ``y_0`` near saturation, and an output at rest far from
+        the model's own (the reason to start off rest) most likely follows a large excursion.
+        Measured on ``pimodel.truth_alt`` (records from negative saturation): the deepest
+        root left 0.0056 um open-loop RMS, the root nearest 0 0.012 um (creep, seed 1).
+
+        Parameters
+        ----------
+        y_0 : float
+            The first sample of the (prefiltered) reference [output units].
+
+        Returns
+        -------
+        numpy.ndarray
+            ``z_i`` [input units], one per play, ``|z_i| <= r_i``.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)
+        >>> m.inverse().initial_memory(-0.1).round(12).tolist()  # ascending branch, u = -0.7
+        [0.0, -0.2]
+        >>> m.inverse().initial_memory(0.0).tolist()  # the output at rest: at rest
+        [0.0, 0.0]
+        """
+        m = self.model.static_part()
+        r = m.radii
+        p = m.params
+
+        def memory(u: float) -> np.ndarray:
+            return np.clip(np.clip(0.0, u - r, u + r), -r, r)
+
+        def output(u: float) -> float:
+            z = memory(u)
+            y = float(z @ m.weights) + m.offset
+            if "asymmetry" in m.effects:
+                x = (float(z @ m.reference_weights) + m.reference_offset - p["center"]) / \
+                    p["half_range"]
+                y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
+            return y - float(y_0)
+
+        # the output is piecewise linear (cubic with the asymmetry) in u between these
+        u = np.unique(np.concatenate(([0.0], r, 2 * r, -r, -2 * r)))
+        f = np.array([output(x) for x in u])
+        roots = list(u[f == 0.0])
+        for i in np.flatnonzero(f[:-1] * f[1:] < 0):
+            roots.append(brentq(output, u[i], u[i + 1], xtol=1e-15 * (1.0 + float(r[-1]))))
+        best = max(roots, key=abs) if roots else float(u[np.argmin(np.abs(f))])
+        return memory(best)
+
+    def simulate(self, y_d, t=None, *, input_range: float | None = None,
+                 initial_state: str | None = None) -> np.ndarray:
         """Input ``v[k]`` that makes the model's output follow ``y_d[k]``.
 
         Parameters
@@ -527,6 +605,16 @@ class DiagnosedInverse:
         input_range : float, optional
             Range for the rate effect's step rule; default the diagnosis' train input span
             (``2 r_n``).
+        initial_state : {"rest", "unknown"}, optional
+            The stage's memory before the first sample; default the model's
+            :attr:`~DiagnosedModel.initial_state` (the diagnosis' assumption). ``"rest"``: the
+            plays at rest at 0 (the exact inverse of :meth:`DiagnosedModel.simulate`).
+            ``"unknown"``: the plays start from :meth:`initial_memory` of the first
+            (prefiltered) reference sample, so the stage is taken to sit at ``y_d[0]`` with
+            the input 0 instead of being driven there from rest. On a stage whose memory
+            differs from rest (e.g. after saturation), the rest assumption makes the inverse's
+            first inputs wrong, and a creep (log law) carries that start-up error through the
+            whole record; measured in ``docs/notes/ff-creep.md``.
 
         Returns
         -------
@@ -537,7 +625,7 @@ class DiagnosedInverse:
         Raises
         ------
         ValueError
-            ``y_d`` not a finite 1-D signal.
+            ``y_d`` not a finite 1-D signal, an unknown ``initial_state``.
 
         Examples
         --------
@@ -545,11 +633,19 @@ class DiagnosedInverse:
         >>> v = m.inverse().simulate([0.1, 0.6, 1.1])
         >>> bool(np.allclose(m.simulate(v), [0.1, 0.6, 1.1]))
         True
+        >>> # y_d[0] = 0 is below the output at rest (0.1): taken as an ascending branch
+        >>> m.inverse().simulate([0.0, 0.6], initial_state="unknown").round(6).tolist()
+        [0.0, 0.5]
         """
         yd = _signal(y_d, "y_d")
         self.model._clock(yd, t)
+        state = self.model.initial_state if initial_state is None else initial_state
+        if state not in INITIAL_STATES:
+            raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got {state!r}")
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
-        return _solve(self.model.static_part(), self.prefilter(yd), rng)
+        x = self.prefilter(yd)
+        z0 = self.initial_memory(x[0]) if state == "unknown" else None
+        return _solve(self.model.static_part(), x, rng, z0)
 
 
 def _advance(x, d):
@@ -558,8 +654,9 @@ def _advance(x, d):
     return np.interp(k, np.arange(x.size), x)
 
 
-def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
-    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring)."""
+def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float, z0=None) -> np.ndarray:
+    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring), the plays starting from
+    ``z0`` (None: at rest at 0)."""
     p, e, r = m.params, m.effects, m.radii
     n = r.size
     w, w0 = m.weights, m.reference_weights
@@ -583,7 +680,7 @@ def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
         step = STEP_SHARE * input_range
         a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
         rho_f = 0.0  # filtered rate of sample k - 1
-    z = np.zeros(n)
+    z = np.zeros(n) if z0 is None else np.array(z0, float)
     v_prev = 0.0
     out = np.empty(yd.size)
     span = max(2 * float(r[-1]), float(np.ptp(yd)) / max(abs(w.sum()), 1e-12), 1.0)
