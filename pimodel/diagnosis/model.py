@@ -29,7 +29,10 @@ The inverse solves, sample by sample, ``F_k(v[k]) = y_d[k]``: with the play stat
 and the rate memory of sample k - 1 fixed, ``F_k`` is a polynomial of degree at most 3 in
 ``v[k]`` between the play breakpoints ``z_i[k-1] -+ r_i`` (and ``v[k-1]``), so the root is
 exact to rounding. Exact (round trip to 1e-9) for the nominal model and
-for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input.
+for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input. The
+plays start at rest at 0, or, when the diagnosis took the stage's initial memory as unknown
+(``initial_state="unknown"``), from the memory of one reversal that puts ``y_d[0]`` on the
+model's output at the input 0 (:meth:`DiagnosedInverse.initial_memory`).
 Approximations, by choice:
 
 * **rate**: the filtered rate of sample k is taken from sample k - 1 (radius family: the terms
@@ -542,12 +545,15 @@ class DiagnosedInverse:
         rate and dynamics act from the next sample; the output is that of :meth:`simulate`'s
         model at its first sample with the input 0).
 
-        When several ``u`` reach ``y_0``, the largest ``|u|`` is taken: the weights of the
-        plays with large radii are the least determined by a fit, so the model's output along
-        this family can wiggle about ``y_0`` near saturation, and an output at rest far from
-        the model's own (the reason to start off rest) most likely follows a large excursion.
-        Measured on ``pimodel.truth_alt`` (records from negative saturation): the deepest
-        root left 0.0056 um open-loop RMS, the root nearest 0 0.012 um (creep, seed 1).
+        ``u`` lies on the side where the output moves towards ``y_0`` (below the output at
+        rest: ``u < 0`` for a model whose output rises with the input, the sign of
+        ``sum w_i``), and of the ``u`` there that reach ``y_0`` the one nearest 0 is taken: it
+        moves the fewest plays. Plays the record never moves keep their memory for good, and
+        at rest their constant share is already in the fitted offset; the weights of the
+        plays with large radii are also the least determined (the output along the family
+        can wiggle about ``y_0``). Measured on ``pimodel.truth_alt`` (records from negative
+        saturation), the deepest ``u`` that reaches ``y_0`` left, e.g., a rate model's
+        open-loop error 2.5 times that of the nearest (``docs/notes/ff-creep.md``).
 
         Parameters
         ----------
@@ -583,14 +589,22 @@ class DiagnosedInverse:
                 y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
             return y - float(y_0)
 
+        f0 = output(0.0)
+        if f0 == 0.0:
+            return memory(0.0)
+        rising = 1.0 if float(np.sum(m.weights)) >= 0 else -1.0
+        side = -1.0 if rising * f0 > 0 else 1.0  # the output at rest is above y_0: u < 0
         # the output is piecewise linear (cubic with the asymmetry) in u between these
-        u = np.unique(np.concatenate(([0.0], r, 2 * r, -r, -2 * r)))
-        f = np.array([output(x) for x in u])
-        roots = list(u[f == 0.0])
-        for i in np.flatnonzero(f[:-1] * f[1:] < 0):
-            roots.append(brentq(output, u[i], u[i + 1], xtol=1e-15 * (1.0 + float(r[-1]))))
-        best = max(roots, key=abs) if roots else float(u[np.argmin(np.abs(f))])
-        return memory(best)
+        u = side * np.unique(np.concatenate(([0.0], r, 2 * r)))
+        f = np.array([f0] + [output(x) for x in u[1:]])
+        cross = np.flatnonzero(f[:-1] * f[1:] <= 0)
+        if cross.size == 0:  # out of reach: the memory closest to it
+            return memory(float(u[np.argmin(np.abs(f))]))
+        i = int(cross[0])  # the crossing nearest 0
+        if f[i + 1] == 0.0:
+            return memory(float(u[i + 1]))
+        return memory(brentq(output, min(u[i], u[i + 1]), max(u[i], u[i + 1]),
+                             xtol=1e-15 * (1.0 + float(r[-1]))))
 
     def simulate(self, y_d, t=None, *, input_range: float | None = None,
                  initial_state: str | None = None) -> np.ndarray:
