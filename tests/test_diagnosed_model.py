@@ -75,10 +75,49 @@ def test_synthetic_creep_asymmetry_round_trip():
     assert np.max(np.abs(m.inverse().simulate(m.simulate(v)) - v)) < 1e-9
 
 
+@pytest.mark.parametrize("u", [-1.3, -0.6, 0.0, 0.45, 1.3])
+def test_unknown_initial_state_recovers_the_memory_of_a_reversal(u):
+    """A stage that went from rest to ``u`` and back to 0 before the reference starts (the
+    memory the rest inverse gets wrong): the inverse with ``initial_state="unknown"`` finds
+    that memory from ``y_d[0]`` and returns the input after the excursion exactly."""
+    params = {"asymmetry_quadratic": 0.05, "asymmetry_cubic": -0.01, "center": 0.3,
+              "half_range": 1.5}
+    m = DiagnosedModel([0.0, 0.2, 0.5], [1.0, 0.4, 0.3], 0.2, dt=1e-3, effects=("asymmetry",),
+                       reference_weights=[0.9, 0.45, 0.3], reference_offset=0.1, params=params)
+    prelude = np.concatenate((np.linspace(0.0, u, 50), np.linspace(u, 0.0, 50)[1:]))
+    t = np.arange(2000) * 1e-3
+    v = 0.8 * np.sin(2 * np.pi * 1.7 * t) * np.exp(-t)
+    y = m.simulate(np.concatenate((prelude, v)))[prelude.size:]
+    z = m.inverse().initial_memory(y[0])
+    expect = np.clip(np.clip(0.0, u - m.radii, u + m.radii), -m.radii, m.radii)
+    assert np.max(np.abs(z - expect)) < 1e-9
+    assert np.max(np.abs(m.inverse().simulate(y, initial_state="unknown") - v)) < 1e-9
+    if u != 0.0:  # from rest, the first inputs differ (the memory is not the rest's)
+        assert np.max(np.abs(m.inverse().simulate(y) - v)) > 1e-3
+
+
+def test_initial_state_comes_from_the_diagnosis(tmp_path):
+    m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3, initial_state="unknown")
+    again = load_diagnosed_model(m.save(tmp_path / "m.json"))
+    assert again.initial_state == "unknown"
+    old = m.to_dict()
+    del old["initial_state"]  # a model written before the field: at rest
+    assert DiagnosedModel.from_dict(old).initial_state == "rest"
+    # y_d[0] below the output at rest: the unknown memory starts on an ascending branch
+    y_d = np.array([-0.1, 0.3, 0.6])
+    assert m.inverse().simulate(y_d)[0] == pytest.approx(0.0, abs=1e-12)
+    # from rest, the input moves there (only the linear play follows a move below 0.5)
+    assert m.inverse().simulate(y_d, initial_state="rest")[0] == pytest.approx(-0.1)
+
+
 def test_bad_input():
     m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)
     with pytest.raises(ValueError, match="y_d"):
         m.inverse().simulate([1.0, np.nan, 2.0])
+    with pytest.raises(ValueError, match="initial_state"):
+        m.inverse().simulate([1.0, 2.0], initial_state="saturated")
+    with pytest.raises(ValueError, match="initial_state"):
+        DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3, initial_state="cold")
     with pytest.raises(ValueError, match="weights"):
         DiagnosedModel([0.0, 0.5], [1.0], 0.0, dt=1e-3)
     with pytest.raises(ValueError, match="effects"):

@@ -89,7 +89,7 @@ class DiagnosisReport:
     before, after : list of numpy.ndarray
         Validate predictions of the nominal and of the chosen model, one per record.
     fitted : dict, optional
-        Internals for :meth:`model` (radii, projection, models, dt); None in a report
+        Internals for :meth:`model` (radii, projection, models, dt, initial_state); None in a report
         rebuilt from JSON.
 
     Examples
@@ -467,7 +467,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     fitted = {"radii": radii, "projection": proj, "nominal": full_nominal,
               "reference": current.reference or nominal,
               "chosen": chosen,
-              "model": current, "dt": dt}
+              "model": current, "dt": dt, "initial_state": initial_state}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
                            fitted)
 

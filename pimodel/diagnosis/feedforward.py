@@ -5,7 +5,11 @@ The reference is the true stage's own noise-free response to the validate input 
 construction); the feedforward ``v_ff = model.inverse().simulate(y_d)`` drives the noise-free
 true stage, and the tracking error ``y - y_d`` is scored after the start-up region (until the
 input first spans 90 % of its range: the true stage's initial memory may differ from the
-model's plays at rest).
+model's plays at rest). The inverse starts from the memory the diagnosis assumed
+(:attr:`~pimodel.diagnosis.model.DiagnosedModel.initial_state`): with ``"unknown"`` from the
+memory that puts ``y_d[0]`` on the model's output at rest
+(:meth:`~pimodel.diagnosis.model.DiagnosedInverse.initial_memory`); a creep carries a start-up
+error far beyond the start-up region.
 """
 
 from __future__ import annotations

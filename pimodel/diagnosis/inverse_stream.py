@@ -178,14 +178,25 @@ class StaticInverse:
                 + [f"source.{s}" for s in self.source.labels()]) if self.rate else []
         return ["started", "v_prev", "guess"] + _labels("z", self.n) + _labels("L", self.m) + rate
 
-    def initial_state(self) -> np.ndarray:
-        """The state before the first sample: not started, plays at rest at 0 (as
-        ``simulate``).
+    def initial_state(self, z0=None) -> np.ndarray:
+        """The state before the first sample: not started, the plays at rest at 0 (as
+        ``simulate``) or at ``z0``.
+
+        Parameters
+        ----------
+        z0 : array_like, optional
+            The plays' outputs before the first sample (``DiagnosedInverse.initial_memory``
+            for a record that starts where the memory is unknown); default zeros.
 
         Returns
         -------
         numpy.ndarray
-            Zeros, ``size`` values (:meth:`labels`).
+            ``size`` values (:meth:`labels`); the rate source starts from the same plays.
+
+        Raises
+        ------
+        ValueError
+            ``z0`` not ``n`` finite values.
 
         Examples
         --------
@@ -193,7 +204,17 @@ class StaticInverse:
         >>> StaticInverse(DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3)).initial_state().tolist()
         [0.0, 0.0, 0.0, 0.0]
         """
-        return np.zeros(self.size)
+        x = np.zeros(self.size)
+        if z0 is not None:
+            z = np.asarray(z0, float)
+            if z.shape != (self.n,) or not np.all(np.isfinite(z)):
+                raise ValueError(f"z0: expected {self.n} finite play outputs, got shape "
+                                 f"{z.shape}")
+            x[3:3 + self.n] = z
+            if self.rate:
+                i0 = 5 + 2 * self.n + self.m
+                x[i0:] = self.source.initial_state(z)
+        return x
 
     def step(self, x: np.ndarray, yk: float) -> float:
         """``v[k]`` for the (prefiltered) reference sample ``yk``; ``x`` advances in place.

@@ -29,7 +29,10 @@ The inverse solves, sample by sample, ``F_k(v[k]) = y_d[k]``: with the play stat
 and the rate memory of sample k - 1 fixed, ``F_k`` is a polynomial of degree at most 3 in
 ``v[k]`` between the play breakpoints ``z_i[k-1] -+ r_i`` (and ``v[k-1]``), so the root is
 exact to rounding. Exact (round trip to 1e-9) for the nominal model and
-for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input.
+for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input. The
+plays start at rest at 0, or, when the diagnosis took the stage's initial memory as unknown
+(``initial_state="unknown"``), from the memory of one reversal that puts ``y_d[0]`` on the
+model's output at the input 0 (:meth:`DiagnosedInverse.initial_memory`).
 Approximations, by choice:
 
 * **rate**: the rate of sample k is not taken from the solution's own ``v[k]``. The model's
@@ -71,6 +74,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ..operator import PIOperator
 from .drift import drift_term
@@ -84,6 +88,7 @@ if TYPE_CHECKING:
 __all__ = ["DiagnosedModel", "DiagnosedInverse", "load_diagnosed_model"]
 
 KIND = "DiagnosedModel"
+INITIAL_STATES = ("rest", "unknown")  # as diagnose(initial_state=...)
 
 
 @dataclass(frozen=True)
@@ -110,6 +115,12 @@ class DiagnosedModel:
         ``drift_t0_train`` for a level per record, :mod:`.drift`);
         ``mode_hz``, ``mode_damping``, ``lti_elements``, ``lti_gains`` (:mod:`.lti`);
         ``delay_samples``.
+    initial_state : {"rest", "unknown"}
+        The diagnosis' assumption on the stage's memory at the start of a record
+        (:func:`~pimodel.diagnosis.diagnose`); the default of :meth:`DiagnosedInverse.simulate`
+        (``"unknown"``: the inverse starts from the memory that puts ``y_d[0]`` on the model's
+        output at rest, :meth:`DiagnosedInverse.initial_memory`). :meth:`simulate` starts at
+        rest either way (it has no output to match).
 
     Examples
     --------
@@ -127,6 +138,7 @@ class DiagnosedModel:
     reference_weights: np.ndarray | None = None
     reference_offset: float = 0.0
     params: dict = field(default_factory=dict)
+    initial_state: str = "rest"
 
     def __post_init__(self):
         r = np.asarray(self.radii, float)
@@ -150,6 +162,9 @@ class DiagnosedModel:
         object.__setattr__(self, "reference_offset", float(
             self.offset if self.reference_weights is None else self.reference_offset))
         object.__setattr__(self, "effects", tuple(self.effects))
+        if self.initial_state not in INITIAL_STATES:
+            raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got "
+                             f"{self.initial_state!r}")
 
     # -- construction -------------------------------------------------------------------
     @classmethod
@@ -164,7 +179,8 @@ class DiagnosedModel:
         if not augmented:
             nom = fitted["nominal"]
             return cls(radii, nom.coef[:n], float(nom.coef[n]), fitted["dt"], (),
-                       params={"rate_scale": nom.params["rate_scale"]})
+                       params={"rate_scale": nom.params["rate_scale"]},
+                       initial_state=fitted.get("initial_state", "rest"))
         model, ref = fitted["model"], fitted["reference"]
         q = n if V is None else V.shape[1]
         params = dict(model.params)
@@ -173,7 +189,7 @@ class DiagnosedModel:
             params["mode_hz"], params["mode_damping"] = model.grid["fn"], model.grid["zeta"]
         return cls(radii, play_weights(model.coef, q), float(model.coef[q]), fitted["dt"],
                    tuple(fitted["chosen"]), play_weights(ref.coef, q), float(ref.coef[q]),
-                   params)
+                   params, fitted.get("initial_state", "rest"))
 
     # -- forward ------------------------------------------------------------------------
     def _clock(self, v: np.ndarray, t) -> np.ndarray:
@@ -326,7 +342,8 @@ class DiagnosedModel:
         -------
         dict
             ``type``, ``radii``, ``weights``, ``offset``, ``dt``, ``effects``,
-            ``reference_weights``, ``reference_offset``, ``params`` (plain JSON values).
+            ``reference_weights``, ``reference_offset``, ``initial_state``, ``params``
+            (plain JSON values).
 
         Examples
         --------
@@ -340,7 +357,7 @@ class DiagnosedModel:
         return {"type": KIND, "radii": self.radii.tolist(), "weights": self.weights.tolist(),
                 "offset": self.offset, "dt": self.dt, "effects": list(self.effects),
                 "reference_weights": self.reference_weights.tolist(),
-                "reference_offset": self.reference_offset,
+                "reference_offset": self.reference_offset, "initial_state": self.initial_state,
                 "params": {k: (list(v) if isinstance(v, tuple) else v)
                            for k, v in self.params.items()}}
 
@@ -351,7 +368,8 @@ class DiagnosedModel:
             raise ValueError(f"model: expected a JSON object with type {KIND!r}")
         try:
             return cls(d["radii"], d["weights"], d["offset"], d["dt"], tuple(d["effects"]),
-                       d["reference_weights"], d["reference_offset"], dict(d["params"]))
+                       d["reference_weights"], d["reference_offset"], dict(d["params"]),
+                       d.get("initial_state", "rest"))
         except KeyError as err:
             raise ValueError(f"model: missing key {err.args[0]!r}") from None
 
@@ -529,7 +547,81 @@ class DiagnosedInverse:
             x = _advance(x, float(p["delay_samples"]))
         return x
 
-    def simulate(self, y_d, t=None, *, input_range: float | None = None) -> np.ndarray:
+    def initial_memory(self, y_0: float) -> np.ndarray:
+        """Play states before the first sample when the stage's memory is unknown: those of one
+        reversal at ``u`` (from rest, the input went to ``u`` and back to 0), with ``u`` chosen
+        so that the model's output at the input 0 is ``y_0`` (a ``y_0`` out of reach gives the
+        memory closest to it).
+
+        Play ``i`` then holds ``z_i = max(min(u + r_i, 0), -r_i)`` for ``u <= 0`` (an ascending
+        branch from a minimum, as after negative saturation) and ``min(max(u - r_i, 0), r_i)``
+        for ``u >= 0``; ``u = 0`` is the memory at rest. Only the static part counts (creep,
+        rate and dynamics act from the next sample; the output is that of :meth:`simulate`'s
+        model at its first sample with the input 0).
+
+        ``u`` lies on the side where the output moves towards ``y_0`` (below the output at
+        rest: ``u < 0`` for a model whose output rises with the input, the sign of
+        ``sum w_i``), and of the ``u`` there that reach ``y_0`` the one nearest 0 is taken: it
+        moves the fewest plays. Plays the record never moves keep their memory for good, and
+        at rest their constant share is already in the fitted offset; the weights of the
+        plays with large radii are also the least determined (the output along the family
+        can wiggle about ``y_0``). Measured on ``pimodel.truth_alt`` (records from negative
+        saturation), the deepest ``u`` that reaches ``y_0`` left, e.g., a rate model's
+        open-loop error 2.5 times that of the nearest (``docs/notes/ff-creep.md``).
+
+        Parameters
+        ----------
+        y_0 : float
+            The first sample of the (prefiltered) reference [output units].
+
+        Returns
+        -------
+        numpy.ndarray
+            ``z_i`` [input units], one per play, ``|z_i| <= r_i``.
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)
+        >>> m.inverse().initial_memory(-0.1).round(12).tolist()  # ascending branch, u = -0.7
+        [0.0, -0.2]
+        >>> m.inverse().initial_memory(0.0).tolist()  # the output at rest: at rest
+        [0.0, 0.0]
+        """
+        m = self.model.static_part()
+        r = m.radii
+        p = m.params
+
+        def memory(u: float) -> np.ndarray:
+            return np.clip(np.clip(0.0, u - r, u + r), -r, r)
+
+        def output(u: float) -> float:
+            z = memory(u)
+            y = float(z @ m.weights) + m.offset
+            if "asymmetry" in m.effects:
+                x = (float(z @ m.reference_weights) + m.reference_offset - p["center"]) / \
+                    p["half_range"]
+                y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
+            return y - float(y_0)
+
+        f0 = output(0.0)
+        if f0 == 0.0:
+            return memory(0.0)
+        rising = 1.0 if float(np.sum(m.weights)) >= 0 else -1.0
+        side = -1.0 if rising * f0 > 0 else 1.0  # the output at rest is above y_0: u < 0
+        # the output is piecewise linear (cubic with the asymmetry) in u between these
+        u = side * np.unique(np.concatenate(([0.0], r, 2 * r)))
+        f = np.array([f0] + [output(x) for x in u[1:]])
+        cross = np.flatnonzero(f[:-1] * f[1:] <= 0)
+        if cross.size == 0:  # out of reach: the memory closest to it
+            return memory(float(u[np.argmin(np.abs(f))]))
+        i = int(cross[0])  # the crossing nearest 0
+        if f[i + 1] == 0.0:
+            return memory(float(u[i + 1]))
+        return memory(brentq(output, min(u[i], u[i + 1]), max(u[i], u[i + 1]),
+                             xtol=1e-15 * (1.0 + float(r[-1]))))
+
+    def simulate(self, y_d, t=None, *, input_range: float | None = None,
+                 initial_state: str | None = None) -> np.ndarray:
         """Input ``v[k]`` that makes the model's output follow ``y_d[k]``.
 
         Parameters
@@ -541,6 +633,16 @@ class DiagnosedInverse:
         input_range : float, optional
             Range for the rate effect's step rule; default the diagnosis' train input span
             (``2 r_n``).
+        initial_state : {"rest", "unknown"}, optional
+            The stage's memory before the first sample; default the model's
+            :attr:`~DiagnosedModel.initial_state` (the diagnosis' assumption). ``"rest"``: the
+            plays at rest at 0 (the exact inverse of :meth:`DiagnosedModel.simulate`).
+            ``"unknown"``: the plays start from :meth:`initial_memory` of the first
+            (prefiltered) reference sample, so the stage is taken to sit at ``y_d[0]`` with
+            the input 0 instead of being driven there from rest. On a stage whose memory
+            differs from rest (e.g. after saturation), the rest assumption makes the inverse's
+            first inputs wrong, and a creep (log law) carries that start-up error through the
+            whole record; measured in ``docs/notes/ff-creep.md``.
 
         Returns
         -------
@@ -551,7 +653,7 @@ class DiagnosedInverse:
         Raises
         ------
         ValueError
-            ``y_d`` not a finite 1-D signal.
+            ``y_d`` not a finite 1-D signal, an unknown ``initial_state``.
 
         Examples
         --------
@@ -559,11 +661,19 @@ class DiagnosedInverse:
         >>> v = m.inverse().simulate([0.1, 0.6, 1.1])
         >>> bool(np.allclose(m.simulate(v), [0.1, 0.6, 1.1]))
         True
+        >>> # y_d[0] = 0 is below the output at rest (0.1): taken as an ascending branch
+        >>> m.inverse().simulate([0.0, 0.6], initial_state="unknown").round(6).tolist()
+        [0.0, 0.5]
         """
         yd = _signal(y_d, "y_d")
         self.model._clock(yd, t)
+        state = self.model.initial_state if initial_state is None else initial_state
+        if state not in INITIAL_STATES:
+            raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got {state!r}")
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
-        return _solve(self.model.static_part(), self.prefilter(yd), rng)
+        x = self.prefilter(yd)
+        z0 = self.initial_memory(x[0]) if state == "unknown" else None
+        return _solve(self.model.static_part(), x, rng, z0)
 
     def block(self, dt: float | None = None, *, name: str = "inverse", input: str = "y_d",
               output: str = "v", input_range: float | None = None,
@@ -630,14 +740,15 @@ def _advance(x, d):
     return np.interp(k, np.arange(x.size), x)
 
 
-def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
-    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring): the per-sample solver
+def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float, z0=None) -> np.ndarray:
+    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring), the plays starting from
+    ``z0`` (None: at rest at 0): the per-sample solver
     :class:`~pimodel.diagnosis.inverse_stream.StaticInverse` over the record, its root rule
     scaled by the reference's range."""
     from .inverse_stream import StaticInverse  # it builds on this module's root finder
 
     inv = StaticInverse(m, input_range, float(np.ptp(yd)))
-    x = inv.initial_state()
+    x = inv.initial_state(z0)
     return np.array([inv.step(x, float(y)) for y in yd])
 
 
