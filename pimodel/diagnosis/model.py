@@ -62,6 +62,7 @@ from ..operator import PIOperator
 from .drift import drift_term
 from .effects import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
+from .monotone import monotone_model
 from .rate import RATE_FAMILIES, STEP_SHARE, play_bands, rate_columns
 
 if TYPE_CHECKING:
@@ -560,6 +561,7 @@ def _advance(x, d):
 
 def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float) -> np.ndarray:
     """Per-sample root of ``F_k(v) = yd[k]`` (module docstring)."""
+    m = monotone_model(m)  # a model that folds is inverted through its nearest monotone one
     p, e, r = m.params, m.effects, m.radii
     n = r.size
     w, w0 = m.weights, m.reference_weights
