@@ -39,7 +39,7 @@ def test_inverse_round_trip_is_exact(invertible):
     """Exact for a monotone model; a model that folds (signed weights with a partial sum <= 0,
     here the asymmetry record's nominal fit) is inverted through its nearest monotone model
     (:mod:`pimodel.diagnosis.monotone`), whose round trip is exact."""
-    effect, rep, rec = invertible
+    _, rep, rec = invertible
     v = rec.v[:N_ROUND_TRIP]
     for model in (rep.model(), rep.model(augmented=False)):
         monotone = monotone_model(model)

@@ -26,8 +26,9 @@ Bound: with ``d_m = z_m - z_{m+1}`` (``|d_m| <= r_{m+1} - r_m``), ``y' - y = sum
 S_m) d_m + (S'_n - S_n) z_n``. The memory of the plays, ``z`` against ``r``, has slopes -1, +1
 or 0 between its corners, so on a memory of ``c`` pieces ``|y' - y| <= 2 c max_j |Phi'_j -
 Phi_j| + sum over the cells holding a corner of ``|S'_m - S_m| (r_{m+1} - r_m)`` (+ the
-last term): :func:`monotone_error` gives ``max_j |Phi'_j - Phi_j|``. On major loops (one
-reversal) the forward output moves by at most about twice that.
+last term): :func:`monotone_error` gives ``E = max_j |Phi'_j - Phi_j|``. On major loops (one
+reversal in the memory) the outputs differ by at most ``2 E`` plus one cell's
+``|S'_m - S_m| (r_{m+1} - r_m)`` (held on the shared real record by a test).
 
 A model whose partial sums are all positive is returned unchanged, so the inverse stays exact
 (round trip to 1e-9) wherever it was.
@@ -54,8 +55,8 @@ def _check(weights, radii) -> tuple[np.ndarray, np.ndarray]:
     if w.ndim != 1 or w.size == 0 or w.shape != r.shape or not np.all(np.isfinite(w)):
         raise ValueError(f"weights: expected {r.size} finite values like radii, got shape "
                          f"{w.shape}")
-    if np.any(r < 0) or np.any(np.diff(r) <= 0):
-        raise ValueError("radii: expected non-negative, strictly ascending values")
+    if np.any(r < 0) or np.any(np.diff(r) < 0):
+        raise ValueError("radii: expected non-negative, ascending values")
     return w, r
 
 
@@ -87,7 +88,8 @@ def monotone_weights(weights, radii, *, floor_share: float = FLOOR_SHARE) -> np.
     weights : array_like
         Play weights ``w_i`` [output / input units], signed.
     radii : array_like
-        Play radii ``r_i`` [input units], strictly ascending.
+        Play radii ``r_i`` [input units], ascending (plays of equal radii are merged into
+        the last of them).
     floor_share : float
         The projected partial sums are at least ``floor_share`` times the median partial sum.
 
@@ -101,7 +103,7 @@ def monotone_weights(weights, radii, *, floor_share: float = FLOOR_SHARE) -> np.
     Raises
     ------
     ValueError
-        Lengths differ, radii not strictly ascending, ``floor_share`` not in (0, 1], or a
+        Lengths differ, radii not ascending, ``floor_share`` not in (0, 1], or a
         median partial sum that is not positive (no monotone model is near).
 
     Examples
@@ -117,6 +119,12 @@ def monotone_weights(weights, radii, *, floor_share: float = FLOOR_SHARE) -> np.
         raise ValueError(f"floor_share: expected a value in (0, 1], got {floor_share!r}")
     if is_monotone(w):
         return w.copy()
+    last = np.append(np.diff(r) > 0, True)  # plays of equal radii act as one: the last holds it
+    if not np.all(last):
+        out = np.zeros_like(w)
+        out[last] = monotone_weights(np.add.reduceat(w, np.flatnonzero(np.diff(
+            r, prepend=-1.0) > 0)), r[last], floor_share=floor_share)
+        return out
     S = np.cumsum(w)
     f = floor_share * float(np.median(S))
     if not f > 0:
