@@ -4,6 +4,8 @@ projection is monotone on every branch, close to the model in branch shape, the 
 monotone model, and the inverse's one-sample step is bounded by the reference's step over the
 projected slope floor (no jumps). The shared real record's nominal fit is such a model."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -108,6 +110,11 @@ def test_folding_model_inverse_has_no_jumps():
 def test_monotone_model_is_the_identity_on_monotone_models():
     m = DiagnosedModel([0.0, 0.5, 1.0], [1.0, -0.3, 0.2], 0.1, dt=1e-3)
     assert monotone_model(m) is m
+    # with an effect a sample's slope is not a partial sum: such models are left alone
+    fold = DiagnosedModel([0.0, 0.5, 1.0], [1.0, -1.5, 1.0], 0.1, dt=1e-3, effects=("creep",),
+                          params={"creep_lag_gains": [0.05], "creep_time_constants_s": [0.1]})
+    assert monotone_model(fold) is fold
+    assert monotone_model(replace(fold, effects=("delay",))) is not fold
     v = np.sin(np.linspace(0, 12, 800))
     assert np.max(np.abs(m.inverse().simulate(m.simulate(v)) - v)) < 1e-9
 

@@ -30,7 +30,8 @@ and the rate memory of sample k - 1 fixed, ``F_k`` is a polynomial of degree at 
 ``v[k]`` between the play breakpoints ``z_i[k-1] -+ r_i`` (and ``v[k-1]``), so the root is
 exact to rounding. Exact (round trip to 1e-9) for the nominal model and
 for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input.
-A model whose hysteresis weights fold (a partial sum ``w_1 + ... + w_m <= 0``, as signed
+A model without creep, asymmetry or rate whose hysteresis weights fold (a partial sum
+``w_1 + ... + w_m <= 0``, as signed
 fine-grid least squares can give: its branches turn back, and the root the inverse follows
 vanishes there, so it jumped to a far one) is inverted through its nearest monotone model
 (:func:`.monotone.monotone_model`: branch slopes at least a floor, the branch curve closest in

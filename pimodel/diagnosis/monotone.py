@@ -169,20 +169,23 @@ def monotone_error(weights, projected, radii) -> float:
 
 
 def monotone_model(model: DiagnosedModel) -> DiagnosedModel:
-    """The model with its hysteresis weights (and reference weights) made monotone.
+    """The model with its hysteresis weights made monotone, where that makes it invertible.
 
     Parameters
     ----------
     model : DiagnosedModel
-        A diagnosis' model.
+        A diagnosis' model (the inverse passes its static part: no dynamics, no delay).
 
     Returns
     -------
     DiagnosedModel
-        ``model`` itself when its weights and reference weights are monotone; else a copy with
-        :func:`monotone_weights` of each. The effect terms are not changed (creep, asymmetry
-        and rate can still make a sample's map non-monotone: their roots are chosen as
-        before).
+        A copy with :func:`monotone_weights` of its weights when the model inverts as a plain
+        PI (no creep, asymmetry or rate; drift is not inverted) and the weights fold;
+        ``model`` itself otherwise. With creep, asymmetry or rate the slope of a sample's map
+        is not a partial sum of the weights (for example ``S(w) - G S(w0)`` with creep, or
+        the rate term's share of the reference weights ``w0``), so the projection would not
+        make it monotone and would change terms the effect fitted; those models are inverted
+        as they are.
 
     Examples
     --------
@@ -191,8 +194,6 @@ def monotone_model(model: DiagnosedModel) -> DiagnosedModel:
     >>> is_monotone(monotone_model(m).weights)
     True
     """
-    w, w0 = model.weights, model.reference_weights
-    if is_monotone(w) and is_monotone(w0):
+    if set(model.effects) & {"creep", "asymmetry", "rate"} or is_monotone(model.weights):
         return model
-    return replace(model, weights=monotone_weights(w, model.radii),
-                   reference_weights=monotone_weights(w0, model.radii))
+    return replace(model, weights=monotone_weights(model.weights, model.radii))
