@@ -107,6 +107,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.lti",
     "pimodel.diagnosis.where",
     "pimodel.diagnosis.noise",
+    "pimodel.diagnosis.monotone",
     "pimodel.diagnosis.plots",
     "pimodel.diagnosis.rate",
     "pimodel.truth",

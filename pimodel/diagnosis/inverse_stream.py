@@ -36,6 +36,7 @@ from scipy.signal import sosfilt_zi
 from ..blocks import _Block, _labels, _Settings
 from .lti import inverse_sos
 from .model import _rate_params, _roots
+from .monotone import monotone_model
 from .rate import STEP_SHARE, play_bands
 
 __all__ = ["StaticInverse", "inverse_block", "inverse_latency"]
@@ -120,7 +121,8 @@ class StaticInverse:
 
     def __init__(self, model, input_range: float | None = None,
                  reference_range: float | None = None):
-        m = model.static_part()
+        # a model that folds is inverted through its nearest monotone one (model module docs)
+        m = monotone_model(model.static_part())
         p, e, r = m.params, m.effects, m.radii
         self.model, self.r, self.w, self.w0 = m, r, m.weights, m.reference_weights
         n = self.n = r.size

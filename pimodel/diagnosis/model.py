@@ -33,6 +33,14 @@ for creep and asymmetry, alone or together, while ``F_k`` is monotone near the i
 plays start at rest at 0, or, when the diagnosis took the stage's initial memory as unknown
 (``initial_state="unknown"``), from the memory of one reversal that puts ``y_d[0]`` on the
 model's output at the input 0 (:meth:`DiagnosedInverse.initial_memory`).
+A model without creep, asymmetry or rate whose hysteresis weights fold (a partial sum
+``w_1 + ... + w_m <= 0``, as signed
+fine-grid least squares can give: its branches turn back, and the root the inverse follows
+vanishes there, so it jumped to a far one) is inverted through its nearest monotone model
+(:func:`.monotone.monotone_model`: branch slopes at least a floor, the branch curve closest in
+the maximum norm): the inverse is then exact for that model, misses the folding model by at
+most the documented branch distance, and its one-sample step is at most the reference's step
+over the floor slope. A monotone model is inverted as it is.
 Approximations, by choice:
 
 * **rate**: the rate of sample k is not taken from the solution's own ``v[k]``. The model's
