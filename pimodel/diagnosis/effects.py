@@ -85,7 +85,7 @@ class Segment:
         their regressors in (:func:`_fit`)."""
         rows = self.__dict__.get("_rows")
         if rows is None or rows.shape[1] != self.Z.shape[0]:
-            rows = self.__dict__["_rows"] = np.vstack((self.Z.T, np.ones((1, self.Z.shape[0]))))
+            rows = self.__dict__["_rows"] = _stack_rows((self.Z.T, np.ones((1, self.Z.shape[0]))))
         n = self.Z.shape[1]
         if offset:
             return rows
@@ -356,8 +356,7 @@ class Model:
         >>> Model("nominal", 0, base_features, np.array([3.0, 0.0])).predict(seg).tolist()
         [0.0, 3.0]
         """
-        rows = getattr(self.features, "rows", None)  # the regressors as rows: no transpose
-        out = self.coef @ rows(seg) if rows is not None else self.features(seg) @ self.coef
+        out = _combine(_row_parts(self.features, seg), self.coef)
         return out if self.adjust is None else self.adjust(seg, out)
 
 
@@ -365,20 +364,63 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     """Least squares over all train records through the normal equations (columns scaled to
     unit norm; the Gram matrix is small), so a grid search costs one pass over the data per
     point; the residual sum of squares is computed from the residuals themselves. The
-    regressors are taken as rows (``features.rows``, shape (p, N)) when the builder has them:
-    stacking rows copies contiguous memory, stacking columns transposes."""
-    rows = getattr(features, "rows", None)
-    blocks = [rows(s)[:, s.used] if rows is not None else features(s)[s.used].T
-              for s in train]  # (p, n) each
+    regressors are taken as blocks of rows when the builder has them (:func:`_row_parts`): no
+    copy of the play columns at each point of a search."""
+    blocks = [tuple(P[:, s.used] for P in _row_parts(features, s)) for s in train]
     ys = [s.y[s.used] for s in train]
-    G = sum(B @ B.T for B in blocks)
-    g = sum(B @ y for B, y in zip(blocks, ys, strict=True))
+    G = sum(_gram(P) for P in blocks)
+    g = sum(np.concatenate([X @ y for X in P]) for P, y in zip(blocks, ys, strict=True))
     d = np.sqrt(np.diag(G))
     d[d == 0] = 1.0
     c, *_ = np.linalg.lstsq(G / d[:, None] / d[None, :], g / d, rcond=1e-13)
     coef = c / d
-    rss = float(sum(np.sum((coef @ B - y) ** 2) for B, y in zip(blocks, ys, strict=True)))
+    rss = float(sum(np.sum((_combine(P, coef) - y) ** 2) for P, y in zip(blocks, ys,
+                                                                          strict=True)))
     return Model(name, k, features, coef, params or {}), rss
+
+
+def _stack_rows(parts) -> np.ndarray:
+    """The blocks of rows ``parts`` (each (p_i, N), any layout) stacked, C-contiguous
+    (``np.vstack`` keeps a column-major layout when its inputs have one)."""
+    out = np.empty((sum(X.shape[0] for X in parts), parts[0].shape[1]))
+    i = 0
+    for X in parts:
+        out[i:i + X.shape[0]] = X
+        i += X.shape[0]
+    return out
+
+
+def _row_parts(features, s: Segment) -> tuple:
+    """The regressors of ``s`` as blocks of rows (shape (p_i, N) each, stacked in order they
+    are the transposed ``features(s)``): ``features.parts`` or ``features.rows`` when the builder
+    has them (no copy: the fits and predictions work on the blocks), else the transpose."""
+    if hasattr(features, "parts"):
+        return features.parts(s)
+    if hasattr(features, "rows"):
+        return (features.rows(s),)
+    return (features(s).T,)
+
+
+def _gram(P: tuple) -> np.ndarray:
+    """``B B^T`` of the rows ``B`` the blocks ``P`` stack, block by block."""
+    edges = np.cumsum([0] + [X.shape[0] for X in P])
+    G = np.empty((edges[-1], edges[-1]))
+    for i, X in enumerate(P):
+        for j in range(i, len(P)):
+            blk = X @ X.T if j == i else X @ P[j].T
+            G[edges[i]:edges[i + 1], edges[j]:edges[j + 1]] = blk
+            G[edges[j]:edges[j + 1], edges[i]:edges[i + 1]] = blk.T
+    return G
+
+
+def _combine(P: tuple, coef: np.ndarray) -> np.ndarray:
+    """``coef @ B`` for the rows ``B`` the blocks ``P`` stack."""
+    out, i = None, 0
+    for X in P:
+        term = coef[i:i + X.shape[0]] @ X
+        out = term if out is None else out + term
+        i += X.shape[0]
+    return out
 
 
 def _ones(s: Segment) -> np.ndarray:
@@ -621,7 +663,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
         def lti_regressors(fn, zeta, els):
             feats = _combo_features(effects, lti_point(fn, zeta, els), nominal, static, ncols)
-            return [feats.rows(s)[:, s.used].T for s in train], [s.y[s.used] for s in train]
+            return ([_stack_rows(feats.parts(s))[:, s.used].T for s in train],
+                    [s.y[s.used] for s in train])
 
         fn, zeta, elements, lti_trace = select_order(
             lambda fn, zeta, els: search([lti_point(fn, zeta, els)])[1], lti_regressors,
@@ -676,8 +719,9 @@ def _combo_k(effects) -> int:
 def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
     """Feature builder for the effects with grid parameters ``p``; the columns that do not
     depend on ``p`` (offset, creep, asymmetry) are memoised per segment in ``static`` (the rate
-    columns per filter in the segment's ``rate_basis``). The regressors are built as rows
-    (``feats.rows(s)``, shape (p, N)); ``feats(s)`` is their transpose (a view)."""
+    columns per filter in the segment's ``rate_basis``). The regressors are built as two blocks
+    of rows (``feats.parts(s)``: the play rows, then the others; :func:`_row_parts`);
+    ``feats(s)`` is the transpose of their stack."""
 
     def static_rows(s: Segment) -> np.ndarray:
         key = id(s)
@@ -692,7 +736,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             static[key] = (s, np.vstack(out))  # keep s alive so its id stays unique
         return static[key][1]
 
-    def rows(s: Segment) -> np.ndarray:
+    def rows(s: Segment) -> tuple[np.ndarray, np.ndarray]:  # the play rows, then the others
         Z = s.play_rows(ncols)
         if "dynamics" in effects:  # filter the play rows
             last = static.get(("mode", id(s), ncols))  # the last mode filtered, for a delay
@@ -714,12 +758,12 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "drift" in effects:  # the trend column last
             parts.append(drift_columns(s.t, p, static["train"].get(id(s)),
                                        len(static["train"])).T)
-        return np.vstack(parts)
+        return Z, _stack_rows(parts[1:])
 
     def feats(s: Segment) -> np.ndarray:
-        return rows(s).T
+        return _stack_rows(rows(s)).T
 
-    feats.rows = rows
+    feats.parts = rows
     return feats
 
 
