@@ -80,9 +80,32 @@ class Segment:
         return float(self.t[1] - self.t[0])
 
     def play_rows(self, ncols: int | None = None, *, offset: bool = False) -> np.ndarray:
-        """The leading ``ncols`` play outputs as rows (shape (ncols, N), C-contiguous; built
-        once and kept), followed by a row of ones with ``offset``: the layout the fits stack
-        their regressors in (:func:`_fit`)."""
+        """The play outputs as rows, the layout the fits stack their regressors in.
+
+        Built once per segment and kept (C-contiguous), so a search does not transpose ``Z``
+        at each point.
+
+        Parameters
+        ----------
+        ncols : int or None
+            The leading play outputs wanted; None: all ``n``.
+        offset : bool
+            Return all play rows followed by a row of ones (the nominal's regressors; ``ncols``
+            is then ignored).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``Z[:, :ncols].T``, shape (ncols, N) (a view of the kept array); with ``offset``
+            shape (n + 1, N).
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.5]), np.zeros(3),
+        ...                    [0.0, 0.5])
+        >>> seg.play_rows(1).tolist(), seg.play_rows(offset=True).shape
+        ([[0.0, 1.0, 0.5]], (3, 3))
+        """
         rows = self.__dict__.get("_rows")
         if rows is None or rows.shape[1] != self.Z.shape[0]:
             rows = self.__dict__["_rows"] = _stack_rows((self.Z.T, np.ones((1, self.Z.shape[0]))))
