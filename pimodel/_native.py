@@ -286,3 +286,33 @@ def health_checks(weights: np.ndarray, history: np.ndarray, *, linear_play: bool
                                 ctypes.byref(rng), fit, merged, pinned)
     return {"flags": int(flags), "drift": drift.value, "input_range": rng.value, "fit": fit,
             "merged": merged[: n - 1].astype(bool), "pinned": pinned.astype(bool)}
+
+
+lib.pim_biquad_rows.restype = None
+lib.pim_biquad_rows.argtypes = [c_size, c_size, F64, F64, F64, F64]
+
+
+def biquad_rows(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """A filter of order <= 2 (``b``, ``a`` with ``a[0] = 1``) on each row of ``x``, each row at
+    rest around its first sample (``fmu/src/pim_filter.h``; equals
+    ``scipy.signal.lfilter(b, a, x, zi=lfilter_zi(b, a)[None, :] * x[:, :1])``).
+
+    Parameters
+    ----------
+    b, a : numpy.ndarray
+        Numerator and denominator in powers of ``z^-1``, at most 3 coefficients each.
+    x : numpy.ndarray
+        Signals as rows, shape (m, N) (1-D: one signal).
+
+    Returns
+    -------
+    numpy.ndarray
+        The filtered signals, shape of ``x``.
+    """
+    bb, aa = np.zeros(3), np.zeros(3)
+    bb[:len(b)], aa[:len(a)] = b, a
+    xc = np.ascontiguousarray(x, dtype=float)
+    out = np.empty_like(xc)
+    rows = xc.reshape(-1, xc.shape[-1]) if xc.ndim else xc
+    lib.pim_biquad_rows(rows.shape[0], rows.shape[1], bb, aa, rows, out.reshape(rows.shape))
+    return out

@@ -13,8 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import minimize_scalar
-from scipy.signal import cont2discrete, lfilter, lfilter_zi
+from scipy.signal import cont2discrete, lfilter
 
+from .._native import biquad_rows
 from ..operator import PIOperator
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
@@ -77,6 +78,41 @@ class Segment:
     def dt(self) -> float:
         """Sample time ``t[1] - t[0]`` [s]."""
         return float(self.t[1] - self.t[0])
+
+    def play_rows(self, ncols: int | None = None, *, offset: bool = False) -> np.ndarray:
+        """The play outputs as rows, the layout the fits stack their regressors in.
+
+        Built once per segment and kept (C-contiguous), so a search does not transpose ``Z``
+        at each point.
+
+        Parameters
+        ----------
+        ncols : int or None
+            The leading play outputs wanted; None: all ``n``.
+        offset : bool
+            Return all play rows followed by a row of ones (the nominal's regressors; ``ncols``
+            is then ignored).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``Z[:, :ncols].T``, shape (ncols, N) (a view of the kept array); with ``offset``
+            shape (n + 1, N).
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.5]), np.zeros(3),
+        ...                    [0.0, 0.5])
+        >>> seg.play_rows(1).tolist(), seg.play_rows(offset=True).shape
+        ([[0.0, 1.0, 0.5]], (3, 3))
+        """
+        rows = self.__dict__.get("_rows")
+        if rows is None or rows.shape[1] != self.Z.shape[0]:
+            rows = self.__dict__["_rows"] = _stack_rows((self.Z.T, np.ones((1, self.Z.shape[0]))))
+        n = self.Z.shape[1]
+        if offset:
+            return rows
+        return rows[:n if ncols is None else min(ncols, n)]
 
 
 def make_segment(t, v, y, radii, mask=None) -> Segment:
@@ -209,10 +245,8 @@ def mode(x: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
     >>> round(float(y[1]), 6), round(float(y[-1]), 3)
     (0.0, 1.0)
     """
-    b, a = mode_coefficients(fn, zeta, dt)
-    zi = lfilter_zi(b, a)
     if x.ndim == 1:
-        return lfilter(b, a, x, zi=zi * x[0])[0]
+        return mode_rows(x[None, :], fn, zeta, dt)[0]
     return mode_rows(np.ascontiguousarray(x.T), fn, zeta, dt).T
 
 
@@ -241,14 +275,13 @@ def mode_rows(xt: np.ndarray, fn: float, zeta: float, dt: float) -> np.ndarray:
     >>> bool(np.allclose(mode_rows(x[None, :], 50.0, 0.7, 1e-3)[0], mode(x, 50.0, 0.7, 1e-3)))
     True
     """
-    b, a = mode_coefficients(fn, zeta, dt)
-    out, _ = lfilter(b, a, xt, axis=-1, zi=lfilter_zi(b, a)[None, :] * xt[:, :1])
-    return out
+    # the C core's biquad (scipy.signal.lfilter's form and start, tests/test_diagnosis_filter)
+    return biquad_rows(*mode_coefficients(fn, zeta, dt), xt)
 
 
-def shift(x: np.ndarray, d: float) -> np.ndarray:
-    """``x`` delayed by ``d >= 0`` samples (rows; held at ``x[0]`` before the start); a
-    fractional part interpolates linearly between the two neighbouring whole delays.
+def shift(x: np.ndarray, d: float, axis: int = 0) -> np.ndarray:
+    """``x`` delayed by ``d >= 0`` samples (along ``axis``; held at ``x[0]`` before the start);
+    a fractional part interpolates linearly between the two neighbouring whole delays.
 
     Parameters
     ----------
@@ -256,6 +289,8 @@ def shift(x: np.ndarray, d: float) -> np.ndarray:
         Signal ``x[k]``, 1-D or (N, m) (rows are samples).
     d : float
         Delay [samples], ``d >= 0``.
+    axis : int
+        The time axis of ``x`` (0: rows are samples; -1: signals as rows, shape (m, N)).
 
     Returns
     -------
@@ -266,15 +301,21 @@ def shift(x: np.ndarray, d: float) -> np.ndarray:
     --------
     >>> shift(np.arange(4.0), 1).tolist(), shift(np.arange(4.0), 0.5).tolist()
     ([0.0, 0.0, 1.0, 2.0], [0.0, 0.5, 1.5, 2.5])
+    >>> shift(np.arange(4.0)[None, :], 1, axis=-1).tolist()
+    [[0.0, 0.0, 1.0, 2.0]]
     """
     n = int(np.floor(d))
     f = float(d) - n
     if f > 1e-12:
-        return (1.0 - f) * shift(x, n) + f * shift(x, n + 1)
+        return (1.0 - f) * shift(x, n, axis) + f * shift(x, n + 1, axis)
     if n == 0:
         return x
-    pad = np.repeat(x[:1], n, axis=0)
-    return np.concatenate((pad, x[: x.shape[0] - n]), axis=0)
+    out = np.empty_like(x)  # the layout of x (signals as rows stay rows)
+    xt, ot = np.moveaxis(x, axis, 0), np.moveaxis(out, axis, 0)
+    lead = min(n, xt.shape[0])
+    ot[:lead] = xt[:1]
+    ot[lead:] = xt[:xt.shape[0] - n]
+    return out
 
 
 @dataclass
@@ -338,24 +379,71 @@ class Model:
         >>> Model("nominal", 0, base_features, np.array([3.0, 0.0])).predict(seg).tolist()
         [0.0, 3.0]
         """
-        out = self.features(seg) @ self.coef
+        out = _combine(_row_parts(self.features, seg), self.coef)
         return out if self.adjust is None else self.adjust(seg, out)
 
 
 def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     """Least squares over all train records through the normal equations (columns scaled to
     unit norm; the Gram matrix is small), so a grid search costs one pass over the data per
-    point; the residual sum of squares is computed from the residuals themselves."""
-    blocks = [features(s)[s.used] for s in train]
+    point; the residual sum of squares is computed from the residuals themselves. The
+    regressors are taken as blocks of rows when the builder has them (:func:`_row_parts`): no
+    copy of the play columns at each point of a search."""
+    blocks = [tuple(P[:, s.used] for P in _row_parts(features, s)) for s in train]
     ys = [s.y[s.used] for s in train]
-    G = sum(A.T @ A for A in blocks)
-    g = sum(A.T @ y for A, y in zip(blocks, ys, strict=True))
+    G = sum(_gram(P) for P in blocks)
+    g = sum(np.concatenate([X @ y for X in P]) for P, y in zip(blocks, ys, strict=True))
     d = np.sqrt(np.diag(G))
     d[d == 0] = 1.0
     c, *_ = np.linalg.lstsq(G / d[:, None] / d[None, :], g / d, rcond=1e-13)
     coef = c / d
-    rss = float(sum(np.sum((A @ coef - y) ** 2) for A, y in zip(blocks, ys, strict=True)))
+    rss = float(sum(np.sum((_combine(P, coef) - y) ** 2) for P, y in zip(blocks, ys,
+                                                                          strict=True)))
     return Model(name, k, features, coef, params or {}), rss
+
+
+def _stack_rows(parts) -> np.ndarray:
+    """The blocks of rows ``parts`` (each (p_i, N), any layout) stacked, C-contiguous
+    (``np.vstack`` keeps a column-major layout when its inputs have one)."""
+    out = np.empty((sum(X.shape[0] for X in parts), parts[0].shape[1]))
+    i = 0
+    for X in parts:
+        out[i:i + X.shape[0]] = X
+        i += X.shape[0]
+    return out
+
+
+def _row_parts(features, s: Segment) -> tuple:
+    """The regressors of ``s`` as blocks of rows (shape (p_i, N) each, stacked in order they
+    are the transposed ``features(s)``): ``features.parts`` or ``features.rows`` when the builder
+    has them (no copy: the fits and predictions work on the blocks), else the transpose."""
+    if hasattr(features, "parts"):
+        return features.parts(s)
+    if hasattr(features, "rows"):
+        return (features.rows(s),)
+    return (features(s).T,)
+
+
+def _gram(P: tuple) -> np.ndarray:
+    """``B B^T`` of the rows ``B`` the blocks ``P`` stack, block by block."""
+    edges = np.cumsum([0] + [X.shape[0] for X in P])
+    G = np.empty((edges[-1], edges[-1]))
+    for i, X in enumerate(P):
+        for j in range(i, len(P)):
+            blk = X @ X.T if j == i else X @ P[j].T
+            G[edges[i]:edges[i + 1], edges[j]:edges[j + 1]] = blk
+            G[edges[j]:edges[j + 1], edges[i]:edges[i + 1]] = blk.T
+    return G
+
+
+def _combine(P: tuple, coef: np.ndarray) -> np.ndarray:
+    """``coef @ B`` for the rows ``B`` the blocks ``P`` stack."""
+    out, i = None, 0
+    for X in P:
+        term = coef[i:i + X.shape[0]] @ X
+        out = term if out is None else out + term
+        i += X.shape[0]
+    return out
 
 
 def _ones(s: Segment) -> np.ndarray:
@@ -381,7 +469,14 @@ def base_features(s: Segment) -> np.ndarray:
     >>> base_features(seg).tolist()
     [[0.0, 0.0, 1.0], [1.0, 0.5, 1.0]]
     """
-    return np.hstack((s.Z, _ones(s)))
+    return _base_rows(s).T
+
+
+def _base_rows(s: Segment) -> np.ndarray:
+    return s.play_rows(offset=True)
+
+
+base_features.rows = _base_rows
 
 
 def fit_nominal(train) -> Model:
@@ -591,7 +686,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
         def lti_regressors(fn, zeta, els):
             feats = _combo_features(effects, lti_point(fn, zeta, els), nominal, static, ncols)
-            return [feats(s)[s.used] for s in train], [s.y[s.used] for s in train]
+            return ([_stack_rows(feats.parts(s))[:, s.used].T for s in train],
+                    [s.y[s.used] for s in train])
 
         fn, zeta, elements, lti_trace = select_order(
             lambda fn, zeta, els: search([lti_point(fn, zeta, els)])[1], lti_regressors,
@@ -646,45 +742,51 @@ def _combo_k(effects) -> int:
 def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
     """Feature builder for the effects with grid parameters ``p``; the columns that do not
     depend on ``p`` (offset, creep, asymmetry) are memoised per segment in ``static`` (the rate
-    columns per filter in the segment's ``rate_basis``)."""
+    columns per filter in the segment's ``rate_basis``). The regressors are built as two blocks
+    of rows (``feats.parts(s)``: the play rows, then the others; :func:`_row_parts`);
+    ``feats(s)`` is the transpose of their stack."""
 
-    def static_columns(s: Segment) -> np.ndarray:
+    def static_rows(s: Segment) -> np.ndarray:
         key = id(s)
         if key not in static:
-            cols = [_ones(s)]
+            out = [np.ones(s.t.size)]
             h0 = nominal.predict(s)
             if "creep" in effects:
-                cols.append(np.column_stack([lag(h0, tau, s.dt) - h0 for tau in CREEP_TAUS]))
+                out += [lag(h0, tau, s.dt) - h0 for tau in CREEP_TAUS]
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
-                cols.append(np.column_stack((u**2, u**3)))
-            static[key] = (s, np.hstack(cols))  # keep s alive so its id stays unique
+                out += [u**2, u**3]
+            static[key] = (s, np.vstack(out))  # keep s alive so its id stays unique
         return static[key][1]
 
-    def feats(s: Segment) -> np.ndarray:
-        Z = s.Z if ncols is None else s.Z[:, :ncols]
-        if "dynamics" in effects:  # filter the (memoised) transposed columns
-            key = ("rows", id(s), ncols)
-            if key not in static:
-                static[key] = (s, np.ascontiguousarray(Z.T))
+    def rows(s: Segment) -> tuple[np.ndarray, np.ndarray]:  # the play rows, then the others
+        Z = s.play_rows(ncols)
+        if "dynamics" in effects:  # filter the play rows
             last = static.get(("mode", id(s), ncols))  # the last mode filtered, for a delay
             if last is None or last[0] != (p["fn"], p["zeta"]):  # search at a fixed mode
-                last = ((p["fn"], p["zeta"]), mode_rows(static[key][1], p["fn"], p["zeta"],
-                                                        s.dt).T)
+                last = ((p["fn"], p["zeta"]), mode_rows(Z, p["fn"], p["zeta"], s.dt), s)
                 static[("mode", id(s), ncols)] = last
             Z = last[1]
         if "delay" in effects:
-            Z = shift(Z, p["d"])
-        cols = [Z, static_columns(s)]
+            Z = shift(Z, p["d"], axis=-1)
+        parts = [Z, static_rows(s)]
         if p.get("lti"):  # the extra elements of the linear part
-            cols.append(_lti_block(s, p, nominal, static))
+            parts.append(_lti_block(s, p, nominal, static).T)
         if "rate" in effects:
-            cols.append(s.rate_basis.columns(p["rate_tau"], p["rate_family"]))
+            key = ("rate", id(s), p["rate_tau"], p["rate_family"])
+            if key not in static:
+                static[key] = (s, np.ascontiguousarray(
+                    s.rate_basis.columns(p["rate_tau"], p["rate_family"]).T))
+            parts.append(static[key][1])
         if "drift" in effects:  # the trend column last
-            cols.append(drift_columns(s.t, p, static["train"].get(id(s)),
-                                      len(static["train"])))
-        return np.hstack(cols)
+            parts.append(drift_columns(s.t, p, static["train"].get(id(s)),
+                                       len(static["train"])).T)
+        return Z, _stack_rows(parts[1:])
 
+    def feats(s: Segment) -> np.ndarray:
+        return _stack_rows(rows(s)).T
+
+    feats.parts = rows
     return feats
 
 

@@ -40,12 +40,12 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.signal import (
     bilinear_zpk,
-    lfilter,
-    lfilter_zi,
     sosfilt,
     sosfilt_zi,
     zpk2sos,
 )
+
+from .._native import biquad_rows
 
 __all__ = ["MAX_MODES", "element_coefficients", "lti_columns", "lti_k", "describe_lti",
            "continuous_zpk", "approximate_inverse", "inverse_sos", "select_order",
@@ -152,7 +152,7 @@ def _at_rest(element, x: np.ndarray, dt: float) -> np.ndarray:
     b, a = element_coefficients(element, dt)
     if a.size == 1:
         return x * (b[0] / a[0])
-    return lfilter(b, a, x, zi=lfilter_zi(b, a) * x[0])[0]
+    return biquad_rows(b, a, x)  # the C core (lfilter at rest around x[0])
 
 
 def lti_columns(h0: np.ndarray, fn: float, zeta: float, elements: Sequence, dt: float, *,
@@ -355,6 +355,7 @@ def approximate_inverse(x: np.ndarray, fn: float, zeta: float, elements: Sequenc
     >>> t = np.arange(4000) * 1e-4
     >>> u = np.sin(2 * np.pi * 5 * t)
     >>> b, a = element_coefficients(("mode", 800.0, 0.05), 1e-4)
+    >>> from scipy.signal import lfilter
     >>> y = lfilter(b, a, u)  # the mode's response to a slow sine
     >>> bool(np.max(np.abs(approximate_inverse(y, 800.0, 0.05, [], [], 1e-4) - u)[:-1]) < 0.01)
     True
@@ -434,6 +435,17 @@ class _Projection:
         rc = float(sum(r @ c for r, c in zip(self.res, cols, strict=True)))
         return self.rss - rc * rc / s
 
+    def rss_with_each(self, candidates) -> np.ndarray:
+        """:meth:`rss_with` of several candidate columns (each a list with one column per
+        block), one matrix product per block instead of one pass over the regressors each."""
+        C = [np.vstack([c[j] for c in candidates]) for j in range(len(self.blocks))]  # (m, n)
+        a = sum(A.T @ Cj.T for A, Cj in zip(self.blocks, C, strict=True)) / self.d[:, None]
+        cc = sum(np.einsum("ij,ij->i", Cj, Cj) for Cj in C)
+        s = cc - np.einsum("im,im->m", a, self.P @ a)
+        rc = sum(Cj @ r for Cj, r in zip(C, self.res, strict=True))
+        ok = s > 1e-12 * cc
+        return np.where(ok, self.rss - rc * rc / np.where(ok, s, 1.0), self.rss)
+
 
 def _separated(freqs) -> bool:
     """Modes at least ``MODE_SEPARATION`` apart in frequency (two close modes with opposite
@@ -498,7 +510,8 @@ def _best_addition(blocks: list, ys: list, column: Callable, chosen: tuple, fmax
                 for z in EXTRA_DAMPING if _admissible(("mode", f, z), fmax, damping_range,
                                                       modes)]
         if grid:
-            options.append(min(((e, rss_of(e)) for e in grid), key=lambda o: o[1]))
+            rss = proj.rss_with_each([column(e) for e in grid])
+            options.append((grid[int(np.argmin(rss))], float(np.min(rss))))
     if ("lowpass" in SELECTED and not any(_kind(e) == "lowpass" for e in chosen) and
             LOWPASS_MIN_HZ < fmax):
         grid = [("lowpass", float(1 / (2 * np.pi * f)))
@@ -555,6 +568,7 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
     --------
     A linear stage (no hysteresis) with two modes; the one-mode fit is a little off:
 
+    >>> from scipy.signal import lfilter
     >>> dt = 1e-4
     >>> rng = np.random.default_rng(0)
     >>> h = np.r_[0.0, np.cumsum(rng.normal(size=4000))] * 1e-2  # input of the linear part

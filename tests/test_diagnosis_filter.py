@@ -1,0 +1,45 @@
+"""The C core's biquad (``fmu/src/pim_filter.c``), the diagnosis' hot loop for the dynamics
+candidate, held equal to its NumPy/SciPy reference: ``scipy.signal.lfilter`` started with
+``lfilter_zi`` around each signal's first sample."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter, lfilter_zi
+
+from pimodel._native import biquad_rows
+from pimodel.diagnosis.effects import mode, mode_coefficients, mode_rows
+from pimodel.diagnosis.lti import element_coefficients
+
+
+def _reference(b, a, x):
+    return lfilter(b, a, x, axis=-1, zi=lfilter_zi(b, a)[None, :] * x[:, :1])[0]
+
+
+@pytest.mark.parametrize("element", [("mode", 300.0, 0.02), ("mode", 2500.0, 0.2),
+                                     ("mode", 40.0, 1.5), ("lowpass", 3e-4)])
+@pytest.mark.parametrize("rows", [1, 4, 7])  # the four-lane loop and the rest
+def test_biquad_rows_equals_lfilter(element, rows):
+    rng = np.random.default_rng(rows)
+    x = np.cumsum(rng.normal(size=(rows, 3000)), axis=1) + rng.normal(size=(rows, 1)) * 5
+    b, a = element_coefficients(element, 1e-4)
+    ref = _reference(b, a, x)
+    got = biquad_rows(b, a, x)
+    assert np.max(np.abs(got - ref)) <= 1e-12 * np.max(np.abs(ref))
+
+
+def test_constant_rows_pass_at_the_static_gain():
+    b, a = mode_coefficients(500.0, 0.1, 1e-4)
+    x = np.array([[2.0] * 50, [-3.0] * 50])
+    assert np.allclose(biquad_rows(b, a, x), x, rtol=0, atol=1e-12)
+
+
+def test_mode_helpers_use_it_on_rows_and_columns():
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(400, 3))
+    b, a = mode_coefficients(800.0, 0.05, 1e-4)
+    ref = _reference(b, a, np.ascontiguousarray(x.T))
+    assert np.max(np.abs(mode_rows(np.ascontiguousarray(x.T), 800.0, 0.05, 1e-4) - ref)) < 1e-12
+    assert np.max(np.abs(mode(x, 800.0, 0.05, 1e-4) - ref.T)) < 1e-12
+    assert np.max(np.abs(mode(x[:, 0], 800.0, 0.05, 1e-4) - ref[0])) < 1e-12
