@@ -50,6 +50,7 @@ from .effects import (
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
+from .wiener import WienerBasis, position_hint
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
@@ -364,6 +365,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
     for s, f in zip(segs, full_segs, strict=True):
         s.rate_basis = RateBasis(f.Z, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
+        s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt)  # dynamics before the plays
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
 
@@ -371,6 +373,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
 
     def fit(name, combo=(), fixed_=None):
         """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
+        if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
+            # the position of the dynamics (before or after the hysteresis) as chosen alone
+            fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
         best = None
         for var in drift_variants((*combo, name), len(va)):
             fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},

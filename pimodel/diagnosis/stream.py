@@ -126,6 +126,10 @@ class NativeModel:
         from .model import _rate_params
 
         e, p, r = model.effects, model.params, model.radii
+        if model.dynamics_before:
+            raise ValueError(f"params: dynamics_position = {p['dynamics_position']!r}: a filter "
+                             "before the hysteresis (wiener_elements) changes the plays' input; "
+                             "the C stream (block, FMU) runs dynamics after the hysteresis only")
         if "dynamics" in e and p.get("lti_elements"):
             raise ValueError(f"params: lti_elements = {list(p['lti_elements'])!r}: the further "
                              "elements of the dynamics' linear part act on the reference "
