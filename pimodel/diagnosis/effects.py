@@ -19,7 +19,7 @@ from ..operator import PIOperator
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import RATE_BANDS, RATE_FAMILIES, RATE_TAU_REFINE, RATE_TAU_START, RATE_TAUS
-from .wiener import describe_wiener, search_filter, wiener_k
+from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
@@ -617,14 +617,18 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                                                           for s in train):
         # the linear part before the hysteresis (module wiener), kept on a lower train BIC
         n = sum(s.y[s.used].size for s in train)
-        els, _, kw = search_filter(lambda e: search([{"wiener": e}])[1], fmax, n)
+        els, _, kw = search_filter(lambda e: search([{"wiener": e}])[1], fmax, n,
+                                   rss_to_beat=best[1])  # the Hammerstein's, same columns
         wmodel, wrss = _fit(name, kw, _combo_features(effects, {"wiener": els}, nominal,
                                                       static), train, {"wiener": els})
         delta = n * np.log(max(wrss, 1e-300) / max(rss, 1e-300)) + (kw - k_all) * np.log(n)
         positions = [{"position": "after", "train_bic": 0.0},
                      {"position": "before", "structure": [els[0][0]], "train_bic": float(delta)}]
-        if delta < 0:
-            model, p, k_all, lti_trace = wmodel, {"wiener": els}, kw, []
+        if delta < 0:  # kept: polished with every play column
+            els, _ = polish_filter(lambda e: _fit(name, kw, _combo_features(
+                effects, {"wiener": e}, nominal, static), train)[1], els, wrss, fmax)
+            p, k_all, lti_trace = {"wiener": els}, kw, []
+            model = _fit(name, kw, _combo_features(effects, p, nominal, static), train, p)[0]
     if "asymmetry" in effects:
         # the static map acts on the hysteresis output, not on the nominal (which took part
         # of the asymmetry into its weights): rebuild the reference h0 from the hysteresis

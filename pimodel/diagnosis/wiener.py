@@ -40,15 +40,17 @@ from scipy.signal import bilinear_zpk, lfilter, lfilter_zi, sosfilt, sosfilt_zi,
 from ..operator import PIOperator
 from .lti import INVERSE_FILTER, element_coefficients, nelder_mead
 
-__all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "position_hint", "prefilter",
-           "search_filter", "wiener_k"]
+__all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "polish_filter",
+           "position_hint", "prefilter", "search_filter", "wiener_k"]
 
 MIN_HZ = 50.0  # slowest corner or mode [Hz] (a slower filter moves every loop of the record)
-LOWPASS_HZ = 8  # points of the low-pass grid, geometric from MIN_HZ to the highest frequency
-MODE_HZ = 6  # points of the mode grid, likewise
+LOWPASS_HZ = 6  # points of the low-pass grid, geometric from MIN_HZ to the highest frequency
+MODE_HZ = 5  # points of the mode grid, likewise
 MODE_DAMPING = (0.1, 0.4, 1.0)
+GATE = 2.0  # refine a kind only when its grid comes within this factor of the RSS to beat
 DAMPING_RANGE = (0.02, 2.0)  # bounds of the refined damping
-REFINE_EVALUATIONS = {"lowpass": 12, "mode": 60}  # Nelder-Mead budget per kind
+REFINE_EVALUATIONS = {"lowpass": 12, "mode": 60}  # Nelder-Mead budget per kind (leading columns)
+POLISH_EVALUATIONS = {"lowpass": 10, "mode": 20}  # then with every column, when it is kept
 KEPT_COLUMNS = 4  # play-output matrices a WienerBasis keeps (the latest)
 ELEMENT_K = {"lowpass": 1, "mode": 2}
 KEYS = ("wiener",)  # the grid key of the Wiener variant (its filter elements)
@@ -223,7 +225,8 @@ def _grid(fmax: float) -> dict:
     return {"lowpass": lp, "mode": modes}
 
 
-def search_filter(rss_of: Callable, fmax: float, n: int) -> tuple[tuple, float, int]:
+def search_filter(rss_of: Callable, fmax: float, n: int,
+                  rss_to_beat: float | None = None) -> tuple[tuple, float, int]:
     """The filter with the lowest train BIC (module docstring).
 
     Parameters
@@ -234,6 +237,11 @@ def search_filter(rss_of: Callable, fmax: float, n: int) -> tuple[tuple, float, 
         Highest corner or mode frequency [Hz] (at least ``MIN_HZ``).
     n : int
         Number of fitted train samples (for the BIC).
+    rss_to_beat : float, optional
+        The train RSS of the alternative (the Hammerstein variant, scored the same way): a
+        kind whose best grid point is more than ``GATE`` times above it is not refined (it
+        cannot win; this spares the refinement on a stage whose dynamics follow the
+        hysteresis).
 
     Returns
     -------
@@ -266,24 +274,69 @@ def search_filter(rss_of: Callable, fmax: float, n: int) -> tuple[tuple, float, 
     best = None
     for kind, grid in _grid(fmax).items():
         scored = [(el, rss_of((el,))) for el in grid if _admissible(el, fmax)]
-        el0, rss0 = min(scored, key=lambda o: o[1])
-        x0 = np.log(np.asarray(el0[1:], float))
-
-        def cost(x, kind=kind):
-            el = (kind, *(float(u) for u in np.exp(x)))
-            return rss_of((el,)) if _admissible(el, fmax) else np.inf
-
-        steps = [0.2] if kind == "lowpass" else [0.1, 0.3]
-        simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(steps)]
-        r = nelder_mead(cost, x0, initial_simplex=simplex, xatol=1e-3,
-                        fatol=1e-6 * rss0, maxfev=REFINE_EVALUATIONS[kind])
-        el, rss = ((kind, *(float(u) for u in np.exp(r.x))), float(r.fun)) if r.fun < rss0 \
-            else (el0, rss0)
+        el, rss = min(scored, key=lambda o: o[1])
+        if rss_to_beat is None or rss < GATE * rss_to_beat:
+            el, rss = _refine(rss_of, el, rss, fmax, REFINE_EVALUATIONS[kind], (0.2, 0.3))
         k = ELEMENT_K[kind]
         score = n * np.log(max(rss, 1e-300) / n) + k * np.log(n)
         if best is None or score < best[0]:
             best = (score, (el,), rss, k)
     return best[1], best[2], best[3]
+
+
+def _refine(rss_of: Callable, el0: tuple, rss0: float, fmax: float, maxfev: int,
+            steps: tuple) -> tuple[tuple, float]:
+    """Nelder-Mead on the log parameters of one element from ``el0`` (``rss0`` its RSS)."""
+    kind = el0[0]
+    x0 = np.log(np.asarray(el0[1:], float))
+
+    def cost(x):
+        el = (kind, *(float(u) for u in np.exp(x)))
+        return rss_of((el,)) if _admissible(el, fmax) else np.inf
+
+    step = [steps[0]] if kind == "lowpass" else [0.5 * steps[0], steps[1]]
+    simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(step)]
+    r = nelder_mead(cost, x0, initial_simplex=simplex, xatol=1e-4, fatol=1e-7 * rss0,
+                    maxfev=maxfev)
+    if r.fun < rss0:
+        return (kind, *(float(u) for u in np.exp(r.x))), float(r.fun)
+    return el0, rss0
+
+
+def polish_filter(rss_of: Callable, elements: tuple, rss: float,
+                  fmax: float) -> tuple[tuple, float]:
+    """A short Nelder-Mead polish of a filter found by :func:`search_filter` (which scores
+    with the leading play columns only) on the fit with every column.
+
+    Parameters
+    ----------
+    rss_of : callable
+        ``rss_of(elements) -> float``: the train RSS of the full fit.
+    elements : tuple
+        The filter found (one element).
+    rss : float
+        Its train RSS with every column.
+    fmax : float
+        Highest corner or mode frequency [Hz].
+
+    Returns
+    -------
+    elements : tuple
+        The polished filter (``elements`` if nothing is lower).
+    rss : float
+        Its train RSS.
+
+    Examples
+    --------
+    >>> tau0 = 1 / (2 * np.pi * 300.0)
+    >>> els, rss = polish_filter(lambda e: 1.0 + np.log(e[0][1] / tau0) ** 2,
+    ...                          (("lowpass", 1.05 * tau0),), 1.0 + np.log(1.05) ** 2, 2000.0)
+    >>> round(els[0][1] / tau0, 2)
+    1.0
+    """
+    el, rss = _refine(rss_of, tuple(elements[0]), rss, fmax,
+                      POLISH_EVALUATIONS[elements[0][0]], (0.03, 0.1))
+    return (el,), rss
 
 
 def position_hint(alone_grid: dict) -> dict:
