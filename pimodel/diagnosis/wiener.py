@@ -44,10 +44,10 @@ __all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "polish_filter
            "position_hint", "prefilter", "search_filter", "wiener_k"]
 
 MIN_HZ = 50.0  # slowest corner or mode [Hz] (a slower filter moves every loop of the record)
-LOWPASS_HZ = 6  # points of the low-pass grid, geometric from MIN_HZ to the highest frequency
-MODE_HZ = 5  # points of the mode grid, likewise
+LOWPASS_HZ = 8  # points of the low-pass grid, geometric from MIN_HZ to the highest frequency
+MODE_HZ = 6  # points of the mode grid, likewise
 MODE_DAMPING = (0.1, 0.4, 1.0)
-GATE = 2.0  # refine a kind only when its grid comes within this factor of the RSS to beat
+GATE = 8.0  # refine a kind only when its grid comes within this factor of the RSS to beat
 DAMPING_RANGE = (0.02, 2.0)  # bounds of the refined damping
 REFINE_EVALUATIONS = {"lowpass": 12, "mode": 60}  # Nelder-Mead budget per kind (leading columns)
 POLISH_EVALUATIONS = {"lowpass": 10, "mode": 20}  # then with every column, when it is kept
