@@ -38,6 +38,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..data import Record
+from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
 from .effects import (
     EFFECTS,
@@ -443,6 +444,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         current, cur_out = m, o
     chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
                                        (nominal, out_va), noise)
+    chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
     after = _errors(va, cur_out)
     regions = {r["region"]: r for r in where["regions"]}
     bands = {b["band"]: b["energy_share"] for b in where["spectrum"]}
@@ -530,6 +532,22 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
             break
         chosen, cur = worst[1], worst[2]
     return chosen, cur[0], cur[1]
+
+
+def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):
+    """A chosen ``dynamics`` that acts as a pure delay on the records (gain within 10 % of 1
+    over the lower quarter of the band, :mod:`.delaylike`) gives way to ``delay`` when the
+    delay in its place fits the validate records within ``ALTERNATIVE_RMS`` (a fast, damped
+    mode or two imitate a delay of a sample; the delay is the simpler name). Returns
+    ``(chosen, model, validate outputs)``."""
+    if "dynamics" not in chosen or "delay" in chosen or not is_delay_like(current.params, dt):
+        return chosen, current, cur_out
+    rest = tuple(c for c in chosen if c != "dynamics")
+    kept = {k: x for k, x in fixed.items() if k not in ("fn", "zeta", "lti", "wiener")}
+    m, o = fit("delay", rest, kept or None)
+    if _errors(va, o)["rms"] <= ALTERNATIVE_RMS * _errors(va, cur_out)["rms"]:
+        return tuple("delay" if c == "dynamics" else c for c in chosen), m, o
+    return chosen, current, cur_out
 
 
 def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float) -> dict:
