@@ -13,6 +13,10 @@ it returns a :class:`DiagnosisReport`. The submodules:
   growing with a low-passed input rate, to first order);
 - :mod:`pimodel.diagnosis.lti`: the linear part of the ``dynamics`` candidate (modes, a
   low-pass, a direct term), its order chosen by the train BIC, and its approximate inverse;
+- :mod:`pimodel.diagnosis.wiener`: the ``dynamics`` candidate with a filter before the
+  hysteresis (a Wiener model: a driver's low-pass or a mode on the input);
+- :mod:`pimodel.diagnosis.delaylike`: whether a fitted ``dynamics`` acts as a pure delay (the
+  tie-break between the names ``dynamics`` and ``delay``);
 - :mod:`pimodel.diagnosis.noise`: the measurement-noise floor of the records;
 - :mod:`pimodel.diagnosis.where`: the regions, bands and correlations of the residual;
 - :mod:`pimodel.diagnosis.plots`: the figures of a report;

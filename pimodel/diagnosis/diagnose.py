@@ -15,7 +15,11 @@ effect passes in the first round, every pair is fitted jointly and the best pair
 same terms (two effects can mask each other). Then the choice is revised on the same terms: a
 chosen effect is swapped for an unchosen one while that passes, and an effect that no longer
 passes against the combination without it is dropped (an effect chosen early can stand in for
-one that only passes beside a later one). The drift's variant (its clock, or a level per
+one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure delay
+on the records (gain within 10 % of 1 over the lower quarter of the band, :mod:`.delaylike`)
+gives way to ``delay`` when the delay fits validate within 10 % in its place. The ``dynamics``
+candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the train BIC says so,
+a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a level per
 record, :mod:`.drift`) is chosen on validate for every combination.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
@@ -38,6 +42,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..data import Record
+from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
 from .effects import (
     EFFECTS,
@@ -50,6 +55,7 @@ from .effects import (
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
+from .wiener import WienerBasis, position_hint
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
@@ -364,6 +370,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
     for s, f in zip(segs, full_segs, strict=True):
         s.rate_basis = RateBasis(f.Z, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
+        s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt)  # dynamics before the plays
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
 
@@ -371,6 +378,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
 
     def fit(name, combo=(), fixed_=None):
         """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
+        if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
+            # the position of the dynamics (before or after the hysteresis) as chosen alone
+            fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
         best = None
         for var in drift_variants((*combo, name), len(va)):
             fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},
@@ -438,6 +448,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         current, cur_out = m, o
     chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
                                        (nominal, out_va), noise)
+    chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
     after = _errors(va, cur_out)
     regions = {r["region"]: r for r in where["regions"]}
     bands = {b["band"]: b["energy_share"] for b in where["spectrum"]}
@@ -525,6 +536,22 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
             break
         chosen, cur = worst[1], worst[2]
     return chosen, cur[0], cur[1]
+
+
+def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):
+    """A chosen ``dynamics`` that acts as a pure delay on the records (gain within 10 % of 1
+    over the lower quarter of the band, :mod:`.delaylike`) gives way to ``delay`` when the
+    delay in its place fits the validate records within ``ALTERNATIVE_RMS`` (a fast, damped
+    mode or two imitate a delay of a sample; the delay is the simpler name). Returns
+    ``(chosen, model, validate outputs)``."""
+    if "dynamics" not in chosen or "delay" in chosen or not is_delay_like(current.params, dt):
+        return chosen, current, cur_out
+    rest = tuple(c for c in chosen if c != "dynamics")
+    kept = {k: x for k, x in fixed.items() if k not in ("fn", "zeta", "lti", "wiener")}
+    m, o = fit("delay", rest, kept or None)
+    if _errors(va, o)["rms"] <= ALTERNATIVE_RMS * _errors(va, cur_out)["rms"]:
+        return tuple("delay" if c == "dynamics" else c for c in chosen), m, o
+    return chosen, current, cur_out
 
 
 def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float) -> dict:

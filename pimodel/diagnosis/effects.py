@@ -20,6 +20,7 @@ from ..operator import PIOperator
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import RATE_BANDS, RATE_FAMILIES, RATE_TAU_REFINE, RATE_TAU_START, RATE_TAUS
+from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
@@ -53,6 +54,9 @@ class Segment:
     rate_basis : pimodel.diagnosis.rate.RateBasis or None
         The rate candidate's columns (:class:`~pimodel.diagnosis.rate.RateBasis`), set by the
         diagnosis.
+    wiener_basis : pimodel.diagnosis.wiener.WienerBasis or None
+        The play columns of a filtered input, for ``dynamics`` before the hysteresis
+        (:mod:`.wiener`), set by the diagnosis; None: that variant is not tried.
 
     Examples
     --------
@@ -68,6 +72,7 @@ class Segment:
     Z: np.ndarray
     mask: np.ndarray | None = None
     rate_basis: object = None  # a rate.RateBasis, set by the diagnosis
+    wiener_basis: object = None  # a wiener.WienerBasis, set by the diagnosis
 
     @property
     def used(self) -> np.ndarray:
@@ -589,7 +594,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
     # then left a spurious second effect)
     lti_trace: list = []
-    ncols = SEARCH_COLUMNS if "dynamics" in effects and "fn" not in fixed else None
+    positions: list = []  # train BIC of the dynamics after and before the hysteresis
+    # the dynamics held (a base mode, or a filter before the hysteresis: module wiener)
+    dyn_fixed = "fn" in fixed or "wiener" in fixed
+    ncols = SEARCH_COLUMNS if "dynamics" in effects and not dyn_fixed else None
 
     def search(points, best=None):
         for p in points:
@@ -605,7 +613,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     for e in effects:
         if e == "dynamics":
             fgrid = [f for f in MODE_HZ if f <= fmax] or [fmax]
-            grids.append([{"fn": fixed["fn"], "zeta": fixed["zeta"],
+            grids.append([{"wiener": fixed["wiener"]}] if "wiener" in fixed else
+                         [{"fn": fixed["fn"], "zeta": fixed["zeta"],
                            "lti": fixed.get("lti", ())}] if "fn" in fixed else
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING])
         elif e == "delay":
@@ -652,7 +661,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             options={"xatol": 0.01})
         if r.fun < best[1]:
             best = search([{**base, "d": float(r.x)}], best)
-    if "dynamics" in effects and "fn" not in fixed:
+    if "dynamics" in effects and not dyn_fixed:
         # refine the mode around the grid optimum, then polish it continuously (a light
         # mode's resonance is narrower than the grid)
         f0, z0 = best[0].params["fn"], best[0].params["zeta"]
@@ -676,7 +685,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
-    if "dynamics" in effects:
+    if "dynamics" in effects and "wiener" not in fixed:
         # the order of the linear part: further modes, a low-pass, a direct term (module lti);
         # chosen again beside effects added later (the base mode held, no polish)
         p0 = {**best[0].params, "lti": ()}
@@ -697,7 +706,25 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
     k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too
-    model = _fit(name, k_all, _combo_features(effects, p, nominal, static), train, p)[0]
+    if p.get("wiener"):  # a filter's parameters instead of the base mode's two
+        k_all += wiener_k(p["wiener"]) - _combo_k(("dynamics",))
+    model, rss = _fit(name, k_all, _combo_features(effects, p, nominal, static), train, p)
+    if effects == ("dynamics",) and not dyn_fixed and all(s.wiener_basis is not None
+                                                          for s in train):
+        # the linear part before the hysteresis (module wiener), kept on a lower train BIC
+        n = sum(s.y[s.used].size for s in train)
+        els, _, kw = search_filter(lambda e: search([{"wiener": e}])[1], fmax, n,
+                                   rss_to_beat=best[1])  # the Hammerstein's, same columns
+        wmodel, wrss = _fit(name, kw, _combo_features(effects, {"wiener": els}, nominal,
+                                                      static), train, {"wiener": els})
+        delta = n * np.log(max(wrss, 1e-300) / max(rss, 1e-300)) + (kw - k_all) * np.log(n)
+        positions = [{"position": "after", "train_bic": 0.0},
+                     {"position": "before", "structure": [els[0][0]], "train_bic": float(delta)}]
+        if delta < 0:  # kept: polished with every play column
+            els, _ = polish_filter(lambda e: _fit(name, kw, _combo_features(
+                effects, {"wiener": e}, nominal, static), train)[1], els, wrss, fmax)
+            p, k_all, lti_trace = {"wiener": els}, kw, []
+            model = _fit(name, kw, _combo_features(effects, p, nominal, static), train, p)[0]
     if "asymmetry" in effects:
         # the static map acts on the hysteresis output, not on the nominal (which took part
         # of the asymmetry into its weights): rebuild the reference h0 from the hysteresis
@@ -712,6 +739,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     model.params = _describe(effects, model, nominal)
     if lti_trace:
         model.params["dynamics_structures_tried"] = lti_trace
+    if positions:
+        model.params["dynamics_positions_tried"] = positions
     if "drift" in effects and p["clock"] == "levels":
         model.params["drift_t0_train"] = float(train[0].t[0])
         in_train = static["train"]
@@ -761,7 +790,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
 
     def rows(s: Segment) -> tuple[np.ndarray, np.ndarray]:  # the play rows, then the others
         Z = s.play_rows(ncols)
-        if "dynamics" in effects:  # filter the play rows
+        if p.get("wiener"):  # the linear part before the hysteresis (module wiener)
+            Z = s.wiener_basis.columns(p["wiener"], ncols).T  # rows, kept C-contiguous
+        elif "dynamics" in effects:  # filter the play rows
             last = static.get(("mode", id(s), ncols))  # the last mode filtered, for a delay
             if last is None or last[0] != (p["fn"], p["zeta"]):  # search at a fixed mode
                 last = ((p["fn"], p["zeta"]), mode_rows(Z, p["fn"], p["zeta"], s.dt), s)
@@ -828,7 +859,10 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
         clock = model.params["clock"]  # "levels": the clock is read from the levels later
         out["drift_clock"] = "record" if clock == "levels" else clock
         out["drift_variant"] = "levels" if clock == "levels" else "trend"
+    if "wiener" in model.params:
+        out.update(describe_wiener(model.params["wiener"]))
     if "fn" in model.params:
+        out["dynamics_position"] = "after"
         out["mode_hz"], out["mode_damping"] = model.params["fn"], model.params["zeta"]
         lti = model.params.get("lti", ())
         out.update(describe_lti(model.params["fn"], model.params["zeta"], lti,

@@ -377,7 +377,8 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
     Raises
     ------
     ValueError
-        ``dt`` other than the model's, a bad model parameter.
+        ``dt`` other than the model's, a bad model parameter, a filter before the hysteresis
+        (``dynamics_position = "before"``).
 
     Examples
     --------
@@ -392,6 +393,11 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
     ([0.0, 1.0, 0.0], 0)
     """
     model = inverse.model
+    if model.dynamics_before:
+        raise ValueError(f"params: dynamics_position = {model.params['dynamics_position']!r}: "
+                         "the inverse of a filter before the hysteresis (wiener_elements) runs "
+                         "after the solve, on the whole record; the block covers dynamics "
+                         "after the hysteresis only")
     dt = model.dt if dt is None else float(dt)
     if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
         raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its filter "

@@ -70,6 +70,12 @@ Approximations, by choice:
   for one mode ``M(s)^-1 / (s / (2 w) + 1)^2``), discretised with Tustin, and a one-sample
   advance for the zero-order hold; the reference is filtered by it, then the static part is
   inverted.
+* **dynamics before the hysteresis** (``dynamics_position == "before"``, a Wiener model,
+  :mod:`.wiener`): the play outputs are those of the filtered input ``F[v]``; the inverse solves
+  the static part for the filter's output ``x``, then passes ``x`` through a stable
+  approximate inverse of ``F`` (:func:`.wiener.inverse_prefilter`: ``F(s)^-1`` times a low-pass
+  of its order at twice its fastest pole, Tustin, one-sample advance), approximate like the
+  dynamics after it.
 * **drift**: not inverted (an additive term in time; compensating it would extrapolate a
   fitted trend), the offset is.
 """
@@ -89,6 +95,7 @@ from .drift import drift_term
 from .effects import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
 from .rate import RATE_FAMILIES, rate_columns
+from .wiener import inverse_prefilter, prefilter
 
 if TYPE_CHECKING:
     import control
@@ -121,7 +128,8 @@ class DiagnosedModel:
         ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
         (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,
         ``drift_t0_train`` for a level per record, :mod:`.drift`);
-        ``mode_hz``, ``mode_damping``, ``lti_elements``, ``lti_gains`` (:mod:`.lti`);
+        ``mode_hz``, ``mode_damping``, ``lti_elements``, ``lti_gains`` (:mod:`.lti`), or
+        ``dynamics_position = "before"`` and ``wiener_elements`` (:mod:`.wiener`);
         ``delay_samples``.
     initial_state : {"rest", "unknown"}
         The diagnosis' assumption on the stage's memory at the start of a record
@@ -247,13 +255,17 @@ class DiagnosedModel:
         p, e = self.params, self.effects
         Z = PIOperator(np.ones(self.radii.size), self.radii).play_outputs(v)
         Zp = Z
-        if "dynamics" in e:
+        if self.dynamics_before:  # the plays of the filtered input (module wiener)
+            Zp = PIOperator(np.ones(self.radii.size), self.radii).play_outputs(
+                prefilter(v, p["wiener_elements"], self.dt))
+        elif "dynamics" in e:
             Zp = mode(Zp, p["mode_hz"], p["mode_damping"], self.dt)
         if "delay" in e:
             Zp = shift(Zp, p["delay_samples"])
         y = Zp @ self.weights + self.offset
         h0 = Z @ self.reference_weights + self.reference_offset
-        if "dynamics" in e and p.get("lti_elements"):  # the linear part's further elements
+        if "dynamics" in e and not self.dynamics_before and p.get("lti_elements"):
+            # the linear part's further elements
             cols = lti_columns(h0, p["mode_hz"], p["mode_damping"], p["lti_elements"], self.dt)
             if "delay" in e:
                 cols = shift(cols, p["delay_samples"])
@@ -336,6 +348,17 @@ class DiagnosedModel:
 
         return diagnosed_block(self, dt, name=name, input=input, output=output,
                                input_range=input_range)
+
+    @property
+    def dynamics_before(self) -> bool:
+        """True when the model's dynamics is a filter before the hysteresis (:mod:`.wiener`).
+
+        Examples
+        --------
+        >>> DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3).dynamics_before
+        False
+        """
+        return "dynamics" in self.effects and self.params.get("dynamics_position") == "before"
 
     @property
     def is_exactly_invertible(self) -> bool:
@@ -536,7 +559,8 @@ class DiagnosedInverse:
         Returns
         -------
         numpy.ndarray
-            ``y_d`` advanced by the delay and filtered by the mode's approximate inverse;
+            ``y_d`` advanced by the delay and filtered by the mode's approximate inverse (a
+            filter before the hysteresis is inverted after the solve, not here);
             ``y_d`` itself for a model with neither.
 
         Examples
@@ -548,7 +572,7 @@ class DiagnosedInverse:
         """
         m, p = self.model, self.model.params
         x = y_d
-        if "dynamics" in m.effects:
+        if "dynamics" in m.effects and not m.dynamics_before:  # (before: after the solve)
             x = approximate_inverse(x, p["mode_hz"], p["mode_damping"],
                                     p.get("lti_elements", ()), p.get("lti_gains", ()), m.dt)
         if "delay" in m.effects:
@@ -681,7 +705,10 @@ class DiagnosedInverse:
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
         x = self.prefilter(yd)
         z0 = self.initial_memory(x[0]) if state == "unknown" else None
-        return _solve(self.model.static_part(), x, rng, z0)
+        x = _solve(self.model.static_part(), x, rng, z0)
+        if self.model.dynamics_before:  # the filter's output -> its input (approximate)
+            return inverse_prefilter(x, self.model.params["wiener_elements"], self.model.dt)
+        return x
 
     def block(self, dt: float | None = None, *, name: str = "inverse", input: str = "y_d",
               output: str = "v", input_range: float | None = None,

@@ -206,6 +206,10 @@ class NativeModel:
         from .model import _rate_params
 
         e, p, r = model.effects, model.params, model.radii
+        if model.dynamics_before:
+            raise ValueError(f"params: dynamics_position = {p['dynamics_position']!r}: a filter "
+                             "before the hysteresis (wiener_elements) changes the plays' input; "
+                             "the C stream (block, FMU) runs dynamics after the hysteresis only")
         n = r.size
         self.model = model
         self.input_range = float(2 * r[-1] if input_range is None else input_range)
