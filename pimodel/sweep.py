@@ -21,6 +21,7 @@ both give identical values, and they come back in case order.
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import json
 import os
@@ -169,12 +170,22 @@ def _check_cases(cases) -> list[dict]:
 
 
 def _call_case(func: Callable, params: dict):
-    """Run one case with one BLAS thread; the result as JSON values (runs on the worker)."""
+    """Run one case with one BLAS thread; the result as JSON values (runs on the worker).
+
+    The garbage of the case is collected before the next one: reference cycles (closures over
+    their caches, caught exceptions' frames) can hold a case's arrays, and Python's collector
+    counts objects, not bytes, so it ran too rarely for a worker that does many cases in a row
+    (``sim_to_real`` workers grew to 2 GiB and Dask paused them; with the collection a worker
+    stays at a case's own peak, a few hundred MB).
+    """
     from threadpoolctl import threadpool_limits
 
-    with threadpool_limits(limits=1):
-        result = func(dict(params))
-    return json.loads(json.dumps(plain(result)))
+    try:
+        with threadpool_limits(limits=1):
+            result = func(dict(params))
+        return json.loads(json.dumps(plain(result)))
+    finally:
+        gc.collect()
 
 
 class _Cache:
