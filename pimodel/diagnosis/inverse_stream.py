@@ -157,8 +157,14 @@ class StaticInverse:
                                         input_range, reference_range)
             self.source_step = self.step_size if tau == 0 else math.inf
         # state: started, v_prev, guess, z[n], L[m], (rate) rho_f, memory[n], v0_prev and the
-        # source's state
-        self.size = 3 + n + self.m + (2 + n + self.source.size if self.rate else 0)
+        # source's state; the positions once, as slices and indices
+        self._z = slice(3, 3 + n)
+        self._lags = slice(3 + n, 3 + n + self.m)
+        self._rho_f = 3 + n + self.m
+        self._memory = slice(self._rho_f + 1, self._rho_f + 1 + n)
+        self._v0_prev = self._rho_f + 1 + n
+        self._source = slice(self._v0_prev + 1, None)
+        self.size = self._rho_f + (2 + n + self.source.size if self.rate else 0)
 
     def labels(self) -> list[str]:
         """Names of the state values.
@@ -212,10 +218,9 @@ class StaticInverse:
             if z.shape != (self.n,) or not np.all(np.isfinite(z)):
                 raise ValueError(f"z0: expected {self.n} finite play outputs, got shape "
                                  f"{z.shape}")
-            x[3:3 + self.n] = z
+            x[self._z] = z
             if self.rate:
-                i0 = 5 + 2 * self.n + self.m
-                x[i0:] = self.source.initial_state(z)
+                x[self._source] = self.source.initial_state(z)
         return x
 
     def step(self, x: np.ndarray, yk: float) -> float:
@@ -240,20 +245,19 @@ class StaticInverse:
         >>> round(inv.step(inv.initial_state(), 1.0), 12)
         0.5
         """
-        m, p, r, w, w0, n = self.model, self.model.params, self.r, self.w, self.w0, self.n
+        m, p, r, w, w0 = self.model, self.model.params, self.r, self.w, self.w0
         first = x[0] == 0.0
         v_prev, guess = float(x[1]), float(x[2])
-        z = x[3:3 + n].copy()
-        lags = x[3 + n:3 + n + self.m].copy()
-        rho_f = float(x[3 + n + self.m]) if self.rate else 0.0
-        memory = x[4 + n + self.m:4 + 2 * n + self.m].copy() if self.rate else None
+        z = x[self._z].copy()
+        lags = x[self._lags].copy()
+        rho_f = float(x[self._rho_f]) if self.rate else 0.0
+        memory = x[self._memory].copy() if self.rate else None
         span = self.span
         if self.rate:  # the fresh rate of sample k from the rate-free inverse v0 (not fed back)
-            i0 = 4 + 2 * n + self.m
-            v0 = self.source.step(x[i0 + 1:], yk)  # advances the source's state in place
-            dv0 = 0.0 if first else abs(v0 - x[i0])
+            v0 = self.source.step(x[self._source], yk)  # advances the source's state in place
+            dv0 = 0.0 if first else abs(v0 - x[self._v0_prev])
             fresh = dv0 / m.dt / p["rate_scale"] if dv0 <= self.source_step else 0.0
-            x[i0] = v0
+            x[self._v0_prev] = v0
             rho_k = self.a_rate * rho_f + (1 - self.a_rate) * fresh
 
         def F(vs):
@@ -294,11 +298,11 @@ class StaticInverse:
             memory = np.where(contact, -np.sign(gap) * rho_f, memory)
         x[2] = vk if first or abs(vk - v_prev) > 0.01 * span else 2 * vk - v_prev
         x[0], x[1] = 1.0, vk
-        x[3:3 + n] = z_new
-        x[3 + n:3 + n + self.m] = lags
+        x[self._z] = z_new
+        x[self._lags] = lags
         if self.rate:
-            x[3 + n + self.m] = rho_f
-            x[4 + n + self.m:4 + 2 * n + self.m] = memory
+            x[self._rho_f] = rho_f
+            x[self._memory] = memory
         return vk
 
 
