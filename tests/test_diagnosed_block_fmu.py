@@ -32,6 +32,9 @@ from pimodel.fmu.operators import unit_parameters
 from pimodel.fmu.unit import FMUUnit
 from pimodel.models import load_model
 
+sys.path.insert(0, str(Path(__file__).parent))
+from diagnosed_unit import run_unit, unit_file  # noqa: E402
+
 DT = 1e-3
 RADII = [0.0, 0.15, 0.4, 0.7, 1.0]
 EFFECT_PARAMS = {
@@ -209,19 +212,6 @@ def fmus(built_fmus) -> Path:
     return built_fmus
 
 
-def run_unit(path: Path, params: dict, v: np.ndarray, h: float = DT) -> np.ndarray:
-    unit = FMUUnit(path, params)
-    out = []
-    try:
-        for x in v:
-            unit.set({"v": x})
-            unit.step(h)
-            out.append(unit.get(["y"])[0])
-    finally:
-        unit.close()
-    return np.array(out)
-
-
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "delay_whole", "rate",
                                   *RATE_VARIANTS])
@@ -232,7 +222,7 @@ def test_unit_equals_simulate(fmus, fmi, case):
     name, params = unit_parameters(m)
     assert name == "DiagnosedModel"
     t, v = signal(1500, t0=0.0)
-    got = run_unit(fmus / f"DiagnosedModel{'_fmi3' if fmi == '3.0' else ''}.fmu", params, v)
+    got = run_unit(unit_file(fmus, fmi), params, v, DT)
     assert np.max(np.abs(got - m.simulate(v, t, input_range=RANGE))) < 1e-12
 
 
@@ -249,7 +239,7 @@ def test_unit_with_more_than_64_plays(fmus, fmi):
     _, params = unit_parameters(m)
     assert params["p_hi[16]"] == m.weights[79] and "p_hi[17]" not in params
     t, v = signal(800, t0=0.0)
-    got = run_unit(fmus / f"DiagnosedModel{'_fmi3' if fmi == '3.0' else ''}.fmu", params, v)
+    got = run_unit(unit_file(fmus, fmi), params, v, DT)
     want = m.simulate(v, t, input_range=2 * radii[-1])
     assert np.max(np.abs(got - want)) < 1e-12 * max(1.0, float(np.max(np.abs(want))))
 
@@ -301,7 +291,7 @@ def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
      ({"offset": float("inf")}, "offset = inf")])
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 def test_bad_parameters_give_logged_errors(fmus, fmi, start, message):
-    path = fmus / f"DiagnosedModel{'_fmi3' if fmi == '3.0' else ''}.fmu"
+    path = unit_file(fmus, fmi)
     with pytest.raises(ValueError, match="initialisation failed") as err:
         FMUUnit(path, start)
     assert message in str(err.value)

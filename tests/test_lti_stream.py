@@ -35,6 +35,9 @@ from pimodel.fmu.build import source_dir
 from pimodel.fmu.model_fmu import cosimulate_chain
 from pimodel.fmu.unit import FMUUnit
 
+sys.path.insert(0, str(Path(__file__).parent))
+from diagnosed_unit import run_unit, unit_file  # noqa: E402
+
 DT = 1e-3
 RADII = [0.0, 0.15, 0.4, 0.7, 1.0]
 ELEMENTS = {
@@ -141,23 +144,6 @@ def test_bad_elements_are_named(change, message):
 
 # ---- the FMU unit -------------------------------------------------------------------------
 
-def run_unit(path: Path, params: dict, v: np.ndarray) -> np.ndarray:
-    unit = FMUUnit(path, params)
-    out = []
-    try:
-        for x in v:
-            unit.set({"v": x})
-            unit.step(DT)
-            out.append(unit.get(["y"])[0])
-    finally:
-        unit.close()
-    return np.array(out)
-
-
-def fmu_file(built: Path, fmi: str) -> Path:
-    return built / f"DiagnosedModel{'_fmi3' if fmi == '3.0' else ''}.fmu"
-
-
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize(("case", "effects"), [("three_modes", ("dynamics",)),
                                                ("modes_lowpass_direct", ALL)])
@@ -166,7 +152,7 @@ def test_unit_equals_simulate(built_fmus, fmi, case, effects):
     name, params = fmu_parameters(m)
     assert params["n_lti_elements"] == len(ELEMENTS[case][0])
     t, v = signal(1500)
-    got = run_unit(fmu_file(built_fmus, fmi), params, v)
+    got = run_unit(unit_file(built_fmus, fmi), params, v, DT)
     assert np.max(np.abs(got - m.simulate(v, t, input_range=2 * RADII[-1]))) < 1e-12
 
 
@@ -187,7 +173,7 @@ def test_unit_equals_simulate(built_fmus, fmi, case, effects):
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 def test_bad_element_parameters_give_logged_errors(built_fmus, fmi, start, message):
     with pytest.raises(ValueError, match="initialisation failed") as err:
-        FMUUnit(fmu_file(built_fmus, fmi), start)
+        FMUUnit(unit_file(built_fmus, fmi), start)
     assert message in str(err.value)
 
 
