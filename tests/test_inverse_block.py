@@ -128,3 +128,11 @@ def test_block_errors():
         m.inverse().block(2e-3)
     with pytest.raises(ValueError, match="reference_range: expected a finite value >= 0"):
         m.inverse().block(reference_range=-1.0)
+    inv = StaticInverse(model(("rate",), **STATIC_CASES["rate_radius"]))
+    with pytest.raises(ValueError, match=r"z0: expected 5 finite play outputs, got shape \(4,\)"):
+        inv.initial_state(np.zeros(4))
+    with pytest.raises(ValueError, match="z0: expected 5 finite play outputs"):
+        inv.initial_state([0.0, np.nan, 0.0, 0.0, 0.0])
+    x = inv.initial_state([0.0, -0.1, -0.2, 0.0, 0.0])  # the rate source starts there too
+    assert x[3:8].tolist() == [0.0, -0.1, -0.2, 0.0, 0.0]
+    assert x[inv.size - inv.source.size:][3:8].tolist() == [0.0, -0.1, -0.2, 0.0, 0.0]
