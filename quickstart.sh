@@ -35,6 +35,10 @@ case "$cmd" in
         # one pytest worker per core, at most 4 (pytest-xdist); a test file stays on one worker
         # so its module fixtures are built once. PIMODEL_TEST_WORKERS=0 runs in this process.
         workers=${PIMODEL_TEST_WORKERS:-$(nproc 2>/dev/null || echo 1)}
+        case $workers in
+            ''|*[!0-9]*) echo "quickstart: PIMODEL_TEST_WORKERS: expected a whole number >= 0" \
+                              "(0: one process), got '$workers'" >&2; exit 2 ;;
+        esac
         [ "$workers" -gt 4 ] && workers=4
         exec .venv/bin/python -m pytest -q -n "$workers" --dist loadfile "$@" ;;
     *)
