@@ -203,13 +203,15 @@ class DiagParams(ctypes.Structure):
                 ("rate_tau", c_double), ("order", c_size),
                 ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
                 ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
-                ("el_g", _DP)]
+                ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP)]
 
 
 lib.pim_diag_state_size.restype = c_size
 lib.pim_diag_state_size.argtypes = [ctypes.POINTER(DiagParams)]
 lib.pim_diag_check.restype = ctypes.c_char_p
 lib.pim_diag_check.argtypes = [ctypes.POINTER(DiagParams)]
+lib.pim_diag_initial_state.restype = None
+lib.pim_diag_initial_state.argtypes = [ctypes.POINTER(DiagParams), F64, c_double]
 lib.pim_diag_step.restype = c_double
 lib.pim_diag_step.argtypes = [ctypes.POINTER(DiagParams), F64, c_double, c_double]
 lib.pim_diag_run.restype = None
@@ -224,6 +226,13 @@ def diag_pointer(a: np.ndarray | None):
 def diag_state_size(d: DiagParams) -> int:
     """Length of the model's flat state."""
     return int(lib.pim_diag_state_size(ctypes.byref(d)))
+
+
+def diag_initial_state(d: DiagParams, z0: float = 0.0) -> np.ndarray:
+    """The state before the first sample: zeros, the plays (and a prefilter's plays) at z0."""
+    x = np.empty(diag_state_size(d))
+    lib.pim_diag_initial_state(ctypes.byref(d), x, float(z0))
+    return x
 
 
 def diag_check(d: DiagParams) -> str | None:

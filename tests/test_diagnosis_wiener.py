@@ -1,6 +1,6 @@
 """The ``dynamics`` candidate with a filter *before* the hysteresis (Wiener form,
 ``pimodel.diagnosis.wiener``): its filter and approximate inverse against python-control, the
-diagnosed model's forward form, inverse and the C stream's refusal, and the verdict on stages
+diagnosed model's forward form, inverse and its stream on the C core, and the verdict on stages
 whose amplifier low-passes the input (written here, independently of the candidate library:
 the filter by python-control's zero-order hold, then the PI stage of ``pimodel.truth`` or the
 Preisach stage of ``pimodel.truth_alt``)."""
@@ -90,16 +90,14 @@ def test_model_simulates_the_plays_of_the_filtered_input(tmp_path):
     assert not m.is_exactly_invertible
 
 
-def test_stream_block_and_fmu_refuse_a_filter_before_the_hysteresis():
-    from pimodel.diagnosis.stream import fmu_parameters, stream_simulate
+def test_stream_runs_the_filter_and_the_inverse_block_refuses_it():
+    """The forward model streams on the C core (tests/test_wiener_stream.py: block and FMU);
+    the inverse's block does not take a filter before the hysteresis."""
+    from pimodel.diagnosis.stream import stream_simulate
 
     m = _wiener_model([["mode", 800.0, 0.7]])
-    with pytest.raises(ValueError, match="dynamics_position"):
-        m.block()
-    with pytest.raises(ValueError, match="dynamics_position"):
-        stream_simulate(m, np.zeros(10))
-    with pytest.raises(ValueError, match="dynamics_position"):
-        fmu_parameters(m)
+    v = np.sin(2 * np.pi * 15 * np.arange(500) * 1e-4)
+    assert np.max(np.abs(stream_simulate(m, v) - m.simulate(v))) < 1e-12
     with pytest.raises(ValueError, match="dynamics_position"):
         m.inverse().block()
 

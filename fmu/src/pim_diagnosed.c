@@ -23,7 +23,21 @@ size_t pim_diag_rate_size(const pim_diag *d)
 size_t pim_diag_state_size(const pim_diag *d)
 {
     return PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
-           pim_diag_element_states(d) + pim_diag_delay_length(d->delay);
+           pim_diag_element_states(d) + pim_diag_delay_length(d->delay) +
+           pim_diag_prefilter_states(d);
+}
+
+size_t pim_diag_prefilter_states(const pim_diag *d)
+{
+    return d->nw ? d->n + (PIM_DIAG_SECTION - 1) * d->nw : 0;
+}
+
+void pim_diag_initial_state(const pim_diag *d, double *x, double z0)
+{
+    const size_t size = pim_diag_state_size(d), nf = pim_diag_prefilter_states(d);
+    for (size_t j = 0; j < size; ++j) x[j] = 0.0;
+    for (size_t i = 0; i < d->n; ++i) x[PIM_DIAG_HEADER + i] = z0;
+    for (size_t i = 0; nf && i < d->n; ++i) x[size - nf + i] = z0; /* zf */
 }
 
 size_t pim_diag_element_states(const pim_diag *d)
@@ -122,6 +136,15 @@ const char *pim_diag_check(const pim_diag *d)
         if (j > 0 && !isfinite(d->el_g[j - 1]))
             return "a further LTI element's gain is not finite";
     }
+    if (d->nw > PIM_DIAG_MAX_ELEMENTS) return "more than 8 prefilter sections";
+    for (size_t j = 0; j < d->nw; ++j) {
+        switch (lti_bad(d->wf_b + PIM_DIAG_SECTION * j, d->wf_a + PIM_DIAG_SECTION * j,
+                        PIM_DIAG_SECTION - 1)) {
+        case 1: return "a prefilter coefficient is not finite";
+        case 2: return "a prefilter section's denominator must start with a[0] = 1";
+        case 3: return "a prefilter section has a pole at z = 1 (sum of a is 0): no rest state";
+        }
+    }
     if (!(isfinite(d->delay) && d->delay >= 0.0 && d->delay <= PIM_DIAG_MAX_DELAY - 2))
         return "the delay must be finite, >= 0 and <= 4094 samples";
     if (d->drift_clock < 0 || d->drift_clock > 2) return "drift_clock must be 0, 1 or 2";
@@ -134,7 +157,8 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     const size_t n = d->n, nr = pim_diag_rate_size(d), q = d->order;
     const size_t nbuf = pim_diag_delay_length(d->delay);
     double *z = x + PIM_DIAG_HEADER, *rate = z + n, *mem = rate + 1, *lag = rate + nr,
-           *s = lag + d->m, *es = s + q, *buf = es + pim_diag_element_states(d);
+           *s = lag + d->m, *es = s + q, *buf = es + pim_diag_element_states(d),
+           *zf = buf + nbuf, *fs = zf + n;
     const int radius = nr && d->rate_family == PIM_DIAG_RATE_RADIUS;
     const int first = x[0] == 0.0;
     if (first) {
@@ -173,6 +197,18 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         }
     }
     h0 += d->c0;
+    /* a prefilter (Wiener model): h from the plays zf of the filtered input x_f instead */
+    if (d->nw) {
+        const size_t m = PIM_DIAG_SECTION, o = PIM_DIAG_SECTION - 1;
+        double xf = v;
+        for (size_t j = 0; j < d->nw; ++j)
+            xf = lti_step(d->wf_b + m * j, d->wf_a + m * j, o, fs + o * j, xf, first);
+        h = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            zf[i] = diag_clamp(zf[i], xf - d->r[i], xf + d->r[i]);
+            h += d->w[i] * zf[i];
+        }
+    }
     /* LTI, transposed direct form II, started at rest around h[0] */
     double xk = q ? lti_step(d->b, d->a, q, s, h, first) : h;
     /* the further elements on h0 (lti.lti_columns): sum_j g_j (E_j[h0] - M_1[h0]) */

@@ -10,6 +10,16 @@
  *
  *     z_i[k] = max(v[k] - r_i, min(v[k] + r_i, z_i[k-1]))              plays (pim_core.h)
  *     h[k]   = sum_i w_i z_i[k],   h0[k] = sum_i w0_i z_i[k] + c0
+ *
+ * With a prefilter (nw > 0, a Wiener model: pimodel.diagnosis.wiener), the hysteresis term h
+ * is that of the filtered input, while h0 and the effect terms keep the plays of v:
+ *
+ *     x_f[k]  = F_nw[... F_1[v] ...][k]    sections F_j = wf_b_j(z^-1) / wf_a_j(z^-1) in series
+ *                                          (transposed DF-II, a_0 = 1), each at rest around its
+ *                                          own first input (F_1: v[0])
+ *     zf_i[k] = max(x_f[k] - r_i, min(x_f[k] + r_i, zf_i[k-1]))    a second play set, zf_i[-1]
+ *                                          the same initial state as z_i[-1]
+ *     h[k]    = sum_i w_i zf_i[k]          (instead of sum_i w_i z_i[k])
  *     x[k]   = LTI[h][k]          b(z^-1) / a(z^-1), a_0 = 1, at rest around h[0]
  *            + sum_j g_j (E_j[h0][k] - M_1[h0][k])   the linear part's further elements:
  *                                     E_j, M_1 second-order sections (b, a of 3 values each,
@@ -33,9 +43,11 @@
  *
  * State (one flat array of pim_diag_state_size(d) doubles, so that python-control blocks and FMU
  * states hold it as is): [started, v_prev, t_start, head, z[n], rate[n_rate], L[m], s[order],
- * e[n_e], buf[nbuf]] (e: two states per section M_1, E_1..E_ne, n_e = 2 (ne + 1), or 0 when
- * ne = 0) with rate = [rho_f[k-1], m[n]] (radius family), [rho_f[k-1]] (weight family) or
- * none; all zero (except z = the initial play states) before the first sample.  `head` is the
+ * e[n_e], buf[nbuf], zf[n_f], f[2 nw]] (e: two states per section M_1, E_1..E_ne, n_e =
+ * 2 (ne + 1), or 0 when ne = 0; zf: the plays of the filtered input and f: two states per
+ * prefilter section, n_f = n, both present only when nw > 0) with rate = [rho_f[k-1], m[n]]
+ * (radius family), [rho_f[k-1]] (weight family) or none; all zero (except z and zf = the
+ * initial play states, pim_diag_initial_state) before the first sample.  `head` is the
  * ring position of x[k-1] in buf (nbuf = floor(d) + 2 when d > 0, else 0).  Units: v and r
  * in the input unit, y, c, c0, center, half in the output unit, t in s, s in output unit / s.
  */
@@ -60,7 +72,8 @@ extern "C" {
 #define PIM_DIAG_MAX_LAGS PIM_MAX_PLAYS        /* creep lags of the FMU unit */
 #define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + 1 + PIM_DIAG_MAX_LAGS + \
                             PIM_DIAG_MAX_ORDER + 2 * (PIM_DIAG_MAX_ELEMENTS + 1) + \
-                            PIM_DIAG_MAX_DELAY)
+                            PIM_DIAG_MAX_DELAY + PIM_DIAG_MAX_PLAYS + \
+                            2 * PIM_DIAG_MAX_ELEMENTS)
 
 typedef struct {
     size_t n;              /* plays */
@@ -86,6 +99,9 @@ typedef struct {
     const double *el_b, *el_a; /* (ne + 1) sections of PIM_DIAG_SECTION coefficients: section 0
                                   the base mode M_1 on h0, section j the element E_j */
     const double *el_g;    /* gains g_j of E_1..E_ne */
+    size_t nw;             /* prefilter sections F_j before the plays (0: none, a Wiener model
+                              has <= PIM_DIAG_MAX_ELEMENTS) */
+    const double *wf_b, *wf_a; /* nw sections of PIM_DIAG_SECTION coefficients, a[0] = 1 */
 } pim_diag;
 
 /* Length of the flat state of d (the layout above). */
@@ -93,6 +109,9 @@ PIM_API size_t pim_diag_state_size(const pim_diag *d);
 
 /* Length of the further elements' state: 2 (ne + 1), or 0 when ne = 0. */
 PIM_API size_t pim_diag_element_states(const pim_diag *d);
+
+/* Length of the prefilter's state: n + 2 nw (zf and the sections), or 0 when nw = 0. */
+PIM_API size_t pim_diag_prefilter_states(const pim_diag *d);
 
 /* Length of the rate state: 1 + n (radius family), 1 (weight family) or 0 (no rate). */
 PIM_API size_t pim_diag_rate_size(const pim_diag *d);
@@ -104,11 +123,15 @@ PIM_API size_t pim_diag_delay_length(double delay);
  * NULL when the parameters are valid (finite; radii sorted >= 0; where used: half > 0,
  * rate_scale > 0, rate_family 0 or 1, rate_tau >= 0, input_range > 0 when rate_tau = 0; lags
  * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists, for the LTI and for each
- * section of the further elements; ne <= PIM_DIAG_MAX_ELEMENTS; 0 <= delay <=
- * PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2), else a static message naming the first bad one
+ * section of the further elements and of the prefilter; ne, nw <= PIM_DIAG_MAX_ELEMENTS;
+ * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2), else a static message naming the first bad one
  * (the FMU adds the value).
  */
 PIM_API const char *pim_diag_check(const pim_diag *d);
+
+/* The state before the first sample into x (pim_diag_state_size(d) values): all zero, the plays
+ * z (and zf) at z0. */
+PIM_API void pim_diag_initial_state(const pim_diag *d, double *x, double z0);
 
 /* One sample: y[k] for v[k] at time t[k]; the state x advances to after sample k. */
 PIM_API double pim_diag_step(const pim_diag *d, double *x, double v, double t);

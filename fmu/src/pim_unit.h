@@ -37,7 +37,8 @@
  * rate band; the rate term is on when one is non-zero), lti_b 800 + i,
  * lti_a 900 + i, and for plays 65..128 p_hi 1000 + i, r_hi 1100 + i, w0_hi 1200 + i,
  * rate_band_gain_hi 1300 + i; the linear part's further elements lti_gain 1400 + i,
- * lti_element_b 1500 + i, lti_element_a 1600 + i); in FMI 3 an array is one variable.
+ * lti_element_b 1500 + i, lti_element_a 1600 + i; a Wiener model's filter before the plays
+ * wiener_element_b 1700 + i, wiener_element_a 1800 + i); in FMI 3 an array is one variable.
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
@@ -129,6 +130,7 @@ typedef enum {
     vr_rate_family = 63,
     vr_rate_tau = 64,
     vr_n_lti_elements = 65,
+    vr_n_wiener_elements = 66,
     vr_p = 100,
     vr_r = 200,
     vr_r_hat = 300,
@@ -144,7 +146,9 @@ typedef enum {
     vr_rate_band_gain_hi = 1300,
     vr_lti_gain = 1400, /* DiagnosedModel: the linear part's further elements */
     vr_lti_element_b = 1500,
-    vr_lti_element_a = 1600
+    vr_lti_element_a = 1600,
+    vr_wiener_element_b = 1700, /* DiagnosedModel: the filter before the plays (Wiener) */
+    vr_wiener_element_a = 1800
 } ValueReference;
 
 typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
@@ -213,6 +217,10 @@ typedef struct {
      * each in lti_element_b, lti_element_a */
     int n_lti_elements;
     double lti_gain[PIM_NMAX], lti_element_b[PIM_NMAX], lti_element_a[PIM_NMAX];
+    /* a Wiener model's filter before the plays (pim_diagnosed.h): n_wiener_elements sections
+     * F_j in series on v, PIM_DIAG_SECTION coefficients each in wiener_element_b, _a */
+    int n_wiener_elements;
+    double wiener_element_b[PIM_NMAX], wiener_element_a[PIM_NMAX];
     double dstate[PIM_DIAG_STATE_MAX];
 #endif
     char msg[256]; /* reason of the last failure */
@@ -326,6 +334,9 @@ static const pim_var unit_vars[] = {
     {"lti_gain", vr_lti_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_gain)},
     {"lti_element_b", vr_lti_element_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_element_b)},
     {"lti_element_a", vr_lti_element_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_element_a)},
+    {"n_wiener_elements", vr_n_wiener_elements, 'I', PIM_PARAMETER, 1, PIM_AT(n_wiener_elements)},
+    {"wiener_element_b", vr_wiener_element_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(wiener_element_b)},
+    {"wiener_element_a", vr_wiener_element_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(wiener_element_a)},
     {"p_hi", vr_p_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p_hi)},
     {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
     {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
@@ -395,6 +406,8 @@ static void unit_defaults(pim_unit *u)
     u->lti_a[0] = 1.0; /* lti_order 0: no LTI */
     for (int j = 0; j <= PIM_DIAG_MAX_ELEMENTS; ++j) /* each section's a[0] = 1 */
         u->lti_element_a[PIM_DIAG_SECTION * j] = 1.0;
+    for (int j = 0; j < PIM_DIAG_MAX_ELEMENTS; ++j)
+        u->wiener_element_a[PIM_DIAG_SECTION * j] = 1.0;
     u->half_range = u->rate_scale = u->input_range = 1.0;
 #endif
 #ifdef PIM_MODEL_DEFAULTS
@@ -492,6 +505,9 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->el_b = u->lti_element_b;
     d->el_a = u->lti_element_a;
     d->el_g = u->lti_gain;
+    d->nw = u->n_wiener_elements > 0 ? (size_t)u->n_wiener_elements : 0;
+    d->wf_b = u->wiener_element_b;
+    d->wf_a = u->wiener_element_a;
 }
 
 /* The plays' arrays joined: plays 1..64 from p, r, w0, rate_band_gain, 65..128 from the _hi
@@ -613,6 +629,30 @@ static int unit_check_diag(pim_unit *u)
         if (!isfinite(u->lti_gain[j]))
             return unit_error(u, "LTI element gain lti_gain[%d] = %g is not finite", j + 1,
                               u->lti_gain[j]);
+    if (u->n_wiener_elements < 0 || u->n_wiener_elements > PIM_DIAG_MAX_ELEMENTS)
+        return unit_error(u, "parameter n_wiener_elements = %d out of range: 0 <= "
+                             "n_wiener_elements <= %d", u->n_wiener_elements,
+                          PIM_DIAG_MAX_ELEMENTS);
+    for (int j = 0; j < PIM_DIAG_SECTION * u->n_wiener_elements; ++j) {
+        if (!isfinite(u->wiener_element_b[j]))
+            return unit_error(u, "prefilter coefficient wiener_element_b[%d] = %g is not finite",
+                              j + 1, u->wiener_element_b[j]);
+        if (!isfinite(u->wiener_element_a[j]))
+            return unit_error(u, "prefilter coefficient wiener_element_a[%d] = %g is not finite",
+                              j + 1, u->wiener_element_a[j]);
+        if (j % PIM_DIAG_SECTION == 0 && u->wiener_element_a[j] != 1.0)
+            return unit_error(u, "parameter wiener_element_a[%d] = %g: each section's "
+                                 "denominator must be normalised (wiener_element_a[%d] = 1)",
+                              j + 1, u->wiener_element_a[j], j + 1);
+        if (j % PIM_DIAG_SECTION == PIM_DIAG_SECTION - 1) {
+            const double *a = u->wiener_element_a + j + 1 - PIM_DIAG_SECTION;
+            if (a[0] + a[1] + a[2] == 0.0)
+                return unit_error(u, "parameters wiener_element_a[%d..%d] = (%g, %g, %g): the "
+                                     "section has a pole at z = 1 (the coefficients sum to 0), "
+                                     "no rest state", j + 2 - PIM_DIAG_SECTION, j + 1, a[0],
+                                  a[1], a[2]);
+        }
+    }
     if (!isfinite(u->delay_samples) || u->delay_samples < 0.0 ||
         u->delay_samples > PIM_DIAG_MAX_DELAY - 2)
         return unit_error(u, "parameter delay_samples = %g out of range: 0 <= delay_samples <= "
@@ -851,8 +891,13 @@ static int unit_setup(pim_unit *u)
     (void)pim_health_init(&u->est_health, n, 1);
     u->health = 0;
 #elif PIM_MODEL == 8
-    memset(u->dstate, 0, sizeof u->dstate); /* not started; plays at z0 */
-    for (size_t i = 0; i < n; ++i) u->dstate[PIM_DIAG_HEADER + i] = u->z0;
+    memset(u->dstate, 0, sizeof u->dstate); /* not started; plays (and a prefilter's) at z0 */
+    {
+        pim_diag d;
+        unit_diag(u, &d);
+        pim_diag_initial_state(&d, u->dstate, u->z0);
+    }
+    (void)n;
 #else
     for (size_t i = 0; i < n; ++i) u->z[i] = u->z0;
 #endif
@@ -1050,8 +1095,8 @@ static int unit_do_step(pim_unit *u, double t, double h)
  * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
 static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
-    /* FMI 2 array elements: base 100, 200, ..., 1600 plus an index below PIM_NMAX */
-    const unsigned base = elements && vr >= 100 && vr < 1700 ? vr - vr % 100 : vr;
+    /* FMI 2 array elements: base 100, 200, ..., 1800 plus an index below PIM_NMAX */
+    const unsigned base = elements && vr >= 100 && vr < 1900 ? vr - vr % 100 : vr;
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
         if (v->vr != base) continue;
@@ -1148,7 +1193,8 @@ static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 3u /* 2: units 4-7 fields; 3: law, health */
+#define PIM_STATE_VERSION 4u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+                                prefilter (Wiener) */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {

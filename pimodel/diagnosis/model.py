@@ -310,6 +310,10 @@ class DiagnosedModel:
               ) -> control.NonlinearIOSystem:
         """The model as a discrete python-control block (C core step, :mod:`.stream`).
 
+        Every forward form streams, a Wiener model (``dynamics_position == "before"``) too:
+        its filter runs as sections in series on ``v`` before a second set of plays, as
+        ``simulate``.
+
         Parameters
         ----------
         dt : float, optional

@@ -31,6 +31,14 @@ order chosen by the diagnosis, zeros from the parallel gains) run as second-orde
 ``h0``: ``sum_j g_j (E_j - M_1)[h0]``, each started at rest around ``h0[0]``, added to the
 hysteresis term before the delay, as :func:`~pimodel.diagnosis.lti.lti_columns` (at most
 ``MAX_ELEMENTS`` elements, :func:`element_sections`).
+
+A Wiener model (``params["dynamics_position"] == "before"``, :mod:`.wiener`) has its filter
+``F`` before the hysteresis instead: the elements of ``params["wiener_elements"]`` run as
+sections in series on ``v`` (:func:`prefilter_sections`), each started at rest around its own
+first input (``x_f[0] = v[0]``), and a second set of plays, at rest at 0 like the first,
+follows ``x_f[k]``; the hysteresis term is ``sum_i w_i zf_i[k]`` of these plays (then the
+delay, as above), while ``h0`` and the creep, asymmetry and rate terms keep the plays of ``v``
+itself, as :meth:`DiagnosedModel.simulate`. No LTI part after the plays applies in this form.
 """
 
 from __future__ import annotations
@@ -48,9 +56,10 @@ from ..fmu.build import NMAX
 from .effects import mode_coefficients
 from .lti import ELEMENT_K, element_coefficients
 from .rate import RATE_FAMILIES, play_bands
+from .wiener import ELEMENT_K as WIENER_K
 
 __all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",
-           "state_labels", "stream_simulate"]
+           "prefilter_sections", "state_labels", "stream_simulate"]
 
 MAX_DELAY = 4094  # samples: PIM_DIAG_MAX_DELAY - 2 (fmu/src/pim_diagnosed.h)
 MAX_ORDER = 63  # LTI order: PIM_DIAG_MAX_ORDER
@@ -93,17 +102,21 @@ def lti_coefficients(model) -> tuple[np.ndarray, np.ndarray] | None:
     return mode_coefficients(p["mode_hz"], p["mode_damping"], model.dt)
 
 
-def _section(element, dt: float, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """ZOH ``(b, a)`` of one element padded to ``SECTION`` coefficients (ValueError naming
-    ``name`` for a malformed element)."""
-    expected = ("expected ('mode', fn > 0 [Hz], zeta > 0), ('lowpass', tau > 0 [s]) or "
-                "('direct',)")
+_FORMS = {"mode": "('mode', fn > 0 [Hz], zeta > 0)", "lowpass": "('lowpass', tau > 0 [s])",
+          "direct": "('direct',)"}
+
+
+def _section(element, dt: float, name: str, kinds=ELEMENT_K) -> tuple[np.ndarray, np.ndarray]:
+    """ZOH ``(b, a)`` of one element (a kind of ``kinds``) padded to ``SECTION`` coefficients
+    (ValueError naming ``name`` for a malformed element)."""
+    forms = [_FORMS[k] for k in kinds]
+    expected = "expected " + ", ".join(forms[:-1]) + " or " + forms[-1]
     try:
         kind = str(element[0])
         values = [float(x) for x in element[1:]]
     except (TypeError, ValueError, IndexError):
         raise ValueError(f"params: {name} = {element!r}: {expected}") from None
-    if (kind not in ELEMENT_K or len(values) != {"mode": 2, "lowpass": 1, "direct": 0}[kind]
+    if (kind not in kinds or len(values) != {"mode": 2, "lowpass": 1, "direct": 0}[kind]
             or not all(math.isfinite(x) and x > 0 for x in values)):
         raise ValueError(f"params: {name} = {element!r}: {expected}")
     b, a = element_coefficients((kind, *values), dt)
@@ -164,6 +177,49 @@ def element_sections(model) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     return np.array([b for b, _ in rows]), np.array([a for _, a in rows]), gains
 
 
+def prefilter_sections(model) -> tuple[np.ndarray, np.ndarray] | None:
+    """A Wiener model's filter before the hysteresis in the C core's form, or None (no filter
+    before the plays).
+
+    Parameters
+    ----------
+    model : DiagnosedModel
+        The model (``params["wiener_elements"]`` when ``model.dynamics_before``).
+
+    Returns
+    -------
+    tuple of numpy.ndarray or None
+        ``b``, ``a`` of shape ``(nw, 3)`` (powers of ``z^-1``, ``a[:, 0] = 1``): row ``j`` the
+        ZOH of element ``j`` (:func:`~pimodel.diagnosis.lti.element_coefficients`, a first-order
+        low-pass padded with zeros), run in series from ``v``.
+
+    Raises
+    ------
+    ValueError
+        No element or more than ``MAX_ELEMENTS`` (8), or a malformed element (named
+        ``wiener_elements[j]``; kinds ``"lowpass"`` and ``"mode"``).
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3, effects=("dynamics",),
+    ...                    params={"dynamics_position": "before",
+    ...                            "wiener_elements": [["lowpass", 1e-3]]})
+    >>> b, a = prefilter_sections(m)
+    >>> b.round(4).tolist(), a.round(4).tolist()
+    ([[0.0, 0.6321, 0.0]], [[1.0, -0.3679, 0.0]])
+    """
+    if not model.dynamics_before:
+        return None
+    elements = model.params.get("wiener_elements")
+    if not isinstance(elements, (list, tuple)) or not 1 <= len(elements) <= MAX_ELEMENTS:
+        raise ValueError(f"params: wiener_elements = {elements!r}: expected 1 to {MAX_ELEMENTS} "
+                         "elements of the filter before the hysteresis")
+    rows = [_section(el, model.dt, f"wiener_elements[{j}]", WIENER_K)
+            for j, el in enumerate(elements)]
+    return np.array([b for b, _ in rows]), np.array([a for _, a in rows])
+
+
 def _band_gains(gains: np.ndarray, n: int) -> np.ndarray:
     """Per play, the gain of its rate band (:func:`.rate.play_bands`, as ``simulate``)."""
     if gains.ndim != 1 or not 1 <= gains.size <= n:
@@ -190,8 +246,9 @@ class NativeModel:
     ValueError
         A parameter the C core refuses (named), rate parameters of an earlier version
         (``rate_band_gains``) or more rate gains than plays, an LTI order above 63, a malformed
-        further element of the linear part or more than 8 (:func:`element_sections`), or a
-        delay above 4094 samples.
+        further element of the linear part or more than 8 (:func:`element_sections`), a
+        malformed filter before the hysteresis (:func:`prefilter_sections`, a Wiener model), or
+        a delay above 4094 samples.
 
     Examples
     --------
@@ -206,10 +263,6 @@ class NativeModel:
         from .model import _rate_params
 
         e, p, r = model.effects, model.params, model.radii
-        if model.dynamics_before:
-            raise ValueError(f"params: dynamics_position = {p['dynamics_position']!r}: a filter "
-                             "before the hysteresis (wiener_elements) changes the plays' input; "
-                             "the C stream (block, FMU) runs dynamics after the hysteresis only")
         n = r.size
         self.model = model
         self.input_range = float(2 * r[-1] if input_range is None else input_range)
@@ -232,7 +285,7 @@ class NativeModel:
             keep["rate_w"] = _band_gains(gains, n)
             d.rate_family, d.rate_tau = RATE_FAMILIES.index(family), tau
             d.rate_scale, d.input_range = p["rate_scale"], self.input_range
-        lti = lti_coefficients(model)
+        lti = None if model.dynamics_before else lti_coefficients(model)
         if lti is not None:
             order = max(lti[0].size, lti[1].size) - 1
             if order > MAX_ORDER:
@@ -240,10 +293,14 @@ class NativeModel:
             keep["b"] = np.pad(lti[0], (0, order + 1 - lti[0].size))
             keep["a"] = np.pad(lti[1], (0, order + 1 - lti[1].size))
             d.order = order
-        sections = element_sections(model)
+        sections = None if model.dynamics_before else element_sections(model)
         if sections is not None:
             keep["el_b"], keep["el_a"], keep["el_g"] = sections
             d.ne = sections[2].size
+        prefilter = prefilter_sections(model)
+        if prefilter is not None:
+            keep["wf_b"], keep["wf_a"] = prefilter
+            d.nw = prefilter[0].shape[0]
         if "delay" in e:
             d.delay = float(p["delay_samples"])
             if not 0 <= d.delay <= MAX_DELAY:
@@ -268,7 +325,8 @@ class NativeModel:
         self.nstates = _native.diag_state_size(d)
 
     def initial_state(self) -> np.ndarray:
-        """The state before the first sample: not started, plays at rest at 0.
+        """The state before the first sample: not started, plays (and a Wiener model's plays of
+        the filtered input) at rest at 0 (``pim_diag_initial_state``).
 
         Returns
         -------
@@ -281,7 +339,7 @@ class NativeModel:
         >>> NativeModel(DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3)).initial_state().tolist()
         [0.0, 0.0, 0.0, 0.0, 0.0]
         """
-        return np.zeros(self.nstates)
+        return _native.diag_initial_state(self.params, 0.0)
 
     def step(self, x: np.ndarray, v: float, t: float) -> float:
         """``y[k]`` for ``v[k]`` at time ``t[k]`` [s]; ``x`` (float64) advances in place.
@@ -393,7 +451,9 @@ def state_labels(model) -> list[str]:
         ``m[1..n]`` (the radius family's terms held from each play's last contact),
         ``L[1..m]`` (creep lags),
         ``s[1..q]`` (LTI states), ``e[1..2 (ne + 1)]`` (the sections of the linear part's
-        further elements and of its base mode on ``h0``), ``x_delay[1..nbuf]`` (delay line).
+        further elements and of its base mode on ``h0``), ``x_delay[1..nbuf]`` (delay line),
+        and for a Wiener model ``zf[1..n]`` (plays of the filtered input) and ``f[1..2 nw]``
+        (two states per section of the filter before the hysteresis).
 
     Examples
     --------
@@ -410,7 +470,8 @@ def state_labels(model) -> list[str]:
     return (["started", "v_prev", "t_start", "head"] + _labels("z", n)
             + rate + _labels("L", d.m)
             + _labels("s", d.order) + _labels("e", 2 * (d.ne + 1) if d.ne else 0)
-            + _labels("x_delay", nbuf))
+            + _labels("x_delay", nbuf)
+            + (_labels("zf", n) + _labels("f", 2 * d.nw) if d.nw else []))
 
 
 def _block_setting(value):
@@ -575,6 +636,9 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
         out.update({"n_lti_elements": int(d.ne), **arr("lti_gain", k["el_g"]),
                     **arr("lti_element_b", k["el_b"].ravel()),
                     **arr("lti_element_a", k["el_a"].ravel())})
+    if d.nw:
+        out.update({"n_wiener_elements": int(d.nw), **arr("wiener_element_b", k["wf_b"].ravel()),
+                    **arr("wiener_element_a", k["wf_a"].ravel())})
     if d.delay:
         out["delay_samples"] = d.delay
     if d.drift_clock:

@@ -273,7 +273,8 @@ MODELS: dict[str, dict] = {
         "id": 8,
         "description": "The model a diagnosis chose: PI hysteresis with signed weights and the "
                        "effect terms in parallel, creep, asymmetry, rate, drift, an LTI (b, a) "
-                       "with further elements on h0, and a delay "
+                       "with further elements on h0 or a filter before the plays (Wiener), "
+                       "and a delay "
                        "(pimodel.diagnosis.model.DiagnosedModel, dt = Ts)",
         "vars": [*_common(z0="initial play state (input unit; a diagnosis starts at 0)",
                           weights=("p", "1", "weight w (any sign), play"),
@@ -331,6 +332,16 @@ MODELS: dict[str, dict] = {
                        "1" if i % 3 == 0 and i <= 3 * MAX_LTI_ELEMENTS else "0",
                        "second-order sections, 3 denominator coefficients each (the first 1), "
                        f"element {i + 1}") for i in range(NMAX)],
+                 Var("n_wiener_elements", 66, "Integer", "parameter", "0",
+                     f"sections F_j of a Wiener model's filter before the plays, in series on "
+                     f"v, 0 <= n_wiener_elements <= {MAX_LTI_ELEMENTS} (0: none)"),
+                 *_arrays("wiener_element_b", 1700, "parameter", "0",
+                          "filter before the plays: second-order sections, 3 numerator "
+                          "coefficients each (z^0, z^-1, z^-2): F_j in 3j-2..3j, element"),
+                 *[Var(f"wiener_element_a[{i + 1}]", 1800 + i, "Real", "parameter",
+                       "1" if i % 3 == 0 and i < 3 * MAX_LTI_ELEMENTS else "0",
+                       "filter before the plays: second-order sections, 3 denominator "
+                       f"coefficients each (the first 1), element {i + 1}") for i in range(NMAX)],
                  *_arrays("p_hi", 1000, "parameter", "1",
                           "weight w of play 64 + i (used when n > 64), element"),
                  *_arrays("r_hi", 1100, "parameter", "0",
