@@ -260,9 +260,10 @@ def test_diagnosed_wiener_model_exports_an_fmu_equal_to_simulate(tmp_path):
     in tests/test_diagnosis_wiener.py; verdict dynamics before the hysteresis): its augmented
     model exported as FMU (FMI 2 and 3) equals simulate to 1e-12 on the validate input in the
     co-simulation master, and so do the C stream and the block."""
+    from test_diagnosis_wiener import truth_driver_records
+
     from pimodel.diagnosis import diagnose
     from pimodel.fmu.model_fmu import build_model_fmus
-    from test_diagnosis_wiener import truth_driver_records
 
     train, validate, _ = truth_driver_records(0)
     m = diagnose(train, validate).model(augmented=True)
