@@ -54,7 +54,8 @@ VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "gua
       "asymmetry_quadratic": 53, "rate_scale": 57, "drift_clock": 60, "lti_order": 61,
       "delay_samples": 62, "creep_gain": 500, "creep_tau": 600, "rate_band_gain": 700,
       "lti_b": 800, "lti_a": 900, "rate_family": 63, "rate_tau": 64, "n_lti_elements": 65,
-      "lti_gain": 1400, "lti_element_b": 1500, "lti_element_a": 1600}
+      "lti_gain": 1400, "lti_element_b": 1500, "lti_element_a": 1600, "n_wiener_elements": 66,
+      "wiener_element_b": 1700, "wiener_element_a": 1800}
 OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
 TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
 CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
@@ -62,6 +63,9 @@ CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
 # stable, a[0] = 1 each
 SECTIONS_B = [0.0, 0.0155, 0.0150, 0.0, 0.0689, 0.0617, 0.0, 0.3935, 0.0]
 SECTIONS_A = [1.0, -1.8779, 0.9084, 1.0, -1.6065, 0.7371, 1.0, -0.6065, 0.0]
+# a Wiener model's filter before the plays: F_1 a low-pass, F_2 a mode (in series on v)
+WIENER_B = [0.0, 0.3935, 0.0, 0.0, 0.0155, 0.0150]
+WIENER_A = [1.0, -0.6065, 0.0, 1.0, -1.8779, 0.9084]
 
 
 def bad_weight(name: str):
@@ -431,6 +435,18 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
                                  [_pick_float(rng, 0.2, 0.1 * hostile), -0.1], 0.0),
                       *set_array(fmi3, VR["lti_element_b"], SECTIONS_B, 0.0),
                       *set_array(fmi3, VR["lti_element_a"], a, 0.0)]
+        if rng.random() < 0.5:  # a filter before the plays (Wiener)
+            a = list(WIENER_A)
+            i = rng.choice([0, 1, 3])
+            a[i] = _pick_float(rng, a[i], 0.1 * hostile)
+            if hostile and rng.random() < 0.1:
+                a[1] = -1.0  # F_1 with a pole at z = 1 (no rest state)
+            extra += [["set_int", VR["n_wiener_elements"], rng.choice([1, 2]) if not hostile else
+                       rng.choice([1, 2, 8, 9, -1, 2**31 - 1])],
+                      *set_array(fmi3, VR["wiener_element_b"],
+                                 [0.0, _pick_float(rng, 0.3935, 0.1 * hostile), 0.0,
+                                  *WIENER_B[3:]], 0.0),
+                      *set_array(fmi3, VR["wiener_element_a"], a, 0.0)]
         if rng.random() < 0.5:
             extra += [*set_array(fmi3, VR["rate_band_gain"], [0.1] * m, 0.0),
                       ["set_real", VR["rate_scale"], _pick_float(rng, 2.0, 0.1 * hostile)],

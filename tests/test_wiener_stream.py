@@ -193,6 +193,40 @@ def test_unit_starts_the_filtered_plays_at_z0(built_fmus):
     assert np.max(np.abs(got - 0.6)) < 1e-15
 
 
+@pytest.mark.parametrize("fmi", ["2.0", "3.0"])
+def test_unit_state_round_trip_holds_the_filter(built_fmus, fmi):
+    """get, serialize, deserialize and set the FMU state half-way: the continuation equals the
+    first run bit for bit (the filter's sections and its plays are in the state)."""
+    m = model("lowpass_then_mode", ("dynamics", "creep", "delay"))
+    _, params = fmu_parameters(m)
+    _, v = signal(400)
+    unit = FMUUnit(unit_file(built_fmus, fmi), params)
+
+    def run(xs):
+        out = []
+        for x in xs:
+            unit.set({"v": x})
+            unit.step(DT)
+            out.append(unit.get(["y"])[0])
+        return out
+
+    try:
+        first = run(v[:200])
+        handle, t_mid = unit.fmu.getFMUState(), unit.time
+        blob = unit.fmu.serializeFMUState(handle)
+        unit.fmu.freeFMUState(handle)
+        second = run(v[200:])
+        handle = unit.fmu.deserializeFMUState(blob)
+        unit.fmu.setFMUState(handle)
+        unit.fmu.freeFMUState(handle)
+        unit.time = t_mid  # the runner's clock follows the restored FMU
+        again = run(v[200:])
+    finally:
+        unit.close()
+    assert again == second
+    assert np.max(np.abs(np.r_[first, second] - m.simulate(v, input_range=RANGE))) < 1e-12
+
+
 @pytest.mark.parametrize(
     ("start", "message"),
     [({"n_wiener_elements": 9}, "parameter n_wiener_elements = 9 out of range: 0 <= "
@@ -254,21 +288,34 @@ def test_cli_builds_a_wiener_fmu_that_validates_and_runs_in_the_masters(tmp_path
     assert np.max(np.abs(r.outputs - want)) < 1e-12
 
 
-@pytest.mark.slow
-def test_diagnosed_wiener_model_exports_an_fmu_equal_to_simulate(tmp_path):
-    """A model the diagnosis chose (``pimodel.truth`` PI behind a first-order driver, written
-    in tests/test_diagnosis_wiener.py; verdict dynamics before the hysteresis): its augmented
-    model exported as FMU (FMI 2 and 3) equals simulate to 1e-12 on the validate input in the
-    co-simulation master, and so do the C stream and the block."""
-    from test_diagnosis_wiener import truth_driver_records
+def _diagnosed(stage: str):
+    """The augmented model the diagnosis chose on a stage of tests/test_diagnosis_wiener.py,
+    and the validate record."""
+    from test_diagnosis_wiener import alt_driver_records, truth_driver_records
 
     from pimodel.diagnosis import diagnose
+
+    if stage == "truth_lowpass":  # pimodel.truth PI behind a first-order driver
+        train, validate, _ = truth_driver_records(0)
+        return diagnose(train, validate).model(augmented=True), validate[0]
+    # pimodel.truth_alt Preisach behind a second-order low-pass (seed 1: the diagnosis fits a
+    # mode of damping above 1)
+    train, validate = alt_driver_records(1)
+    return diagnose(train, validate, initial_state="unknown").model(augmented=True), validate[0]
+
+
+@pytest.mark.parametrize("stage", ["truth_lowpass", "alt_mode"])
+def test_diagnosed_wiener_model_exports_an_fmu_equal_to_simulate(tmp_path, stage):
+    """A model the diagnosis chose (verdict dynamics before the hysteresis) on a stage written
+    in tests/test_diagnosis_wiener.py: the C stream on the whole validate record, and the
+    augmented model exported as FMU (FMI 2 and 3; fmpy validate, fmutool -check) in the
+    co-simulation master and the block on its first samples, equal simulate to 1e-12."""
     from pimodel.fmu.model_fmu import build_model_fmus
 
-    train, validate, _ = truth_driver_records(0)
-    m = diagnose(train, validate).model(augmented=True)
+    m, rec = _diagnosed(stage)
     assert m.dynamics_before and m.params["wiener_elements"]
-    rec = validate[0]
+    assert m.params["wiener_elements"][0][0] == ("lowpass" if stage == "truth_lowpass" else
+                                                 "mode")
     rng = 2 * m.radii[-1]
     want = m.simulate(rec.v, rec.t, input_range=rng)
     assert np.max(np.abs(stream_simulate(m, rec.v, rec.t, input_range=rng) - want)) < 1e-12
@@ -282,3 +329,28 @@ def test_diagnosed_wiener_model_exports_an_fmu_equal_to_simulate(tmp_path):
     blk = m.block()
     r = control.input_output_response(blk, t[:1000], v[:1000], initial_state=initial_state(blk))
     assert np.max(np.abs(r.outputs - want[:1000])) < 1e-12
+
+
+def test_diagnose_export_writes_a_wiener_fmu(tmp_path):
+    """pimodel diagnose --export on the records of the first-order driver stage: the augmented
+    model's FMU (a Wiener model) validates and equals the exported model's simulate to 1e-12
+    in the co-simulation master."""
+    from test_diagnosis_wiener import truth_driver_records
+
+    from pimodel.cli import main
+    from pimodel.data import save_record
+    from pimodel.diagnosis.model import load_diagnosed_model
+
+    train, validate, _ = truth_driver_records(0)
+    paths = [save_record(r, tmp_path / f"{name}.csv")
+             for r, name in ((train[0], "train"), (validate[0], "validate"))]
+    out = tmp_path / "export"
+    assert main(["diagnose", "--train", str(paths[0]), "--validate", str(paths[1]), "--json",
+                 str(tmp_path / "r.json"), "--export", str(out)]) == 0
+    m = load_diagnosed_model(out / "augmented.json")
+    assert m.dynamics_before
+    fmu = out / "augmented_1_DiagnosedModel.fmu"
+    _check_fmu(fmu, "2.0")
+    v = validate[0].v[:3000]
+    want = m.simulate(v, input_range=2 * m.radii[-1])
+    assert np.max(np.abs(cosimulate_chain([fmu], v, m.dt) - want)) < 1e-12
