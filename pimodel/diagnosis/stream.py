@@ -522,7 +522,8 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
     Params (defaults from the model): ``"<name>.weights"``, ``"<name>.offset"``,
     ``"<name>.reference_weights"``, ``"<name>.reference_offset"``, ``"<name>.input_range"``
     and every effect parameter of ``model.params`` (``"<name>.creep_lag_gains"``, ...). A
-    change that alters the state layout (number of lags, LTI order, delay line) is refused.
+    change that alters the state layout (number of lags, LTI order, delay line, number of
+    elements of a Wiener model's filter) is refused.
 
     Examples
     --------
@@ -585,7 +586,9 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
     Parameters
     ----------
     model : DiagnosedModel
-        The model (at most 128 plays, ``p[1..64]`` and ``p_hi[1..64]``, and 64 creep lags).
+        The model (at most 128 plays, ``p[1..64]`` and ``p_hi[1..64]``, and 64 creep lags; a
+        Wiener model's filter in ``n_wiener_elements``, ``wiener_element_b``,
+        ``wiener_element_a``, :func:`prefilter_sections`).
     input_range : float, optional
         Range of the rate effect's step rule; default ``2 r_n``.
 
