@@ -17,7 +17,8 @@ fi
 if [ ! -x .venv/bin/python ]; then
     echo "quickstart: creating .venv with $PY"
     "$PY" -m venv .venv
-    .venv/bin/python -m pip install -q --upgrade pip
+    # the build backend too, so that a rebuild with --no-build-isolation works (docs/DEVELOPING.md)
+    .venv/bin/python -m pip install -q --upgrade pip "setuptools>=77" wheel
 fi
 
 cmd=${1:-demo}
