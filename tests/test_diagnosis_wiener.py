@@ -13,6 +13,7 @@ import pytest
 from scipy.signal import lfilter, lfilter_zi
 
 from pimodel import Record
+from pimodel.blocks import initial_state
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.model import DiagnosedModel, load_diagnosed_model
 from pimodel.diagnosis.wiener import inverse_prefilter, prefilter, search_filter
@@ -90,16 +91,16 @@ def test_model_simulates_the_plays_of_the_filtered_input(tmp_path):
     assert not m.is_exactly_invertible
 
 
-def test_stream_runs_the_filter_and_the_inverse_block_refuses_it():
+def test_stream_and_inverse_block_run_the_filter():
     """The forward model streams on the C core (tests/test_wiener_stream.py: block and FMU);
-    the inverse's block does not take a filter before the hysteresis."""
+    the inverse's block runs the filter's inverse after its solver, one sample later than the
+    batch (tests/test_inverse_block.py)."""
     from pimodel.diagnosis.stream import stream_simulate
 
     m = _wiener_model([["mode", 800.0, 0.7]])
     v = np.sin(2 * np.pi * 15 * np.arange(500) * 1e-4)
     assert np.max(np.abs(stream_simulate(m, v) - m.simulate(v))) < 1e-12
-    with pytest.raises(ValueError, match="dynamics_position"):
-        m.inverse().block()
+    assert m.inverse().block().latency == 1
 
 
 def truth_driver_records(seed: int):
@@ -155,6 +156,23 @@ def test_diagnosed_wiener_model_simulates_what_was_fitted(driver_report):
     aug = rep.model()
     assert aug.dynamics_before
     assert np.max(np.abs(aug.simulate(rec.v, rec.t) - rep.after[0])) < 1e-9 * np.ptp(rec.y)
+
+
+@pytest.mark.slow
+def test_diagnosed_wiener_inverse_block_equals_its_batch(driver_report):
+    """The inverse of the model the diagnosis chose (a low-pass before 40 plays) as a block:
+    the batch feedforward delayed by one sample, for the first 3000 samples of the validate
+    record's output as the reference."""
+    rep, rec, _ = driver_report
+    inv = rep.model().inverse()
+    y_d = rec.y[:3000]
+    want = inv.simulate(y_d)
+    blk = inv.block(reference_range=float(np.ptp(inv.prefilter(y_d))))
+    t = np.arange(y_d.size) * rep.model().dt
+    res = control.input_output_response(blk, t, y_d, initial_state=initial_state(blk))
+    a = blk.latency
+    assert a == 1
+    assert np.max(np.abs(res.outputs[a:] - want[:y_d.size - a])) < 1e-9 * np.ptp(want)
 
 
 @pytest.mark.slow

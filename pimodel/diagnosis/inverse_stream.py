@@ -6,7 +6,8 @@ prefilter reads the reference ahead, by one sample for the zero-order hold of th
 approximate inverse (none when the linear part has a direct term) and by the delay ``d``
 samples. The block runs the causal part and delays its output instead, by the latency
 
-    A = advance + floor(d) + (1 if the delay has a fractional part else 0)   samples,
+    A = advance + floor(d) + (1 if the delay has a fractional part else 0)
+          + (1 for a filter before the hysteresis)                           samples,
 
 so that, fed ``y_d[0..k]``, it outputs ``v[k] = v_batch[k - A]`` for ``k >= A`` (``v_batch =
 DiagnosedInverse.simulate(y_d)``, exact to rounding, the last ``A`` batch samples aside, which
@@ -22,6 +23,12 @@ Per sample ``k``: the reference goes through the prefilter's filter (second-orde
 :func:`~pimodel.diagnosis.lti.approximate_inverse`), the advanced sample ``j = k - A`` is
 interpolated from its last two outputs (the delay's fraction), and the static part is inverted
 sample by sample (:class:`StaticInverse`, the per-sample form of the model module's solver).
+A filter before the hysteresis (a Wiener model, ``dynamics_position == "before"``) has no
+prefilter; the solver gives the filter's output ``x`` and the sections of the filter's stable
+approximate inverse (:func:`~pimodel.diagnosis.wiener.inverse_sections`, started at rest around
+the first solver output, as :func:`~pimodel.diagnosis.wiener.inverse_prefilter`) give ``v``.
+The batch advances that inverse by one sample (the zero-order hold); the block cannot, which
+is its one more sample of latency.
 """
 
 from __future__ import annotations
@@ -38,6 +45,7 @@ from .lti import inverse_sos
 from .model import _rate_params, _roots
 from .monotone import monotone_model
 from .rate import STEP_SHARE, play_bands
+from .wiener import inverse_sections
 
 __all__ = ["StaticInverse", "inverse_block", "inverse_latency"]
 
@@ -53,8 +61,9 @@ def inverse_latency(model) -> int:
     Returns
     -------
     int
-        ``A = advance + floor(d) + (1 if d has a fractional part above 1e-12)``; 0 for a
-        model without dynamics and delay.
+        ``A = advance + floor(d) + (1 if d has a fractional part above 1e-12)``, plus 1 for a
+        filter before the hysteresis (its inverse's one-sample advance); 0 for a model
+        without dynamics and delay.
 
     Examples
     --------
@@ -65,7 +74,7 @@ def inverse_latency(model) -> int:
     (4, 0)
     """
     d0, f = _delay(model)
-    return _advance_of(model) + d0 + (1 if f > 0 else 0)
+    return _advance_of(model) + d0 + (1 if f > 0 else 0) + (1 if model.dynamics_before else 0)
 
 
 def _delay(model) -> tuple[int, float]:
@@ -79,8 +88,9 @@ def _delay(model) -> tuple[int, float]:
 
 
 def _filter(model) -> tuple[np.ndarray | None, int]:
-    """The prefilter's sections (None without dynamics) and its advance (0 or 1)."""
-    if "dynamics" not in model.effects:
+    """The prefilter's sections (None without dynamics after the hysteresis) and its advance
+    (0 or 1)."""
+    if "dynamics" not in model.effects or model.dynamics_before:
         return None, 0
     p = model.params
     return inverse_sos(p["mode_hz"], p["mode_damping"], p.get("lti_elements", ()),
@@ -306,9 +316,22 @@ class StaticInverse:
         return vk
 
 
+def _sections_step(sos: np.ndarray, s: np.ndarray, u: float) -> float:
+    """One sample of ``sos`` in transposed direct form II (as :func:`scipy.signal.sosfilt`);
+    the states ``s`` (shape ``(sections, 2)``) advance in place."""
+    for i, (b0, b1, b2, _, a1, a2) in enumerate(sos):
+        y = b0 * u + s[i, 0]
+        s[i, 0] = b1 * u - a1 * y + s[i, 1]
+        s[i, 1] = b2 * u - a2 * y
+        u = y
+    return u
+
+
 class _InverseStream:
-    """The block's sample: prefilter sections, the delay's interpolation and the solver, on one
-    flat state ``[started, seen, v_rest, F_prev, sections (2 each), solver state]``."""
+    """The block's sample: prefilter sections, the delay's interpolation, the solver and, for a
+    filter before the hysteresis, the sections of its inverse after the solver, on one flat
+    state ``[started, seen, v_rest, F_prev, sections (2 each), post sections (2 each), solver
+    state]``."""
 
     HEAD = 4
 
@@ -317,35 +340,43 @@ class _InverseStream:
         self.sos, _ = _filter(model)
         self.zi = None if self.sos is None else sosfilt_zi(self.sos)
         self.ns = 0 if self.sos is None else self.sos.shape[0]
+        self.post = (inverse_sections(model.params["wiener_elements"], model.dt)
+                     if model.dynamics_before else None)
+        self.post_zi = None if self.post is None else sosfilt_zi(self.post)
+        self.np = 0 if self.post is None else self.post.shape[0]
         self.latency = inverse_latency(model)
+        self.solve_from = self.latency - (1 if model.dynamics_before else 0)  # the delay's part
         self.frac = _delay(model)[1]
-        self.size = self.HEAD + 2 * self.ns + self.solver.size
+        self._s = slice(self.HEAD, self.HEAD + 2 * self.ns)
+        self._post = slice(self._s.stop, self._s.stop + 2 * self.np)
+        self.size = self._post.stop + self.solver.size
 
     def labels(self) -> list[str]:
         return (["started", "seen", "v_rest", "F_prev"] + _labels("f", 2 * self.ns)
-                + [f"solver.{s}" for s in self.solver.labels()])
+                + _labels("g", 2 * self.np) + [f"solver.{s}" for s in self.solver.labels()])
 
     def step(self, x: np.ndarray, yd: float) -> float:
         """``v`` output at this sample; ``x`` advances in place."""
-        s = x[self.HEAD:self.HEAD + 2 * self.ns].reshape(self.ns, 2)
-        solver_x = x[self.HEAD + 2 * self.ns:]
+        s = x[self._s].reshape(self.ns, 2)
+        post = x[self._post].reshape(self.np, 2)
+        solver_x = x[self._post.stop:]
         if x[0] == 0.0:
             x[0] = 1.0
             if self.ns:
                 s[:] = self.zi * yd
             if self.latency:  # the inverse of y_d[0] at rest (output until the first solve)
                 x[2] = self.solver.step(self.solver.initial_state(), yd)
-        fk = yd
-        for i, (b0, b1, b2, _, a1, a2) in enumerate(self.sos if self.ns else ()):
-            y = b0 * fk + s[i, 0]  # transposed direct form II, as scipy.signal.sosfilt
-            s[i, 0] = b1 * fk - a1 * y + s[i, 1]
-            s[i, 1] = b2 * fk - a2 * y
-            fk = y
+        fk = _sections_step(self.sos, s, yd) if self.ns else yd
         seen = int(x[1])
-        if seen >= self.latency:
+        v = float(x[2])
+        if seen >= self.solve_from:
             ref = fk if self.frac == 0.0 else x[3] + (fk - x[3]) * self.frac
             v = self.solver.step(solver_x, ref)
-        else:
+            if self.np:  # the filter's inverse, at rest around the first solver output
+                if seen == self.solve_from:
+                    post[:] = self.post_zi * v
+                v = _sections_step(self.post, post, v)
+        if seen < self.latency:
             v = float(x[2])
             x[1] = seen + 1
         x[3] = fk
@@ -381,8 +412,7 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
     Raises
     ------
     ValueError
-        ``dt`` other than the model's, a bad model parameter, a filter before the hysteresis
-        (``dynamics_position = "before"``).
+        ``dt`` other than the model's, a bad model parameter.
 
     Examples
     --------
@@ -397,11 +427,6 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
     ([0.0, 1.0, 0.0], 0)
     """
     model = inverse.model
-    if model.dynamics_before:
-        raise ValueError(f"params: dynamics_position = {model.params['dynamics_position']!r}: "
-                         "the inverse of a filter before the hysteresis (wiener_elements) runs "
-                         "after the solve, on the whole record; the block covers dynamics "
-                         "after the hysteresis only")
     dt = model.dt if dt is None else float(dt)
     if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
         raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its filter "

@@ -40,8 +40,8 @@ from scipy.signal import bilinear_zpk, lfilter, lfilter_zi, sosfilt, sosfilt_zi,
 from ..operator import PIOperator
 from .lti import INVERSE_FILTER, element_coefficients, nelder_mead
 
-__all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "polish_filter",
-           "position_hint", "prefilter", "search_filter", "wiener_k"]
+__all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "inverse_sections",
+           "polish_filter", "position_hint", "prefilter", "search_filter", "wiener_k"]
 
 MIN_HZ = 50.0  # slowest corner or mode [Hz] (a slower filter moves every loop of the record)
 LOWPASS_HZ = 8  # points of the low-pass grid, geometric from MIN_HZ to the highest frequency
@@ -361,6 +361,51 @@ def position_hint(alone_grid: dict) -> dict:
     return {k: alone_grid[k] for k in KEYS if k in alone_grid}
 
 
+def inverse_sections(elements: Sequence, dt: float) -> np.ndarray | None:
+    """Second-order sections of the stable approximate inverse of the filter ``F`` (module
+    docstring), before its one-sample advance; None for an empty filter.
+
+    Parameters
+    ----------
+    elements : sequence
+        The filter's elements.
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    numpy.ndarray or None
+        ``sos`` of shape ``(s, 6)`` (:func:`scipy.signal.sosfilt` form), static gain 1: what
+        :func:`inverse_prefilter` runs and the inverse block
+        (:mod:`~pimodel.diagnosis.inverse_stream`) steps through.
+
+    Raises
+    ------
+    ValueError
+        An unknown element kind.
+
+    Examples
+    --------
+    >>> sos = inverse_sections([("lowpass", 1e-3)], 1e-4)
+    >>> sos.shape, round(float(np.sum(sos[0, :3]) / np.sum(sos[0, 3:])), 12)
+    ((1, 6), 1.0)
+    """
+    poles = []
+    for e in elements:
+        if _check(e) == "lowpass":
+            poles.append(np.array([-1.0 / float(e[1])]))
+        else:
+            w, z = 2 * np.pi * float(e[1]), float(e[2])
+            poles.append(np.roots([1.0, 2 * z * w, w * w]))
+    p = np.concatenate(poles) if poles else np.zeros(0)
+    if p.size == 0:
+        return None
+    wf = INVERSE_FILTER * float(np.max(np.abs(p)))
+    p_inv = np.full(p.size, -wf)
+    k = float(np.real(np.prod(-p_inv) / np.prod(-p)))  # static gain 1
+    return zpk2sos(*bilinear_zpk(p, p_inv, k, fs=1.0 / dt))
+
+
 def inverse_prefilter(x: np.ndarray, elements: Sequence, dt: float) -> np.ndarray:
     """``x`` through a stable approximate inverse of the filter ``F`` (module docstring).
 
@@ -388,19 +433,8 @@ def inverse_prefilter(x: np.ndarray, elements: Sequence, dt: float) -> np.ndarra
     >>> bool(np.max(err) < 0.02)  # the added low-pass at 318 Hz lags 5 Hz by about 1 degree
     True
     """
-    poles = []
-    for e in elements:
-        if _check(e) == "lowpass":
-            poles.append(np.array([-1.0 / float(e[1])]))
-        else:
-            w, z = 2 * np.pi * float(e[1]), float(e[2])
-            poles.append(np.roots([1.0, 2 * z * w, w * w]))
-    p = np.concatenate(poles) if poles else np.zeros(0)
-    if p.size == 0:
+    sos = inverse_sections(elements, dt)
+    if sos is None:
         return np.asarray(x, float)
-    wf = INVERSE_FILTER * float(np.max(np.abs(p)))
-    p_inv = np.full(p.size, -wf)
-    k = float(np.real(np.prod(-p_inv) / np.prod(-p)))  # static gain 1
-    sos = zpk2sos(*bilinear_zpk(p, p_inv, k, fs=1.0 / dt))
     out = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])[0]
     return np.r_[out[1:], out[-1]]
