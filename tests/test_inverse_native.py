@@ -235,3 +235,19 @@ def test_errors():
         NativeInverse(wiener.inverse())
     with pytest.raises(ValueError, match="dynamics_position"):
         inverse_fmu_parameters(wiener.inverse())
+
+
+@pytest.mark.parametrize("case", ["nominal", "asymmetry", "rate_radius", "static_all"])
+def test_jumps_and_an_unreachable_reference(case, single_roots):
+    """Steps (the root far from the branch guess: the C solver searches outward from the guess
+    and stops early, the Python one scans every segment) and samples beyond the search bracket
+    (no root: the breakpoint closest to the target) give the same inputs."""
+    effects, extra = CASES[case]
+    m = model(effects, **extra)
+    steps = np.repeat([0.05, 1.2, -0.9, 0.4, 1e4, 0.3, -1e4, -0.2], 25)
+    want, _ = python_stream(m, steps, None)
+    got = NativeInverse(m.inverse()).run(steps)
+    assert min(single_roots) > 1e-6
+    assert np.max(np.abs(got - want)) < 1e-9
+    out_of_reach = np.abs(m.simulate(got, input_range=2 * RADII[-1]) - steps) > 1.0
+    assert out_of_reach[100] and out_of_reach[150]  # beyond the bracket at the jump

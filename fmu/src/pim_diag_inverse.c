@@ -142,15 +142,22 @@ static int dinv_cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The candidate root x (inside the segment) against the best so far: the nearest the guess
- * wins, the first one on a tie. */
-static void dinv_take(double x, double guess, double *best, double *dist, int *found)
+/* The root chosen so far: the nearest the branch guess; on a tie the first in the full scan's
+ * order (segment roots by segment, then breakpoints), given by key. */
+typedef struct {
+    double guess, best, dist;
+    size_t key;
+    int found;
+} dinv_pick;
+
+static void dinv_take(dinv_pick *p, double x, size_t key)
 {
-    const double e = fabs(x - guess);
-    if (!*found || e < *dist) {
-        *best = x;
-        *dist = e;
-        *found = 1;
+    const double e = fabs(x - p->guess);
+    if (!p->found || e < p->dist || (e == p->dist && key < p->key)) {
+        p->best = x;
+        p->dist = e;
+        p->key = key;
+        p->found = 1;
     }
 }
 
@@ -161,11 +168,10 @@ static double cubic_at(const double *a, double x)
 
 /* Real roots in [0, 1] of a[0] x^3 + a[1] x^2 + a[2] x + a[3]: the interval split at the
  * closed-form extrema (where the polynomial is monotone), a sign change on a piece bisected. */
-static void cubic_roots01(const double *a, double lo, double width, double guess, double *best,
-                          double *dist, int *found)
+static void cubic_roots01(const double *a, double lo, double width, dinv_pick *p, size_t key)
 {
     if (a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0 && a[3] == 0.0) { /* as np.roots' [0.0] */
-        dinv_take(lo, guess, best, dist, found);
+        dinv_take(p, lo, key);
         return;
     }
     double pts[5] = {0.0, 1.0, 0.0, 0.0, 0.0};
@@ -184,11 +190,11 @@ static void cubic_roots01(const double *a, double lo, double width, double guess
         double pa = pts[j], pb = pts[j + 1];
         double fa = cubic_at(a, pa), fb = cubic_at(a, pb);
         if (fa == 0.0) {
-            dinv_take(lo + pa * width, guess, best, dist, found);
+            dinv_take(p, lo + pa * width, key);
             continue;
         }
         if (j + 2 == np && fb == 0.0) {
-            dinv_take(lo + pb * width, guess, best, dist, found);
+            dinv_take(p, lo + pb * width, key);
             continue;
         }
         if (!((fa < 0.0 && fb > 0.0) || (fa > 0.0 && fb < 0.0))) continue;
@@ -207,7 +213,7 @@ static void cubic_roots01(const double *a, double lo, double width, double guess
                 pb = mid;
             }
         }
-        dinv_take(lo + 0.5 * (pa + pb) * width, guess, best, dist, found);
+        dinv_take(p, lo + 0.5 * (pa + pb) * width, key);
     }
 }
 
@@ -269,38 +275,69 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
         ++nb;
     }
     if (bhi > b[nb - 1]) b[nb++] = bhi;
-    /* roots inside the segments: the polynomial from interior nodes */
-    double best = 0.0, dist = 0.0;
-    int found = 0;
-    for (size_t s = 0; s + 1 < nb; ++s) {
-        const double lo = b[s], width = b[s + 1] - b[s];
+    /* the roots, searched outward from the guess: segment s holds roots within [b[s], b[s+1]]
+     * (the polynomial from interior nodes), breakpoint s is a root when F(b[s]) is on the
+     * target; the search stops where every segment left is farther from the guess than the
+     * root found (the choice of the full scan of pim_diag_inverse.h, in O(1) segments when the
+     * root is near the guess) */
+    dinv_pick pick = {guess, 0.0, 0.0, 0, 0};
+    const double tol = 1e-10 * (1.0 + fabs(yk));
+    const double slack = 1e-12 * (1.0 + fabs(guess) + span);
+    double gb[DINV_NB_MAX];
+    unsigned char seen[DINV_NB_MAX];
+    memset(seen, 0, nb);
+    size_t left = 0; /* the segment holding the guess (or the end one nearest it) */
+    while (left + 2 < nb && b[left + 1] <= guess) ++left;
+    size_t right = left + 1; /* segments left - 1 .. 0 and right .. nb - 2 are still to do */
+    int has_left = nb >= 2; /* (nb >= 3 but for values near the largest doubles) */
+    for (;;) {
+        const double dl = has_left ? (guess < b[left] ? b[left] - guess
+                                      : guess > b[left + 1] ? guess - b[left + 1] : 0.0)
+                                   : INFINITY;
+        const double dr = right + 1 < nb ? (guess < b[right] ? b[right] - guess : 0.0)
+                                         : INFINITY;
+        const double dn = dl < dr ? dl : dr;
+        if (dn == INFINITY || (pick.found && dn > pick.dist + slack)) break;
+        size_t sg;
+        if (dl <= dr) {
+            sg = left;
+            if (left == 0) has_left = 0;
+            else --left;
+        } else {
+            sg = right++;
+        }
+        const double lo = b[sg], width = b[sg + 1] - b[sg];
         if (!d->asym) {
             const double f0 = dinv_F(&c, lo + 0.25 * width) - yk;
             const double f1 = dinv_F(&c, lo + 0.75 * width) - yk;
             const double slope = 2.0 * (f1 - f0), c0 = 1.5 * f0 - 0.5 * f1;
-            if (slope == 0.0) continue;
-            const double xr = -c0 / slope;
-            if (xr >= 0.0 && xr <= 1.0) dinv_take(lo + xr * width, guess, &best, &dist, &found);
+            const double xr = slope != 0.0 ? -c0 / slope : -1.0;
+            if (xr >= 0.0 && xr <= 1.0) dinv_take(&pick, lo + xr * width, sg);
         } else {
             double f[4], a[4] = {0.0, 0.0, 0.0, 0.0};
             for (int j = 0; j < 4; ++j) f[j] = dinv_F(&c, lo + (0.125 + 0.25 * j) * width) - yk;
             for (int i = 0; i < 4; ++i)
                 for (int j = 0; j < 4; ++j) a[i] += VINV[i][j] * f[j];
-            cubic_roots01(a, lo, width, guess, &best, &dist, &found);
+            cubic_roots01(a, lo, width, &pick, sg);
+        }
+        for (size_t e = sg; e <= sg + 1; ++e) { /* its ends, each once */
+            if (seen[e]) continue;
+            seen[e] = 1;
+            gb[e] = fabs(dinv_F(&c, b[e]) - yk);
+            if (gb[e] <= tol) dinv_take(&pick, b[e], nb + e);
         }
     }
-    /* a breakpoint on the target is a root; out of reach, the closest breakpoint */
-    double vk = b[0], gmin = INFINITY;
-    const double tol = 1e-10 * (1.0 + fabs(yk));
-    for (size_t s = 0; s < nb; ++s) {
-        const double g = fabs(dinv_F(&c, b[s]) - yk);
-        if (g <= tol) dinv_take(b[s], guess, &best, &dist, &found);
-        if (g < gmin) {
-            gmin = g;
-            vk = b[s];
-        }
+    double vk = b[0];
+    if (pick.found) {
+        vk = pick.best;
+    } else { /* out of reach (every breakpoint seen): the closest to the target, the first */
+        double gmin = INFINITY;
+        for (size_t e = 0; e < nb; ++e)
+            if (seen[e] && gb[e] < gmin) {
+                gmin = gb[e];
+                vk = b[e];
+            }
     }
-    if (found) vk = best;
     /* the state after the solve */
     double h = 0.0;
     for (size_t i = 0; i < n; ++i) {

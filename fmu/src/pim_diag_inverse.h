@@ -31,7 +31,9 @@
  * between the sorted breakpoints b (z - r, z + r, v[k-1] and 10 span beyond them) F_k is a
  * polynomial (linear, cubic with the asymmetry) interpolated from interior nodes; a breakpoint
  * where |F_k - ref| <= 1e-10 (1 + |ref|) is a root too.  The root nearest the branch guess
- * wins; out of reach, the breakpoint closest to the target.  Guess: v[k] after a jump of more
+ * wins (the first in segment order on a tie; the segments are searched outward from the guess
+ * and the search stops where the rest lie farther than the root found, which chooses as a scan
+ * of every segment does); out of reach, the breakpoint closest to the target.  Guess: v[k] after a jump of more
  * than 1 % of span, else 2 v[k] - v[k-1].  span = max(2 r_n, reference_range / max(|sum w|,
  * 1e-12), 1).  After the solve: plays, creep lags L_j = a_j L_j + (1 - a_j) h0 (L = h0 on the
  * first solve), rate rho_f and the radius family's memory m_i of the plays in contact.
