@@ -83,9 +83,10 @@ def test_unit_with_more_than_64_plays_and_a_start_memory(fmus, fmi):
     native = NativeInverse(m.inverse())
     got = run_inverse_unit(unit_path(fmus, fmi), params, y_d, DT)
     assert np.max(np.abs(got - native.run(y_d))) < 1e-9
-    z0 = np.clip(-0.2, -radii, radii)
     got = run_inverse_unit(unit_path(fmus, fmi), {**params, "z0": -0.2}, y_d, DT)
-    assert np.max(np.abs(got - native.run(y_d, z0=np.maximum(z0, -0.2)))) < 1e-9
+    want = native.run(y_d, z0=np.full(n, -0.2))  # z0: every play (and the rate source's)
+    assert np.max(np.abs(got - want)) < 1e-9
+    assert np.max(np.abs(want - native.run(y_d))) > 0.01  # the start memory matters
 
 
 @pytest.mark.parametrize(
