@@ -251,3 +251,26 @@ def test_jumps_and_an_unreachable_reference(case, single_roots):
     assert np.max(np.abs(got - want)) < 1e-9
     out_of_reach = np.abs(m.simulate(got, input_range=2 * RADII[-1]) - steps) > 1.0
     assert out_of_reach[100] and out_of_reach[150]  # beyond the bracket at the jump
+
+
+@pytest.mark.slow
+def test_c_step_equals_python_on_the_real_record_models(real_record_path, single_roots):
+    """The models diagnosed on the shared real record (80 signed plays, the nominal one folding:
+    the monotone projection), inverted on the measured output of the validate half (2000
+    samples; data no model made, so not every sample is reachable)."""
+    from pimodel import load_record
+
+    rec = load_record(real_record_path)
+    k0 = int(np.argmax(np.abs(rec.v) > 1))
+    mid = k0 + (len(rec) - k0) // 2
+    rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)])
+    y_d = np.asarray(rec.y[mid:mid + 2000], float)
+    for m in (rep.model(), rep.model(augmented=False)):
+        single_roots.clear()
+        inv = m.inverse()
+        rr = float(np.ptp(inv.prefilter(y_d)))
+        want, _ = python_stream(m, y_d, rr)
+        got = NativeInverse(inv, reference_range=rr).run(y_d)
+        assert min(single_roots) > 1e-6
+        assert np.max(np.abs(got - want)) < 1e-9
+    assert not is_monotone(rep.model(augmented=False).weights)
