@@ -253,6 +253,64 @@ def diag_run(d: DiagParams, x: np.ndarray, v: np.ndarray, t: np.ndarray | None) 
     return y
 
 
+# -- the diagnosed model's feedforward (fmu/src/pim_diag_inverse.h) ---------------------------
+
+
+class InverseParams(ctypes.Structure):
+    """``pim_dinv`` (fmu/src/pim_diag_inverse.h): a diagnosed model's causal feedforward."""
+
+    _fields_ = [("n", c_size), ("w", _DP), ("r", _DP), ("w0", _DP), ("c", c_double),
+                ("c0", c_double), ("m", c_size), ("lag_a", _DP), ("lag_g", _DP),
+                ("asym", c_int), ("q", c_double), ("c3", c_double), ("center", c_double),
+                ("half", c_double), ("rate_w", _DP), ("dt", c_double),
+                ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
+                ("rate_tau", c_double), ("reference_range", c_double), ("ns", c_size),
+                ("sos", _DP), ("latency", c_size), ("frac", c_double)]
+
+
+_IP = ctypes.POINTER(InverseParams)
+lib.pim_dinv_state_size.restype = c_size
+lib.pim_dinv_state_size.argtypes = [_IP]
+lib.pim_dinv_check.restype = ctypes.c_char_p
+lib.pim_dinv_check.argtypes = [_IP]
+lib.pim_dinv_initial_state.restype = None
+lib.pim_dinv_initial_state.argtypes = [_IP, F64, F64_OR_NULL]
+lib.pim_dinv_step.restype = c_double
+lib.pim_dinv_step.argtypes = [_IP, F64, c_double]
+lib.pim_dinv_run.restype = None
+lib.pim_dinv_run.argtypes = [_IP, F64, c_size, F64, F64]
+
+
+def inverse_state_size(d: InverseParams) -> int:
+    """Length of the feedforward's flat state."""
+    return int(lib.pim_dinv_state_size(ctypes.byref(d)))
+
+
+def inverse_check(d: InverseParams) -> str | None:
+    """Message naming the first bad parameter, or None."""
+    msg = lib.pim_dinv_check(ctypes.byref(d))
+    return None if msg is None else msg.decode()
+
+
+def inverse_initial_state(d: InverseParams, z0: np.ndarray | None = None) -> np.ndarray:
+    """The state before the first sample: zeros, the plays at ``z0`` (None: 0)."""
+    x = np.empty(inverse_state_size(d))
+    lib.pim_dinv_initial_state(ctypes.byref(d), x, z0)
+    return x
+
+
+def inverse_step(d: InverseParams, x: np.ndarray, y_d: float) -> float:
+    """One sample ``v[k]``; the state ``x`` advances in place."""
+    return lib.pim_dinv_step(ctypes.byref(d), x, float(y_d))
+
+
+def inverse_run(d: InverseParams, x: np.ndarray, y_d: np.ndarray) -> np.ndarray:
+    """``v[k]`` for ``y_d[0..N-1]``; ``x`` advances in place."""
+    v = np.empty(y_d.shape[0])
+    lib.pim_dinv_run(ctypes.byref(d), x, y_d.shape[0], y_d, v)
+    return v
+
+
 # -- health of a radius estimate (fmu/src/pim_est_health.h) ------------------------------------
 
 HEALTH_EXCITATION, HEALTH_MERGED, HEALTH_PINNED, HEALTH_MOVING, HEALTH_FIT = 1, 2, 4, 8, 16

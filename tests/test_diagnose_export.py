@@ -49,7 +49,8 @@ def test_export_refuses_to_overwrite_an_input(records, tmp_path):
 def test_export_writes_fmus_equal_to_the_models(records, tmp_path):
     """--export writes both models' FMUs (unit DiagnosedModel, signed weights and the creep
     term in parallel): fmpy validate and fmutool -check pass, and in the co-simulation master
-    each equals its model's simulate to 1e-12 on the validate input."""
+    each equals its model's simulate to 1e-12 on the validate input; and their feedforwards'
+    FMUs (unit DiagnosedInverse) validate and equal the C stream of the inverse."""
     import shutil
     import subprocess
     import sys
@@ -57,6 +58,7 @@ def test_export_writes_fmus_equal_to_the_models(records, tmp_path):
 
     from fmpy.validation import validate_fmu
 
+    from pimodel.diagnosis.inverse_native import NativeInverse
     from pimodel.fmu.model_fmu import cosimulate_chain
 
     train, validate, vv = records
@@ -76,4 +78,10 @@ def test_export_writes_fmus_equal_to_the_models(records, tmp_path):
         v = vv[:4000]
         want = model.simulate(v, input_range=2 * model.radii[-1])
         assert np.max(np.abs(cosimulate_chain([fmu], v, model.dt) - want)) < 1e-12
+        # the feedforward's FMU (unit DiagnosedInverse) equals the C stream of its inverse
+        inverse_fmu = out / f"{stem}_1_DiagnosedInverse.fmu"
+        assert validate_fmu(str(inverse_fmu)) == []
+        y_d = want[:1500]
+        v_ff = NativeInverse(model.inverse()).run(y_d)
+        assert np.max(np.abs(cosimulate_chain([inverse_fmu], y_d, model.dt) - v_ff)) < 1e-9
     assert np.any(load_diagnosed_model(out / "nominal.json").weights < 0)  # signed weights

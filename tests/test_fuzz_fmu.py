@@ -1,6 +1,7 @@
 """FMU robustness (issue 14), FMI 2 and FMI 3, all units (issue 19 added GeneralizedPI,
 AsymmetricPI, RateDependentPI and CreepOperator, each with its inverse flag, and
-DiagnosedModel, signed weights, up to 128 plays), every call in a
+DiagnosedModel, signed weights, up to 128 plays, and its feedforward DiagnosedInverse), every
+call in a
 child process (tests/fmu_driver.py) so that a crash or a hang fails
 the test instead of killing pytest:
 
@@ -55,8 +56,10 @@ VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "gua
       "delay_samples": 62, "creep_gain": 500, "creep_tau": 600, "rate_band_gain": 700,
       "lti_b": 800, "lti_a": 900, "rate_family": 63, "rate_tau": 64, "n_lti_elements": 65,
       "lti_gain": 1400, "lti_element_b": 1500, "lti_element_a": 1600, "n_wiener_elements": 66,
-      "wiener_element_b": 1700, "wiener_element_a": 1800}
+      "wiener_element_b": 1700, "wiener_element_a": 1800, "reference_range": 67, "latency": 68,
+      "delay_fraction": 69, "n_sections": 70, "section": 1900}
 OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
+DIAG_UNITS = ("DiagnosedModel", "DiagnosedInverse")  # signed weights, up to 128 plays
 TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
 CREEP_GAINS = [0.05, 0.03, 0.02]  # minimum phase at every Ts (sum < 1)
 # the DiagnosedModel's further LTI elements: sections M_1, E_1 (modes) and E_2 (a low-pass),
@@ -66,21 +69,25 @@ SECTIONS_A = [1.0, -1.8779, 0.9084, 1.0, -1.6065, 0.7371, 1.0, -0.6065, 0.0]
 # a Wiener model's filter before the plays: F_1 a low-pass, F_2 a mode (in series on v)
 WIENER_B = [0.0, 0.3935, 0.0, 0.0, 0.0155, 0.0150]
 WIENER_A = [1.0, -0.6065, 0.0, 1.0, -1.8779, 0.9084]
+# the DiagnosedInverse's prefilter (a mode's approximate inverse at dt = 1 ms, lti.inverse_sos
+# of 40 Hz, zeta 0.3, rounded) and a pass-through: sections b0 b1 b2 a0 a1 a2
+INVERSE_SOS = [2.7875, -5.0285, 2.4023, 1.0, -1.1966, 0.358,
+               1.0, 0.0, 0.0, 1.0, 0.0, 0.0]
 
 
 def bad_weight(name: str):
     """A weight value the unit refuses (DiagnosedModel: any sign is valid, NaN is not)."""
-    return "nan" if name == "DiagnosedModel" else -1.0
+    return "nan" if name in DIAG_UNITS else -1.0
 
 
 def n_max(name: str) -> int:
     """The largest number of plays of the unit."""
-    return 2 * NMAX if name == "DiagnosedModel" else NMAX
+    return 2 * NMAX if name in DIAG_UNITS else NMAX
 
 
 def weight_message(name: str, i: int, value) -> str:
     """The logged reason for weight (creep: gain) i (1-based) of a bad value."""
-    if name == "DiagnosedModel":
+    if name in DIAG_UNITS:
         return f"weight p[{i}] = {value} is not finite"
     if name == "CreepOperator":
         return f"gain c[{i}] = {value:g} is not positive"
@@ -363,7 +370,7 @@ def test_sixty_four_plays_match_operator(fmu_dir, fmi):
 
 # ---- random life-cycle fuzzer -------------------------------------------------------------
 
-RUNS_PER_CONFIG = 170  # x 14 configurations = 2380 random runs (about 1 s per configuration)
+RUNS_PER_CONFIG = 170  # x 18 configurations = 3060 random runs (about 1 s per configuration)
 BAD_FLOATS = ["nan", "inf", "-inf", -1.0, 0.0, 1e308, -1e308, 5e-324, 1e-300]
 
 
@@ -454,6 +461,33 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
                        rng.choice([0, 1, 2, -1])],
                       ["set_real", VR["rate_tau"], _pick_float(rng, rng.choice([0.0, 3e-3]),
                                                                0.1 * hostile)]]
+    if name == "DiagnosedInverse":  # the feedforward: creep, asymmetry, rate, prefilter
+        extra += [["set_int", VR["latency"], rng.choice([0, 1, 3]) if not hostile else
+                   rng.choice([0, 2, -1, 10**7])],
+                  ["set_real", VR["delay_fraction"], rng.choice([0.0, 0.5]) if not hostile else
+                   rng.choice([0.0, 0.5, 1.0, -0.1, "nan"])],
+                  ["set_real", VR["reference_range"], _pick_float(rng, rng.uniform(0, 3),
+                                                                  0.1 * hostile)],
+                  ["set_int", VR["n_lags"], rng.choice([0, 1, 2]) if not hostile else
+                   rng.choice([0, 2, -1, 65])],
+                  *set_array(fmi3, VR["creep_gain"], [0.05, -0.02], 0.0),
+                  *set_array(fmi3, VR["creep_tau"], [_pick_float(rng, 0.01, 0.1 * hostile), 0.3],
+                             1.0),
+                  ["set_real", VR["asymmetry_quadratic"], _pick_float(rng, 0.05, 0.1 * hostile)]]
+        if rng.random() < 0.5:
+            sos = list(INVERSE_SOS)
+            i = rng.choice([0, 3, 4])
+            sos[i] = _pick_float(rng, sos[i], 0.1 * hostile)
+            extra += [["set_int", VR["n_sections"], rng.choice([1, 2]) if not hostile else
+                       rng.choice([1, 2, 10, 11, -1])],
+                      *set_array(fmi3, VR["section"], sos, 0.0)]
+        if rng.random() < 0.5:
+            extra += [*set_array(fmi3, VR["rate_band_gain"], [0.1] * m, 0.0),
+                      ["set_real", VR["rate_scale"], _pick_float(rng, 2.0, 0.1 * hostile)],
+                      ["set_int", VR["rate_family"], rng.choice([0, 1]) if not hostile else
+                       rng.choice([0, 1, 2, -1])],
+                      ["set_real", VR["rate_tau"], _pick_float(rng, rng.choice([0.0, 3e-3]),
+                                                               0.1 * hostile)]]
     acts = init(name, fmi3, n=n, p=p, r=r, Ts=Ts, t0=t0, extra=extra)
     if hostile and rng.random() < 0.2:  # drop or repeat a life-cycle call
         acts.insert(rng.randrange(len(acts) + 1), rng.choice(
@@ -529,7 +563,7 @@ def must_reject(mutation: dict, blob_mode: int, name: str = "") -> bool:
         return True  # checksum, size or magic
     if name == "AsymmetricPI" and mutation["field"] == "p" and mutation["value"] == 0.0:
         return False  # a zero play weight is valid there
-    if name == "DiagnosedModel" and (mutation["field"], mutation["value"]) in (
+    if name in DIAG_UNITS and (mutation["field"], mutation["value"]) in (
             ("p", 0.0), ("p", -1.0), ("n", 65)):
         return False  # signed weights and up to 128 plays are valid there
     return mutation["field"] in ALWAYS_CHECKED or blob_mode >= 3

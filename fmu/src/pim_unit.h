@@ -3,12 +3,15 @@
  * one internal sample, the sub-stepping rule and the checked FMU state format.  Included (static
  * functions) by the FMI 2 and FMI 3 glue after PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
  * 3 InversePI, 4 GeneralizedPI, 5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator,
- * 8 DiagnosedModel) is defined.  Units 4-7 have a Boolean parameter `inverse`: false runs the operator (input u = v,
+ * 8 DiagnosedModel, 9 DiagnosedInverse) is defined.  Units 4-7 have a Boolean parameter `inverse`: false runs the operator (input u = v,
  * output y), true its exact inverse (input u = y_d, output y = v) with the same parameters,
  * started from the forward operator's initial state (as InversePI).  The numerics are the shared
  * C core (pim_pi.c, pim_estimator.c, pim_loops.c, pim_generalized.c, pim_asymmetric.c,
  * pim_rate_dependent.c, pim_creep.c, pim_diagnosed.c).  Unit 8 (DiagnosedModel) runs the model a
- * diagnosis chose (pim_diagnosed.h): signed play weights and the effect terms in parallel.  An optional PIM_MODEL_DEFAULTS(u) (defined by a
+ * diagnosis chose (pim_diagnosed.h): signed play weights and the effect terms in parallel.  Unit 9
+ * (DiagnosedInverse) runs its causal feedforward (pim_diag_inverse.h): input y_d, output v, the
+ * static part's variables as unit 8's (same names and references), plus the prefilter sections
+ * (n_sections, section), latency, delay_fraction and reference_range.  An optional PIM_MODEL_DEFAULTS(u) (defined by a
  * model-specific model.c, `pimodel fmu build --model`) sets the parameters' start values.
  * Functions return 0 on success, or -1 with the reason in u->msg.
  *
@@ -38,7 +41,8 @@
  * lti_a 900 + i, and for plays 65..128 p_hi 1000 + i, r_hi 1100 + i, w0_hi 1200 + i,
  * rate_band_gain_hi 1300 + i; the linear part's further elements lti_gain 1400 + i,
  * lti_element_b 1500 + i, lti_element_a 1600 + i; a Wiener model's filter before the plays
- * wiener_element_b 1700 + i, wiener_element_a 1800 + i); in FMI 3 an array is one variable.
+ * wiener_element_b 1700 + i, wiener_element_a 1800 + i; DiagnosedInverse: the prefilter's
+ * sections section 1900 + i); in FMI 3 an array is one variable.
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
@@ -54,6 +58,7 @@
 #include "pim_asymmetric.h"
 #include "pim_core.h"
 #include "pim_creep.h"
+#include "pim_diag_inverse.h"
 #include "pim_diagnosed.h"
 #include "pim_est_health.h"
 #include "pim_estimator.h"
@@ -61,15 +66,17 @@
 #include "pim_loops.h"
 #include "pim_rate_dependent.h"
 
-#if !defined(PIM_MODEL) || PIM_MODEL < 1 || PIM_MODEL > 8
+#if !defined(PIM_MODEL) || PIM_MODEL < 1 || PIM_MODEL > 9
 #error "define PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator, 3 InversePI, 4 GeneralizedPI, \
-5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator, 8 DiagnosedModel)"
+5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator, 8 DiagnosedModel, 9 DiagnosedInverse)"
 #endif
 #define PIM_HAS_INVERSE_FLAG (PIM_MODEL >= 4 && PIM_MODEL <= 7)
+#define PIM_DIAG_UNIT (PIM_MODEL == 8 || PIM_MODEL == 9) /* the diagnosed model's units */
+#define PIM_DINV_FMU_SECTIONS 10 /* DiagnosedInverse: sections in section[1..60] */
 
 #define PIM_NMAX PIM_MAX_PLAYS            /* declared array size: p[1..64], r[..], r_hat[..] */
 #define NMAX PIM_NMAX
-#if PIM_MODEL == 8
+#if PIM_DIAG_UNIT
 #define PIM_UNIT_NMAX PIM_DIAG_MAX_PLAYS  /* plays 1..64 in p, r, ...; 65..128 in p_hi, r_hi, ... */
 #else
 #define PIM_UNIT_NMAX PIM_NMAX            /* largest n */
@@ -131,6 +138,10 @@ typedef enum {
     vr_rate_tau = 64,
     vr_n_lti_elements = 65,
     vr_n_wiener_elements = 66,
+    vr_reference_range = 67, /* DiagnosedInverse */
+    vr_latency = 68,
+    vr_delay_fraction = 69,
+    vr_n_sections = 70,
     vr_p = 100,
     vr_r = 200,
     vr_r_hat = 300,
@@ -148,7 +159,8 @@ typedef enum {
     vr_lti_element_b = 1500,
     vr_lti_element_a = 1600,
     vr_wiener_element_b = 1700, /* DiagnosedModel: the filter before the plays (Wiener) */
-    vr_wiener_element_a = 1800
+    vr_wiener_element_a = 1800,
+    vr_section = 1900 /* DiagnosedInverse: the prefilter's sections */
 } ValueReference;
 
 typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
@@ -199,7 +211,7 @@ typedef struct {
     int law, health;
 #if PIM_MODEL == 2
     pim_est_health est_health; /* rows v[k], rhat[k], y[k], e[k] of the samples processed */
-#elif PIM_MODEL == 8
+#elif PIM_DIAG_UNIT
     /* DiagnosedModel parameters (pim_diagnosed.h; weights w of plays 1..64 in p, radii in r,
      * plays 65..128 in p_hi, r_hi, w0_hi, rate_band_gain_hi; the creep poles exp(-Ts /
      * creep_tau) derived into a), the plays' arrays joined (derived) and the flat state */
@@ -221,7 +233,12 @@ typedef struct {
      * F_j in series on v, PIM_DIAG_SECTION coefficients each in wiener_element_b, _a */
     int n_wiener_elements;
     double wiener_element_b[PIM_NMAX], wiener_element_a[PIM_NMAX];
-    double dstate[PIM_DIAG_STATE_MAX];
+    /* DiagnosedInverse (pim_diag_inverse.h): the root rule's scale, latency A, the delay's
+     * fraction and the prefilter's sections (6 coefficients each: b0 b1 b2 a0 a1 a2) */
+    double reference_range, delay_fraction;
+    int latency, n_sections;
+    double section[PIM_NMAX];
+    double dstate[PIM_DIAG_STATE_MAX]; /* unit 8: pim_diag's state, unit 9: pim_dinv's */
 #endif
     char msg[256]; /* reason of the last failure */
 } pim_unit;
@@ -341,6 +358,35 @@ static const pim_var unit_vars[] = {
     {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
     {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
     {"rate_band_gain_hi", vr_rate_band_gain_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain_hi)},
+#elif PIM_MODEL == 9
+    {"y_d", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
+    {"v", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
+    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
+    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
+    {"w0", vr_w0, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0)},
+    {"offset", vr_offset, 'R', PIM_PARAMETER, 1, PIM_AT(offset)},
+    {"reference_offset", vr_reference_offset, 'R', PIM_PARAMETER, 1, PIM_AT(reference_offset)},
+    {"n_lags", vr_n_lags, 'I', PIM_PARAMETER, 1, PIM_AT(n_lags)},
+    {"creep_gain", vr_creep_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_gain)},
+    {"creep_tau", vr_creep_tau, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_tau)},
+    {"asymmetry_quadratic", vr_asymmetry_quadratic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_q)},
+    {"asymmetry_cubic", vr_asymmetry_cubic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_c3)},
+    {"center", vr_center, 'R', PIM_PARAMETER, 1, PIM_AT(center)},
+    {"half_range", vr_half_range, 'R', PIM_PARAMETER, 1, PIM_AT(half_range)},
+    {"rate_band_gain", vr_rate_band_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain)},
+    {"rate_scale", vr_rate_scale, 'R', PIM_PARAMETER, 1, PIM_AT(rate_scale)},
+    {"rate_family", vr_rate_family, 'I', PIM_PARAMETER, 1, PIM_AT(rate_family)},
+    {"rate_tau", vr_rate_tau, 'R', PIM_PARAMETER, 1, PIM_AT(rate_tau)},
+    {"input_range", vr_input_range, 'R', PIM_PARAMETER, 1, PIM_AT(input_range)},
+    {"reference_range", vr_reference_range, 'R', PIM_PARAMETER, 1, PIM_AT(reference_range)},
+    {"latency", vr_latency, 'I', PIM_PARAMETER, 1, PIM_AT(latency)},
+    {"delay_fraction", vr_delay_fraction, 'R', PIM_PARAMETER, 1, PIM_AT(delay_fraction)},
+    {"n_sections", vr_n_sections, 'I', PIM_PARAMETER, 1, PIM_AT(n_sections)},
+    {"section", vr_section, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(section)},
+    {"p_hi", vr_p_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p_hi)},
+    {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
+    {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
+    {"rate_band_gain_hi", vr_rate_band_gain_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain_hi)},
 #endif
     {"Ts", vr_Ts, 'R', PIM_PARAMETER, 1, PIM_AT(Ts)},
     {"n", vr_n, 'I', PIM_PARAMETER, 1, PIM_AT(n)},
@@ -398,7 +444,7 @@ static void unit_defaults(pim_unit *u)
         u->r[i] = 1.0;  /* time constant tau [s] */
     }
 #endif
-#if PIM_MODEL == 8
+#if PIM_DIAG_UNIT
     for (int i = 0; i < PIM_NMAX; ++i) {
         u->w0[i] = u->w0_hi[i] = u->p_hi[i] = 1.0;
         u->creep_tau[i] = 1.0;
@@ -409,6 +455,7 @@ static void unit_defaults(pim_unit *u)
     for (int j = 0; j < PIM_DIAG_MAX_ELEMENTS; ++j)
         u->wiener_element_a[PIM_DIAG_SECTION * j] = 1.0;
     u->half_range = u->rate_scale = u->input_range = 1.0;
+    for (int j = 0; j < PIM_DINV_FMU_SECTIONS; ++j) u->section[6 * j + 3] = 1.0; /* a0 = 1 */
 #endif
 #ifdef PIM_MODEL_DEFAULTS
     PIM_MODEL_DEFAULTS(u);
@@ -466,6 +513,7 @@ static int unit_check_creep(pim_unit *u)
 }
 #endif
 
+#if PIM_DIAG_UNIT
 #if PIM_MODEL == 8
 /* The model of the unit's parameters (pointers into u; built per sample, never stored, so that
  * a restored FMU state holds no pointer).  The asymmetry and rate terms are on when a
@@ -509,6 +557,7 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->wf_b = u->wiener_element_b;
     d->wf_a = u->wiener_element_a;
 }
+#endif
 
 /* The plays' arrays joined: plays 1..64 from p, r, w0, rate_band_gain, 65..128 from the _hi
  * arrays (derived, recomputed for every restored state). */
@@ -533,8 +582,9 @@ static const char *unit_play_name(const char *name, int i, char *buf, size_t siz
     return buf;
 }
 
-/* The DiagnosedModel parameter rules, with the variable, index and value in the message. */
-static int unit_check_diag(pim_unit *u)
+/* The rules of the static part's parameters (units 8 and 9), with the variable, index and
+ * value in the message. */
+static int unit_check_diag_static(pim_unit *u)
 {
     unit_diag_join(u);
     char a[48], b[48];
@@ -590,6 +640,14 @@ static int unit_check_diag(pim_unit *u)
     if (!isfinite(u->input_range) || !(u->input_range > 0.0))
         return unit_error(u, "parameter input_range = %g: must be finite and > 0",
                           u->input_range);
+    return 0;
+}
+
+#if PIM_MODEL == 8
+/* The DiagnosedModel parameter rules, with the variable, index and value in the message. */
+static int unit_check_diag(pim_unit *u)
+{
+    if (unit_check_diag_static(u) != 0) return -1;
     if (!isfinite(u->drift_per_s))
         return unit_error(u, "parameter drift_per_s = %g: must be finite", u->drift_per_s);
     if (u->drift_clock < 0 || u->drift_clock > 2)
@@ -663,7 +721,78 @@ static int unit_check_diag(pim_unit *u)
     if (msg) return unit_error(u, "bad parameters: %s", msg);
     return 0;
 }
-#endif
+#endif /* PIM_MODEL == 8 */
+
+#if PIM_MODEL == 9
+/* The feedforward of the unit's parameters (pointers into u, built per sample as unit_diag). */
+static void unit_dinv(const pim_unit *u, pim_dinv *d)
+{
+    const size_t n = (size_t)u->n;
+    int rate = 0;
+    for (size_t i = 0; i < n; ++i) rate |= u->drb[i] != 0.0;
+    d->n = n;
+    d->w = u->dw;
+    d->r = u->dr;
+    d->w0 = u->dw0;
+    d->c = u->offset;
+    d->c0 = u->reference_offset;
+    d->m = u->n_lags > 0 ? (size_t)u->n_lags : 0;
+    d->lag_a = u->a;
+    d->lag_g = u->creep_gain;
+    d->asym = u->asym_q != 0.0 || u->asym_c3 != 0.0;
+    d->q = u->asym_q;
+    d->c3 = u->asym_c3;
+    d->center = u->center;
+    d->half = u->half_range;
+    d->rate_w = rate ? u->drb : NULL;
+    d->dt = u->Ts;
+    d->rate_scale = u->rate_scale;
+    d->input_range = u->input_range;
+    d->rate_family = u->rate_family;
+    d->rate_tau = u->rate_tau;
+    d->reference_range = u->reference_range;
+    d->ns = u->n_sections > 0 ? (size_t)u->n_sections : 0;
+    d->sos = u->section;
+    d->latency = u->latency > 0 ? (size_t)u->latency : 0;
+    d->frac = u->delay_fraction;
+}
+
+/* The DiagnosedInverse parameter rules, with the variable, index and value in the message. */
+static int unit_check_dinv(pim_unit *u)
+{
+    if (unit_check_diag_static(u) != 0) return -1;
+    if (!isfinite(u->reference_range) || u->reference_range < 0.0)
+        return unit_error(u, "parameter reference_range = %g: must be finite and >= 0",
+                          u->reference_range);
+    if (u->latency < 0 || u->latency > PIM_DINV_MAX_LATENCY)
+        return unit_error(u, "parameter latency = %d out of range: 0 <= latency <= %d",
+                          u->latency, PIM_DINV_MAX_LATENCY);
+    if (!isfinite(u->delay_fraction) || u->delay_fraction < 0.0 || !(u->delay_fraction < 1.0))
+        return unit_error(u, "parameter delay_fraction = %g out of range: 0 <= delay_fraction "
+                             "< 1", u->delay_fraction);
+    if (u->n_sections < 0 || u->n_sections > PIM_DINV_FMU_SECTIONS)
+        return unit_error(u, "parameter n_sections = %d out of range: 0 <= n_sections <= %d",
+                          u->n_sections, PIM_DINV_FMU_SECTIONS);
+    for (int j = 0; j < 6 * u->n_sections; ++j) {
+        if (!isfinite(u->section[j]))
+            return unit_error(u, "prefilter coefficient section[%d] = %g is not finite", j + 1,
+                              u->section[j]);
+        if (j % 6 == 3 && u->section[j] != 1.0)
+            return unit_error(u, "parameter section[%d] = %g: each section's a0 must be 1 "
+                                 "(b0 b1 b2 a0 a1 a2 per section)", j + 1, u->section[j]);
+        if (j % 6 == 5 && u->section[j - 2] + u->section[j - 1] + u->section[j] == 0.0)
+            return unit_error(u, "parameters section[%d..%d] = (%g, %g, %g): the section has "
+                                 "a pole at z = 1 (a0 + a1 + a2 = 0), no rest state", j - 1,
+                              j + 1, u->section[j - 2], u->section[j - 1], u->section[j]);
+    }
+    pim_dinv d;
+    unit_dinv(u, &d);
+    const char *msg = pim_dinv_check(&d);
+    if (msg) return unit_error(u, "bad parameters: %s", msg);
+    return 0;
+}
+#endif /* PIM_MODEL == 9 */
+#endif /* PIM_DIAG_UNIT */
 
 /* Quantities derived from checked parameters (inverse PI, envelope struct, rate filter, creep
  * poles); at setup and for every restored FMU state.  0, or -1 with the reason. */
@@ -685,7 +814,7 @@ static int unit_derive(pim_unit *u)
     u->lam = u->rate_tc > 0.0 ? exp(-u->Ts / u->rate_tc) : 0.0;
 #elif PIM_MODEL == 7
     for (size_t i = 0; i < n; ++i) u->a[i] = exp(-u->Ts / u->r[i]);
-#elif PIM_MODEL == 8
+#elif PIM_DIAG_UNIT
     for (int j = 0; j < u->n_lags; ++j) u->a[j] = exp(-u->Ts / u->creep_tau[j]);
     unit_diag_join(u);
 #endif
@@ -710,6 +839,8 @@ static int unit_check_parameters(pim_unit *u)
     return unit_check_creep(u);
 #elif PIM_MODEL == 8
     return unit_check_diag(u);
+#elif PIM_MODEL == 9
+    return unit_check_dinv(u);
 #else
     for (int i = 0; i < u->n; ++i) {
 #if PIM_MODEL == 5
@@ -789,7 +920,7 @@ static int unit_check_parameters(pim_unit *u)
                              "must be 0)", u->r[0]);
 #endif
     return 0;
-#endif /* PIM_MODEL != 7, 8 */
+#endif /* PIM_MODEL != 7, 8, 9 */
 }
 
 #if PIM_MODEL == 2
@@ -898,6 +1029,16 @@ static int unit_setup(pim_unit *u)
         pim_diag_initial_state(&d, u->dstate, u->z0);
     }
     (void)n;
+#elif PIM_MODEL == 9
+    memset(u->dstate, 0, sizeof u->dstate); /* not started; plays (and the rate source's) at z0 */
+    {
+        double z0[PIM_DINV_MAX_PLAYS];
+        for (size_t i = 0; i < n; ++i) z0[i] = u->z0;
+        pim_dinv d;
+        unit_diag_join(u); /* the joined arrays for d (unit_derive below recomputes them) */
+        unit_dinv(u, &d);
+        pim_dinv_initial_state(&d, u->dstate, z0);
+    }
 #else
     for (size_t i = 0; i < n; ++i) u->z[i] = u->z0;
 #endif
@@ -927,7 +1068,10 @@ static int unit_check_inputs(pim_unit *u)
 {
     if (!isfinite(u->in1))
         return unit_error(u, "input %s = %g is not finite (NaN or Inf)",
-                          PIM_MODEL == 3 ? "y_d" : PIM_HAS_INVERSE_FLAG ? "u" : "v", u->in1);
+                          PIM_MODEL == 3 || PIM_MODEL == 9 ? "y_d"
+                          : PIM_HAS_INVERSE_FLAG          ? "u"
+                                                          : "v",
+                          u->in1);
 #if PIM_MODEL == 2
     if (!isfinite(u->in2)) return unit_error(u, "input y = %g is not finite (NaN or Inf)", u->in2);
 #elif PIM_MODEL == 3
@@ -990,10 +1134,15 @@ static void unit_sample(pim_unit *u)
         pim_creep_inverse_run(1, n, u->a, u->p, u->z, &u->in1, &u->out1);
     else
         pim_creep_run(1, n, u->a, u->p, u->z, &u->in1, &u->out1);
-#else
+#elif PIM_MODEL == 8
     pim_diag d;
     unit_diag(u, &d);
     u->out1 = pim_diag_step(&d, u->dstate, u->in1, (double)u->k_next * u->Ts);
+    (void)n;
+#else
+    pim_dinv d;
+    unit_dinv(u, &d);
+    u->out1 = pim_dinv_step(&d, u->dstate, u->in1);
     (void)n;
 #endif
 }
@@ -1008,6 +1157,22 @@ static int unit_outputs_finite(const pim_unit *u)
 #endif
     return 1;
 }
+
+#if PIM_DIAG_UNIT
+/* Length of the flat state in dstate (unit 8: pim_diag's, unit 9: pim_dinv's). */
+static size_t unit_flat_state_size(const pim_unit *u)
+{
+#if PIM_MODEL == 8
+    pim_diag d;
+    unit_diag(u, &d);
+    return pim_diag_state_size(&d);
+#else
+    pim_dinv d;
+    unit_dinv(u, &d);
+    return pim_dinv_state_size(&d);
+#endif
+}
+#endif
 
 /* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
 static int unit_do_step(pim_unit *u, double t, double h)
@@ -1046,14 +1211,12 @@ static int unit_do_step(pim_unit *u, double t, double h)
 #if PIM_MODEL == 2
     const pim_estimator est_saved = u->est;
     const pim_est_health health_saved = u->est_health;
-#elif PIM_MODEL != 8
+#elif !PIM_DIAG_UNIT
     double z_saved[PIM_MAX_PLAYS];
     for (int i = 0; i < u->n; ++i) z_saved[i] = u->z[i];
     const double hist_saved[2] = {u->hist[0], u->hist[1]};
 #else
-    pim_diag dg;
-    unit_diag(u, &dg);
-    const size_t dsize = pim_diag_state_size(&dg);
+    const size_t dsize = unit_flat_state_size(u);
     double dsaved[PIM_DIAG_STATE_MAX];
     memcpy(dsaved, u->dstate, dsize * sizeof(double));
 #endif
@@ -1068,7 +1231,7 @@ static int unit_do_step(pim_unit *u, double t, double h)
             u->est = est_saved;
             u->est_health = health_saved;
             for (int i = 0; i < u->n; ++i) u->rhat_out[i] = u->est.rhat[i];
-#elif PIM_MODEL != 8
+#elif !PIM_DIAG_UNIT
             memcpy(u->z, z_saved, (size_t)u->n * sizeof(double));
             u->hist[0] = hist_saved[0];
             u->hist[1] = hist_saved[1];
@@ -1095,8 +1258,8 @@ static int unit_do_step(pim_unit *u, double t, double h)
  * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
 static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
-    /* FMI 2 array elements: base 100, 200, ..., 1800 plus an index below PIM_NMAX */
-    const unsigned base = elements && vr >= 100 && vr < 1900 ? vr - vr % 100 : vr;
+    /* FMI 2 array elements: base 100, 200, ..., 1900 plus an index below PIM_NMAX */
+    const unsigned base = elements && vr >= 100 && vr < 2000 ? vr - vr % 100 : vr;
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
         if (v->vr != base) continue;
@@ -1193,8 +1356,8 @@ static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 4u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
-                                prefilter (Wiener) */
+#define PIM_STATE_VERSION 5u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+                                prefilter (Wiener); 5: DiagnosedInverse fields */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {
@@ -1277,7 +1440,7 @@ static int unit_check_states(pim_unit *u, pim_unit *s)
     msg = pim_health_check(&s->est_health, n);
     if (msg) return unit_error(u, "FMU state rejected: %s", msg);
     s->health = s->est_health.count > 0.0 ? unit_health(s, NULL, NULL, NULL, NULL, NULL) : 0;
-#elif PIM_MODEL != 8
+#elif !PIM_DIAG_UNIT
     if (!unit_all_finite(s->z, n))
         return unit_error(u, "FMU state rejected: a play state z is not finite");
 #endif
@@ -1298,6 +1461,26 @@ static int unit_check_states(pim_unit *u, pim_unit *s)
         if (pim_diag_rate_size(&d) && x[PIM_DIAG_HEADER + d.n] < 0.0)
             return unit_error(u, "FMU state rejected: the filtered rate rho_f = %g must be "
                                  ">= 0", x[PIM_DIAG_HEADER + d.n]);
+    }
+#endif
+#if PIM_MODEL == 9
+    (void)n; /* the plays' states are in dstate */
+    {
+        pim_dinv d;
+        unit_diag_join(s);
+        unit_dinv(s, &d);
+        const double *x = s->dstate, *solver = x + PIM_DINV_HEAD + 2 * d.ns;
+        if (!unit_all_finite(x, pim_dinv_state_size(&d)))
+            return unit_error(u, "FMU state rejected: a feedforward state is not finite");
+        if ((x[0] != 0.0 && x[0] != 1.0) || x[1] < 0.0 || x[1] != floor(x[1]) ||
+            x[1] > (double)d.latency || (solver[0] != 0.0 && solver[0] != 1.0))
+            return unit_error(u, "FMU state rejected: feedforward state started = %g, seen = %g, "
+                                 "solver started = %g (expected 0 or 1, 0 <= seen <= latency "
+                                 "%llu)", x[0], x[1], solver[0],
+                              (unsigned long long)d.latency);
+        if (d.rate_w && solver[3 + d.n + d.m] < 0.0)
+            return unit_error(u, "FMU state rejected: the filtered rate rho_f = %g must be "
+                                 ">= 0", solver[3 + d.n + d.m]);
     }
 #endif
 #if PIM_MODEL == 6

@@ -10,7 +10,8 @@ from ..data import load_record
 from .common import add_columns_option, refuse_overwrite
 
 EXPORT_FILES = ("augmented.json", "nominal.json", "nominal.model.json",
-                "augmented_1_DiagnosedModel.fmu", "nominal_1_DiagnosedModel.fmu")
+                "augmented_1_DiagnosedModel.fmu", "nominal_1_DiagnosedModel.fmu",
+                "augmented_1_DiagnosedInverse.fmu", "nominal_1_DiagnosedInverse.fmu")
 
 
 def register(sub) -> None:
@@ -37,7 +38,9 @@ def register(sub) -> None:
                    help="write the augmented and the nominal model as JSON (augmented.json, "
                    "nominal.json: pimodel.diagnosis.model.load_diagnosed_model; 'pimodel fmu "
                    "build --model' takes them) and their FMUs (FMI 2, unit DiagnosedModel: "
-                   "augmented_1_DiagnosedModel.fmu, nominal_1_DiagnosedModel.fmu); "
+                   "augmented_1_DiagnosedModel.fmu, nominal_1_DiagnosedModel.fmu; their "
+                   "feedforwards, unit DiagnosedInverse, input y_d, output v: "
+                   "augmented_1_DiagnosedInverse.fmu, nominal_1_DiagnosedInverse.fmu); "
                    "nominal.model.json is the nominal model as an operator (GeneralizedPI)")
     p.add_argument("--no-fmu", action="store_true",
                    help="with --export: write the JSON files only (no C compiler needed)")
@@ -74,8 +77,8 @@ def run(args: argparse.Namespace) -> int:
 
 def export_models(rep, out_dir, *, fmu: bool = True) -> list:
     """Write ``augmented.json``, ``nominal.json``, ``nominal.model.json`` (operator JSON) and,
-    with ``fmu``, both models' FMUs (unit DiagnosedModel) into ``out_dir``; returns the paths
-    written."""
+    with ``fmu``, both models' FMUs (unit DiagnosedModel) and their feedforwards' (unit
+    DiagnosedInverse) into ``out_dir``; returns the paths written."""
     from ..models import save_model
 
     out = Path(out_dir)
@@ -87,11 +90,12 @@ def export_models(rep, out_dir, *, fmu: bool = True) -> list:
     except ValueError as err:
         print(f"no operator form of the nominal model: {err}")
     if fmu:
-        from ..fmu.model_fmu import build_model_fmus
+        from ..fmu.model_fmu import build_inverse_fmu, build_model_fmus
 
         for stem, model in (("augmented", aug), ("nominal", nom)):
-            try:
-                paths += build_model_fmus(model, out, stem=stem)
-            except ValueError as err:
-                print(f"{stem} model: no FMU ({err})")
+            for build, what in ((build_model_fmus, "FMU"), (build_inverse_fmu, "inverse FMU")):
+                try:
+                    paths += build(model, out, stem=stem)
+                except ValueError as err:
+                    print(f"{stem} model: no {what} ({err})")
     return paths

@@ -14,17 +14,21 @@ def register(sub) -> None:
                         description="Compile the C core and FMI glue with the C compiler on "
                         "PATH and write PIHysteresis.fmu, RadiusEstimator.fmu, InversePI.fmu, "
                         "GeneralizedPI.fmu, AsymmetricPI.fmu, RateDependentPI.fmu, "
-                        "CreepOperator.fmu and DiagnosedModel.fmu (Linux binary, sources, "
-                        "buildDescription.xml); with "
+                        "CreepOperator.fmu, DiagnosedModel.fmu and DiagnosedInverse.fmu "
+                        "(Linux binary, sources, buildDescription.xml); with "
                         "--fmi-version 3.0 the FMI 3.0 versions NAME_fmi3.fmu (arrays as "
                         "arrays). With --model MODEL.json: one FMU per operator of the model "
                         "(MODEL_1_Unit.fmu, ...; a Cascade in the order of its stages) with the "
                         "model's parameters as start values; a DiagnosedModel JSON (pimodel "
-                        "diagnose --export) gives one DiagnosedModel FMU.")
+                        "diagnose --export) gives its DiagnosedModel FMU (MODEL_1_"
+                        "DiagnosedModel.fmu, input v, output y) and its feedforward's "
+                        "DiagnosedInverse FMU (MODEL_1_DiagnosedInverse.fmu, input y_d, output v "
+                        "delayed by the FMU's parameter latency; none for a Wiener model).")
     b.add_argument("--out", required=True, help="output folder")
     b.add_argument("--which", nargs="+", default=None,
                    help="units to build (default: all): PIHysteresis RadiusEstimator InversePI "
-                   "GeneralizedPI AsymmetricPI RateDependentPI CreepOperator DiagnosedModel")
+                   "GeneralizedPI AsymmetricPI RateDependentPI CreepOperator DiagnosedModel "
+                   "DiagnosedInverse")
     b.add_argument("--model", default=None,
                    help="a model JSON file (pimodel.models, or a DiagnosedModel): build its "
                    "operators' FMUs")
@@ -45,13 +49,19 @@ def run_build(args: argparse.Namespace) -> int:
                 raise ValueError("--which and --model exclude each other")
             from pathlib import Path
 
-            from ..fmu.model_fmu import build_model_fmus
+            from ..fmu.model_fmu import build_inverse_fmu, build_model_fmus
             from ..models import load_model
 
             stem = "".join(ch if ch.isalnum() else "_" for ch in Path(args.model).stem)
             stem = stem if stem[:1].isalpha() else f"m_{stem}"
-            paths = build_model_fmus(load_model(args.model), args.out,
-                                     fmi_version=args.fmi_version, Ts=args.dt, stem=stem)
+            model = load_model(args.model)
+            paths = build_model_fmus(model, args.out, fmi_version=args.fmi_version,
+                                     Ts=args.dt, stem=stem)
+            try:
+                paths += build_inverse_fmu(model, args.out, fmi_version=args.fmi_version,
+                                           stem=stem)
+            except ValueError as err:
+                print(f"no inverse FMU: {err}")
         else:
             paths = build_fmus(args.out, args.which, fmi_version=args.fmi_version)
     except RuntimeError as exc:  # no compiler, compile error

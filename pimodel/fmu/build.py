@@ -23,10 +23,10 @@ MAX_LTI_ELEMENTS = 8  # further elements of a DiagnosedModel's linear part; PIM_
 # in fmu/src/pim_diagnosed.h
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_est_health.c", "pim_loops.c",
                 "pim_generalized.c", "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c",
-                "pim_diagnosed.c")
+                "pim_diagnosed.c", "pim_diag_inverse.c")
 HEADERS = ("pim_core.h", "pim_estimator.h", "pim_est_health.h", "pim_loops.h",
            "pim_generalized.h", "pim_asymmetric.h", "pim_rate_dependent.h", "pim_creep.h",
-           "pim_diagnosed.h",
+           "pim_diagnosed.h", "pim_diag_inverse.h",
            "pim_unit.h")
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}
 FMI_VERSIONS = tuple(GLUE)
@@ -353,6 +353,44 @@ MODELS: dict[str, dict] = {
                  Var("v", 10, "Real", "input", "0", "input v"),
                  Var("y", 11, "Real", "output", "0", "output y")],
     },
+}
+
+
+# The DiagnosedInverse unit (9): the causal feedforward of a DiagnosedModel
+# (pimodel.diagnosis.inverse_native, fmu/src/pim_diag_inverse.h). The static part's variables
+# are the DiagnosedModel unit's (same names and references, the weights projected monotone).
+MAX_INVERSE_SECTIONS = 10  # prefilter sections in section[1..60]; PIM_DINV_FMU_SECTIONS
+_INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset", "n_lags",
+                   "creep_gain", "creep_tau", "asymmetry_quadratic", "asymmetry_cubic",
+                   "center", "half_range", "rate_band_gain", "rate_scale", "rate_family",
+                   "rate_tau", "input_range", "p_hi", "r_hi", "w0_hi", "rate_band_gain_hi"}
+MODELS["DiagnosedInverse"] = {
+    "id": 9,
+    "description": "The causal feedforward of a diagnosed model: the prefilter (the dynamics' "
+                   "approximate inverse), the delay's fraction and the exact per-sample root "
+                   "of the static part (creep, asymmetry, rate), its output delayed by the "
+                   "latency (pimodel.diagnosis.model.DiagnosedInverse.block, dt = Ts)",
+    "vars": [*[v for v in MODELS["DiagnosedModel"]["vars"]
+               if v.name.split("[")[0] in _INVERSE_SHARED],
+             Var("reference_range", 67, "Real", "parameter", "0",
+                 "range of the (prefiltered) reference, the root rule's scale: span = max(2 "
+                 "r_n, reference_range / |sum w|, 1) (>= 0)"),
+             Var("latency", 68, "Integer", "parameter", "0",
+                 "samples A by which v is delayed (the prefilter's advance and the delay's "
+                 "whole samples, one more for a fraction); v = v_rest before"),
+             Var("delay_fraction", 69, "Real", "parameter", "0",
+                 "the delay's fractional part f (0 <= f < 1): the reference interpolated "
+                 "between the last two prefilter outputs"),
+             Var("n_sections", 70, "Integer", "parameter", "0",
+                 f"prefilter sections (the dynamics' approximate inverse), 0 <= n_sections "
+                 f"<= {MAX_INVERSE_SECTIONS}"),
+             *[Var(f"section[{i + 1}]", 1900 + i, "Real", "parameter",
+                   "1" if i % 6 == 3 and i < 6 * MAX_INVERSE_SECTIONS else "0",
+                   "prefilter second-order sections, 6 coefficients each (b0 b1 b2 a0 a1 a2, "
+                   f"a0 = 1, as scipy.signal.sosfilt), element {i + 1}") for i in range(NMAX)],
+             Var("y_d", 10, "Real", "input", "0", "reference y_d (the model's output unit)"),
+             Var("v", 11, "Real", "output", "0", "feedforward input v (the model's input "
+                 "unit)")],
 }
 
 

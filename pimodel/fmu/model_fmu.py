@@ -20,7 +20,7 @@ from .build import MODEL_UNITS, MODELS, Var, build_fmus, check_fmi_version
 from .operators import unit_parameters
 from .unit import FMUUnit
 
-__all__ = ["build_model_fmus", "cosimulate_chain"]
+__all__ = ["build_inverse_fmu", "build_model_fmus", "cosimulate_chain"]
 
 # FMU variable -> pim_unit field (fmu/src/pim_unit.h) for the compiled start values
 _FIELDS = {"in_kind": "kind_in", "out_kind": "kind_out", "shape_kind": "kind_in",
@@ -113,6 +113,7 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
     dts = {s.dt for s in stages if hasattr(s, "dt")} | {s.forward.dt for s in stages
                                                         if hasattr(getattr(s, "forward", None),
                                                                    "dt")}
+    dts |= {s.model.dt for s in stages if hasattr(getattr(s, "model", None), "dt")}
     if len(dts) > 1:
         raise ValueError(f"model: the stages have different sample times dt {sorted(dts)}")
     Ts = Ts if Ts is not None else (dts.pop() if dts else 1e-3)
@@ -131,6 +132,51 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
     finally:
         for ident in names:
             MODEL_UNITS.pop(ident, None)
+
+
+def build_inverse_fmu(model, out_dir, *, fmi_version: str = "2.0", stem: str = "model",
+                      compiler: str | None = None) -> list[Path]:
+    """The feedforward FMU of a diagnosed model (unit DiagnosedInverse), beside its model FMU.
+
+    Parameters
+    ----------
+    model : DiagnosedModel or other
+        A :class:`~pimodel.diagnosis.model.DiagnosedModel`: its inverse is built as
+        ``<stem>_1_DiagnosedInverse[_fmi3].fmu`` (input ``y_d``, output ``v``, delayed by its
+        ``latency``); any other model has no such FMU (empty list).
+    out_dir : str or Path
+        Directory of the FMU (created).
+    fmi_version : {"2.0", "3.0"}
+    stem : str
+        File name prefix (a C identifier), as :func:`build_model_fmus`.
+    compiler : str, optional
+        C compiler (default: found on PATH).
+
+    Returns
+    -------
+    list of Path
+        The inverse's FMU, or ``[]``.
+
+    Raises
+    ------
+    ValueError
+        A model whose inverse has no FMU (a filter before the hysteresis,
+        ``dynamics_position = "before"``; more than 10 prefilter sections).
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> import tempfile
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> build_inverse_fmu(m, tempfile.mkdtemp())[0].name  # doctest: +SKIP
+    'model_1_DiagnosedInverse.fmu'
+    """
+    from ..diagnosis.model import DiagnosedModel
+
+    if not isinstance(model, DiagnosedModel):
+        return []
+    return build_model_fmus(model.inverse(), out_dir, fmi_version=fmi_version, stem=stem,
+                            compiler=compiler)
 
 
 def cosimulate_chain(paths, u, Ts: float) -> np.ndarray:

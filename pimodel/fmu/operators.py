@@ -52,13 +52,15 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
     op : GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, an inverse of these,
         a PIOperator (unit PIHysteresis, input ``v``; no ``inverse`` variable) or a
         :class:`~pimodel.diagnosis.model.DiagnosedModel` (unit DiagnosedModel, input ``v``,
-        ``Ts`` its ``dt``; :func:`pimodel.diagnosis.stream.fmu_parameters`)
+        ``Ts`` its ``dt``; :func:`pimodel.diagnosis.stream.fmu_parameters`) or its
+        :class:`~pimodel.diagnosis.model.DiagnosedInverse` (unit DiagnosedInverse, input
+        ``y_d``, output ``v``; :func:`pimodel.diagnosis.inverse_native.inverse_fmu_parameters`)
         The operator (inverses: ``AsymmetricPIInverse``, ``RateDependentPIInverse``, an
         inverted ``CreepOperator``, the result of ``GeneralizedPI.inverse()``).
     Ts : float, optional
         Sample time [s] for the rate-independent operators (default 1e-3); the rate-dependent
-        and creep operators and a DiagnosedModel use their own ``dt`` (a different ``Ts``
-        raises ValueError).
+        and creep operators, a DiagnosedModel and its inverse use their own ``dt`` (a
+        different ``Ts`` raises ValueError).
 
     Returns
     -------
@@ -80,7 +82,7 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
     >>> name, params["inverse"], params["tau[1]"]
     ('CreepOperator', True, 0.1)
     """
-    from ..diagnosis.model import DiagnosedModel
+    from ..diagnosis.model import DiagnosedInverse, DiagnosedModel
 
     if isinstance(op, DiagnosedModel):
         from ..diagnosis.stream import fmu_parameters
@@ -88,6 +90,12 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
         if Ts is not None and Ts != op.dt:
             raise ValueError(f"Ts: {Ts!r} differs from the model's dt = {op.dt!r}")
         return fmu_parameters(op)
+    if isinstance(op, DiagnosedInverse):
+        from ..diagnosis.inverse_native import inverse_fmu_parameters
+
+        if Ts is not None and Ts != op.model.dt:
+            raise ValueError(f"Ts: {Ts!r} differs from the model's dt = {op.model.dt!r}")
+        return inverse_fmu_parameters(op)
     inverse = False
     if isinstance(op, GeneralizedPI) and isinstance(getattr(op, "forward", None),
                                                     GeneralizedPI):

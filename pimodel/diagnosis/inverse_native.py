@@ -1,0 +1,282 @@
+"""A :class:`~pimodel.diagnosis.model.DiagnosedInverse`'s causal feedforward on the C core
+(``fmu/src/pim_diag_inverse.c``): the runner :class:`NativeInverse` and the values of the
+DiagnosedInverse FMU unit (:func:`inverse_fmu_parameters`).
+
+It runs what :func:`~pimodel.diagnosis.inverse_stream.inverse_block` runs in Python (the
+``_InverseStream`` sample), so ``tests/test_inverse_native.py`` holds the two equal to 1e-9:
+fed ``y_d[0..k]``, it outputs ``v[k] = DiagnosedInverse.simulate(y_d)[k - A]`` for ``k >= A``
+(``A`` = :func:`~pimodel.diagnosis.inverse_stream.inverse_latency`: the dynamics' one-sample
+advance and the delay's whole samples, one more for a fractional delay) and ``v_rest``, the
+inverse of ``y_d[0]`` from the initial state, before. Per sample: the prefilter's second-order
+sections (:func:`~pimodel.diagnosis.lti.inverse_sos`, at rest around ``y_d[0]``), the delay's
+fractional interpolation, and the exact root of the static part (creep, asymmetry, rate with
+the fresh rate of a nested rate-free solve), on the model's nearest monotone weights
+(:mod:`.monotone`); the semantics in ``fmu/src/pim_diag_inverse.h``.
+
+Parameters computed here and passed to C: the projected weights, the sections, the latency,
+the delay's fraction and the root rule's scale ``reference_range``. Models with the filter
+before the hysteresis (``dynamics_position = "before"``, a Wiener model) are refused: their
+inverse runs a filter after the solve, which this stream does not have yet.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import _native
+from ..fmu.build import NMAX
+from .inverse_stream import StaticInverse, _delay, _filter, inverse_latency
+from .rate import RATE_FAMILIES
+from .stream import _band_gains
+
+__all__ = ["NativeInverse", "inverse_fmu_parameters"]
+
+MAX_SECTIONS = 32  # PIM_DINV_MAX_SECTIONS (fmu/src/pim_diag_inverse.h)
+MAX_LATENCY = 1_000_000  # PIM_DINV_MAX_LATENCY
+
+
+class NativeInverse:
+    """A diagnosed model's feedforward in the C core's form (``pim_dinv``), arrays kept alive.
+
+    Parameters
+    ----------
+    inverse : DiagnosedInverse
+        The inverse (``model.inverse()``).
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n`` (as ``simulate``).
+    reference_range : float, optional
+        The root rule's scale (:class:`~pimodel.diagnosis.inverse_stream.StaticInverse`);
+        ``simulate`` uses ``ptp(inverse.prefilter(y_d))``; default 0.
+
+    Raises
+    ------
+    ValueError
+        A Wiener model (``dynamics_position = "before"``), more than 128 plays or 64 creep
+        lags, a parameter the C core refuses (named), or one the Python solver refuses.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> ni = NativeInverse(m.inverse())
+    >>> ni.run([0.1, 1.35, 0.35]).round(9).tolist(), ni.latency
+    ([0.0, 1.0, 0.0], 0)
+    """
+
+    def __init__(self, inverse, input_range: float | None = None,
+                 reference_range: float | None = None):
+        model = inverse.model
+        if model.dynamics_before:
+            raise ValueError(f"params: dynamics_position = {model.params['dynamics_position']!r}"
+                             ": the C feedforward covers dynamics after the hysteresis only (a "
+                             "Wiener model's inverse filter runs after the solve)")
+        solver = StaticInverse(model, input_range, reference_range)  # checks, projects
+        m, p = solver.model, solver.model.params
+        n = solver.n
+        if n > 2 * NMAX:
+            raise ValueError(f"model: {n} plays; the C feedforward takes at most {2 * NMAX}")
+        self.model, self.input_range = model, solver.input_range
+        self.reference_range = 0.0 if reference_range is None else float(reference_range)
+        keep = {"w": solver.w, "r": solver.r, "w0": solver.w0}
+        d = _native.InverseParams()
+        d.n, d.c, d.c0, d.dt = n, m.offset, m.reference_offset, m.dt
+        d.input_range, d.reference_range = self.input_range, self.reference_range
+        if solver.creep:
+            keep["lag_a"] = solver.a_lag
+            keep["lag_g"] = np.asarray(p["creep_lag_gains"], float)
+            if keep["lag_g"].shape != solver.a_lag.shape or solver.m > NMAX:
+                raise ValueError("params: creep_lag_gains and creep_time_constants_s: expected "
+                                 f"as many gains as time constants, at most {NMAX}")
+            d.m = solver.m
+        if solver.asym:
+            d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
+            d.center, d.half = p["center"], p["half_range"]
+        if solver.rate:
+            keep["rate_w"] = _band_gains(np.asarray(p["rate_gains"], float), n)
+            d.rate_family = RATE_FAMILIES.index(p["rate_family"])
+            d.rate_tau, d.rate_scale = solver.tau, p["rate_scale"]
+        sos, _ = _filter(model)
+        if sos is not None:
+            if sos.shape[0] > MAX_SECTIONS:
+                raise ValueError(f"params: the prefilter has {sos.shape[0]} sections; the C "
+                                 f"feedforward takes at most {MAX_SECTIONS}")
+            keep["sos"] = sos
+            d.ns = sos.shape[0]
+        self.latency = inverse_latency(model)
+        if self.latency > MAX_LATENCY:
+            raise ValueError(f"params: the latency {self.latency} is above {MAX_LATENCY} samples")
+        d.latency, d.frac = self.latency, _delay(model)[1]
+        self._keep = {k: np.ascontiguousarray(v, dtype=float) for k, v in keep.items()}
+        for k, v in self._keep.items():
+            setattr(d, k, _native.diag_pointer(v))
+        msg = _native.inverse_check(d)
+        if msg:
+            raise ValueError(f"model: {msg}")
+        self.params, self.n = d, n
+        self.nstates = _native.inverse_state_size(d)
+
+    def initial_state(self, z0=None) -> np.ndarray:
+        """The state before the first sample: not started, the plays at rest at 0 or at ``z0``.
+
+        Parameters
+        ----------
+        z0 : array_like, optional
+            The plays' outputs before the first sample (``inverse.initial_memory(y_d[0])`` for
+            a stage whose memory is unknown, as ``simulate(initial_state="unknown")``).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``nstates`` values, the layout of the Python stream's state.
+
+        Raises
+        ------
+        ValueError
+            ``z0`` not ``n`` finite values.
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> ni = NativeInverse(DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3).inverse())
+        >>> ni.initial_state([0.0]).tolist()
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        """
+        if z0 is None:
+            return _native.inverse_initial_state(self.params)
+        z = np.ascontiguousarray(z0, dtype=float)
+        if z.shape != (self.n,) or not np.all(np.isfinite(z)):
+            raise ValueError(f"z0: expected {self.n} finite play outputs, got shape {z.shape}")
+        return _native.inverse_initial_state(self.params, z)
+
+    def step(self, x: np.ndarray, y_d: float) -> float:
+        """``v[k]`` for the reference sample ``y_d[k]``; ``x`` (float64) advances in place.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The state after sample k - 1 (``nstates`` values, C-contiguous).
+        y_d : float
+            The reference sample [output units].
+
+        Returns
+        -------
+        float
+            ``v[k]`` [input units].
+
+        Raises
+        ------
+        ValueError
+            ``x`` of another length, ``y_d`` not finite.
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> ni = NativeInverse(DiagnosedModel([0.0], [2.0], 0.0, dt=1e-3).inverse())
+        >>> ni.step(ni.initial_state(), 1.0)
+        0.5
+        """
+        if x.shape != (self.nstates,) or x.dtype != np.float64:
+            raise ValueError(f"state: expected {self.nstates} float64 values, got {x.shape} "
+                             f"{x.dtype}")
+        if not math.isfinite(y_d):
+            raise ValueError(f"y_d: sample {y_d!r} is not finite")
+        return _native.inverse_step(self.params, x, y_d)
+
+    def run(self, y_d, z0=None) -> np.ndarray:
+        """``v[k]`` for a whole reference from the initial state (:meth:`initial_state`).
+
+        Parameters
+        ----------
+        y_d : array_like
+            Reference samples, every ``dt``.
+        z0 : array_like, optional
+            The plays' start (:meth:`initial_state`).
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ValueError
+            ``y_d`` not a finite 1-D signal.
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> m = DiagnosedModel([0.0], [2.0], 0.0, dt=1e-3, effects=("delay",),
+        ...                    params={"delay_samples": 1})
+        >>> NativeInverse(m.inverse()).run([2.0, 4.0, 6.0]).tolist()  # latency 1
+        [1.0, 2.0, 3.0]
+        """
+        from .model import _signal
+
+        yd = np.ascontiguousarray(_signal(y_d, "y_d"), dtype=float)
+        return _native.inverse_run(self.params, self.initial_state(z0), yd)
+
+
+def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
+                           reference_range: float | None = None) -> tuple[str, dict]:
+    """The DiagnosedInverse FMU unit and its variable values for ``inverse`` (``Ts = dt``).
+
+    The static part's variables are those of the DiagnosedModel unit
+    (:func:`~pimodel.diagnosis.stream.fmu_parameters`) with the projected (monotone) weights;
+    the feedforward adds ``n_sections``, ``section[1..6 ns]`` (the prefilter),
+    ``latency``, ``delay_fraction`` and ``reference_range``.
+
+    Parameters
+    ----------
+    inverse : DiagnosedInverse
+        The inverse (at most 128 plays, 64 creep lags, 10 prefilter sections).
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n``.
+    reference_range : float, optional
+        The root rule's scale; default 0.
+
+    Returns
+    -------
+    (str, dict)
+        ``"DiagnosedInverse"`` and ``{variable name: value}`` (FMI 2 names, ``"p[2]"``).
+
+    Raises
+    ------
+    ValueError
+        As :class:`NativeInverse`, or more sections than the FMU holds.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> name, values = inverse_fmu_parameters(m.inverse())
+    >>> name, values["n"], values["latency"], values["offset"]
+    ('DiagnosedInverse', 2, 0, 0.1)
+    """
+    ni = NativeInverse(inverse, input_range, reference_range)
+    d, k = ni.params, ni._keep
+    if 6 * d.ns > NMAX:
+        raise ValueError(f"params: the prefilter has {d.ns} sections; the FMU takes at most "
+                         f"{NMAX // 6}")
+
+    def arr(name, values):
+        """Plays 1..64 in NAME[i], 65..128 in NAME_hi[i] (other arrays: up to 64)."""
+        return {(f"{name}[{i + 1}]" if i < NMAX else f"{name}_hi[{i - NMAX + 1}]"): float(x)
+                for i, x in enumerate(values)}
+
+    out = {"Ts": d.dt, "n": int(d.n), **arr("p", k["w"]), **arr("r", k["r"]),
+           **arr("w0", k["w0"]), "offset": d.c, "reference_offset": d.c0,
+           "input_range": d.input_range, "reference_range": d.reference_range,
+           "latency": int(d.latency), "delay_fraction": d.frac}
+    if d.m:
+        out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
+                    **arr("creep_tau", inverse.model.params["creep_time_constants_s"])})
+    if d.asym:
+        out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
+                    "half_range": d.half})
+    if "rate_w" in k:
+        out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
+                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
+    if d.ns:
+        out.update({"n_sections": int(d.ns), **arr("section", k["sos"].ravel())})
+    return "DiagnosedInverse", out
