@@ -265,7 +265,8 @@ class InverseParams(ctypes.Structure):
                 ("half", c_double), ("rate_w", _DP), ("dt", c_double),
                 ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
                 ("rate_tau", c_double), ("reference_range", c_double), ("ns", c_size),
-                ("sos", _DP), ("latency", c_size), ("frac", c_double)]
+                ("sos", _DP), ("latency", c_size), ("frac", c_double), ("npost", c_size),
+                ("post", _DP)]
 
 
 _IP = ctypes.POINTER(InverseParams)

@@ -57,7 +57,8 @@ VR = {"Ts": 0, "n": 1, "z0": 2, "adaptive": 3, "gain": 4, "linear_play": 5, "gua
       "lti_b": 800, "lti_a": 900, "rate_family": 63, "rate_tau": 64, "n_lti_elements": 65,
       "lti_gain": 1400, "lti_element_b": 1500, "lti_element_a": 1600, "n_wiener_elements": 66,
       "wiener_element_b": 1700, "wiener_element_a": 1800, "reference_range": 67, "latency": 68,
-      "delay_fraction": 69, "n_sections": 70, "section": 1900}
+      "delay_fraction": 69, "n_sections": 70, "section": 1900, "n_post_sections": 71,
+      "post_section": 2000}
 OPERATOR_UNITS = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator")
 DIAG_UNITS = ("DiagnosedModel", "DiagnosedInverse")  # signed weights, up to 128 plays
 TAU = [0.01, 0.2, 0.6]  # creep time constants (the r array of CreepOperator)
@@ -481,6 +482,13 @@ def random_run(name: str, fmi3: bool, rng: random.Random) -> list:
             extra += [["set_int", VR["n_sections"], rng.choice([1, 2]) if not hostile else
                        rng.choice([1, 2, 10, 11, -1])],
                       *set_array(fmi3, VR["section"], sos, 0.0)]
+        if rng.random() < 0.5:  # a Wiener filter's inverse after the solve (latency >= 1)
+            sos = list(INVERSE_SOS)
+            i = rng.choice([0, 3, 5])
+            sos[i] = _pick_float(rng, sos[i], 0.1 * hostile)
+            extra += [["set_int", VR["n_post_sections"], rng.choice([1, 2]) if not hostile else
+                       rng.choice([1, 2, 10, 11, -1])],
+                      *set_array(fmi3, VR["post_section"], sos, 0.0)]
         if rng.random() < 0.5:
             extra += [*set_array(fmi3, VR["rate_band_gain"], [0.1] * m, 0.0),
                       ["set_real", VR["rate_scale"], _pick_float(rng, 2.0, 0.1 * hostile)],

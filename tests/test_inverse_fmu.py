@@ -53,7 +53,8 @@ def fmus(built_fmus) -> Path:
 
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "dynamics_delay_creep", "rate_weight",
-                                  "rate_weight_filtered", "delay_whole"])
+                                  "rate_weight_filtered", "delay_whole",
+                                  "wiener_two_delay_creep"])
 def test_unit_equals_the_python_stream(fmus, fmi, case):
     effects, extra = CASES[case]
     m = model(effects, **extra)
@@ -101,6 +102,13 @@ def test_unit_with_more_than_64_plays_and_a_start_memory(fmus, fmi):
      ({"n_sections": 1, "section[4]": 2.0}, "section[4] = 2: each section's a0 must be 1"),
      ({"n_sections": 1, "section[5]": -2.0, "section[6]": 1.0}, "pole at z = 1"),
      ({"n_sections": 1, "section[2]": float("inf")}, "section[2] = inf is not finite"),
+     ({"n_post_sections": 11}, "parameter n_post_sections = 11 out of range"),
+     ({"n_post_sections": 1, "latency": 1, "post_section[4]": 0.5},
+      "post_section[4] = 0.5: each section's a0 must be 1"),
+     ({"n_post_sections": 1, "latency": 1, "post_section[3]": float("nan")},
+      "post_section[3] = nan is not finite"),
+     ({"n_post_sections": 1}, "parameter latency = 0: post sections (n_post_sections = 1) need "
+                              "a latency >= 1"),
      ({"rate_band_gain[1]": 0.1, "rate_scale": 0.0}, "parameter rate_scale = 0"),
      ({"n_lags": 1, "creep_tau[1]": 0.0}, "time constant creep_tau[1] = 0 is not positive")])
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])

@@ -11,6 +11,8 @@ the branch rule can fall one way on one machine and the other way elsewhere."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -61,6 +63,13 @@ CASES = {
     "delay_fraction": (("delay",), {}),
     "dynamics_delay_creep": (("dynamics", "delay", "creep"), {}),
     "all": (("dynamics", "delay", "creep", "asymmetry", "rate"), {}),
+    # a filter before the hysteresis (a Wiener model): its inverse's post sections
+    "wiener_lowpass": (("dynamics",), {"dynamics_position": "before",
+                                       "wiener_elements": [["lowpass", 1 / (2 * np.pi * 60)]]}),
+    "wiener_two_delay_creep": (("dynamics", "delay", "creep"),
+                               {"dynamics_position": "before",
+                                "wiener_elements": [["lowpass", 1 / (2 * np.pi * 150)],
+                                                    ["mode", 90.0, 1.2]]}),
 }
 
 
@@ -233,11 +242,24 @@ def test_errors():
         NativeInverse(bad.inverse())
     wiener = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=DT, effects=("dynamics",),
                             params={"dynamics_position": "before",
-                                    "wiener_elements": [["lowpass", 2e-3]]})
-    with pytest.raises(ValueError, match="dynamics_position = 'before'"):
+                                    "wiener_elements": [["mode", 80.0, 0.5]] * 33})
+    with pytest.raises(ValueError, match="wiener_elements: the filter's inverse has 33 sections"):
         NativeInverse(wiener.inverse())
-    with pytest.raises(ValueError, match="dynamics_position"):
+    eleven = [["mode", 80.0, 0.5]] * 11
+    wiener = replace(wiener, params={**wiener.params, "wiener_elements": eleven})
+    with pytest.raises(ValueError, match="the Wiener filter's inverse has 11 sections; the FMU"):
         inverse_fmu_parameters(wiener.inverse())
+
+
+def test_wiener_model_runs_its_filter_inverse_after_the_solve():
+    """The post sections: one more sample of latency, in the FMU values."""
+    effects, extra = CASES["wiener_two_delay_creep"]
+    m = model(effects, **extra)
+    native = NativeInverse(m.inverse())
+    assert native.latency == 4 and native.params.npost == 2 and native.params.ns == 0
+    _, values = inverse_fmu_parameters(m.inverse())
+    assert values["n_post_sections"] == 2 and values["post_section[4]"] == 1.0
+    assert "n_sections" not in values and values["latency"] == 4
 
 
 @pytest.mark.parametrize("case", ["nominal", "asymmetry", "rate_radius", "static_all"])

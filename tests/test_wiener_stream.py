@@ -334,7 +334,8 @@ def test_diagnosed_wiener_model_exports_an_fmu_equal_to_simulate(tmp_path, stage
 def test_diagnose_export_writes_a_wiener_fmu(tmp_path):
     """pimodel diagnose --export on the records of the first-order driver stage: the augmented
     model's FMU (a Wiener model) validates and equals the exported model's simulate to 1e-12
-    in the co-simulation master."""
+    in the co-simulation master; its inverse FMU equals the batch inverse one sample later
+    (reference_range 0 both: the model's default, so the root rule's scale is the same)."""
     from test_diagnosis_wiener import truth_driver_records
 
     from pimodel.cli import main
@@ -354,3 +355,13 @@ def test_diagnose_export_writes_a_wiener_fmu(tmp_path):
     v = validate[0].v[:3000]
     want = m.simulate(v, input_range=2 * m.radii[-1])
     assert np.max(np.abs(cosimulate_chain([fmu], v, m.dt) - want)) < 1e-12
+    # its feedforward's FMU: the filter's inverse after the solve (post sections), the batch
+    # inverse delayed by one sample; chained into the model FMU, the model follows the record
+    inverse = out / "augmented_1_DiagnosedInverse.fmu"
+    _check_fmu(inverse, "2.0")
+    y_d = validate[0].y[:3000]
+    v_ff = cosimulate_chain([inverse], y_d, m.dt)
+    batch = m.inverse().simulate(y_d)
+    assert np.max(np.abs(v_ff[1:] - batch[:-1])) < 1e-9 * np.ptp(batch)
+    y = cosimulate_chain([inverse, fmu], y_d, m.dt)
+    assert np.sqrt(np.mean((y[1:] - y_d[:-1]) ** 2)) < 0.05 * np.ptp(y_d)

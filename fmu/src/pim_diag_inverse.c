@@ -27,7 +27,7 @@ size_t pim_dinv_solver_size(const pim_dinv *d, int rate)
 
 size_t pim_dinv_state_size(const pim_dinv *d)
 {
-    return PIM_DINV_HEAD + 2 * d->ns + pim_dinv_solver_size(d, d->rate_w != NULL);
+    return PIM_DINV_HEAD + 2 * (d->ns + d->npost) + pim_dinv_solver_size(d, d->rate_w != NULL);
 }
 
 static int finite_all(const double *x, size_t n)
@@ -35,6 +35,45 @@ static int finite_all(const double *x, size_t n)
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(x[i])) return 0;
     return 1;
+}
+
+/* 0 when the ns sections (rows of 6) are finite with a0 = 1 and no pole at z = 1, else 1 (not
+ * finite), 2 (a0 != 1) or 3 (a pole at z = 1: no rest state). */
+static int sections_bad(const double *sos, size_t ns)
+{
+    for (size_t j = 0; j < ns; ++j) {
+        const double *s = sos + 6 * j;
+        if (!finite_all(s, 6)) return 1;
+        if (s[3] != 1.0) return 2;
+        if (s[3] + s[4] + s[5] == 0.0) return 3;
+    }
+    return 0;
+}
+
+/* The chain of ns sections at rest around the input u (scipy.signal.sosfilt_zi(sos) * u). */
+static void sections_rest(const double *sos, size_t ns, double *s, double u)
+{
+    double scale = 1.0;
+    for (size_t j = 0; j < ns; ++j) {
+        const double *q = sos + 6 * j;
+        const double g = (q[0] + q[1] + q[2]) / (q[3] + q[4] + q[5]);
+        s[2 * j] = (q[1] + q[2] - (q[4] + q[5]) * g) * scale * u;
+        s[2 * j + 1] = (q[2] - q[5] * g) * scale * u;
+        scale *= g;
+    }
+}
+
+/* One sample of the chain, transposed direct form II as scipy.signal.sosfilt; s advances. */
+static double sections_step(const double *sos, size_t ns, double *s, double u)
+{
+    for (size_t j = 0; j < ns; ++j) {
+        const double *q = sos + 6 * j;
+        const double y = q[0] * u + s[2 * j];
+        s[2 * j] = q[1] * u - q[4] * y + s[2 * j + 1];
+        s[2 * j + 1] = q[2] * u - q[5] * y;
+        u = y;
+    }
+    return u;
 }
 
 const char *pim_dinv_check(const pim_dinv *d)
@@ -73,13 +112,19 @@ const char *pim_dinv_check(const pim_dinv *d)
     if (!(isfinite(d->reference_range) && d->reference_range >= 0.0))
         return "reference_range must be finite and >= 0";
     if (d->ns > PIM_DINV_MAX_SECTIONS) return "more than 32 prefilter sections";
-    for (size_t j = 0; j < d->ns; ++j) {
-        const double *s = d->sos + 6 * j;
-        if (!finite_all(s, 6)) return "a prefilter coefficient is not finite";
-        if (s[3] != 1.0) return "a prefilter section's denominator must start with a0 = 1";
-        if (s[3] + s[4] + s[5] == 0.0)
-            return "a prefilter section has a pole at z = 1 (no rest state)";
+    switch (sections_bad(d->sos, d->ns)) {
+    case 1: return "a prefilter coefficient is not finite";
+    case 2: return "a prefilter section's denominator must start with a0 = 1";
+    case 3: return "a prefilter section has a pole at z = 1 (no rest state)";
     }
+    if (d->npost > PIM_DINV_MAX_SECTIONS) return "more than 32 post sections";
+    switch (sections_bad(d->post, d->npost)) {
+    case 1: return "a post section's coefficient is not finite";
+    case 2: return "a post section's denominator must start with a0 = 1";
+    case 3: return "a post section has a pole at z = 1 (no rest state)";
+    }
+    if (d->npost && d->latency < 1)
+        return "post sections need a latency >= 1 (their one-sample advance)";
     if (d->latency > PIM_DINV_MAX_LATENCY) return "the latency is above 1000000 samples";
     if (!(isfinite(d->frac) && d->frac >= 0.0 && d->frac < 1.0))
         return "the delay fraction must be finite, >= 0 and < 1";
@@ -91,7 +136,7 @@ void pim_dinv_initial_state(const pim_dinv *d, double *x, const double *z0)
     const size_t size = pim_dinv_state_size(d), n = d->n;
     for (size_t j = 0; j < size; ++j) x[j] = 0.0;
     if (!z0) return;
-    double *solver = x + PIM_DINV_HEAD + 2 * d->ns;
+    double *solver = x + PIM_DINV_HEAD + 2 * (d->ns + d->npost);
     for (size_t i = 0; i < n; ++i) solver[3 + i] = z0[i];
     if (d->rate_w) {
         double *source = solver + pim_dinv_solver_size(d, 0) + 2 + n;
@@ -366,39 +411,32 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
 
 double pim_dinv_step(const pim_dinv *d, double *x, double yd)
 {
-    double *s = x + PIM_DINV_HEAD, *solver = s + 2 * d->ns;
+    double *s = x + PIM_DINV_HEAD, *g = s + 2 * d->ns, *solver = g + 2 * d->npost;
     const int rate = d->rate_w != NULL;
+    const double solve_from = (double)(d->latency - (d->npost ? 1 : 0));
     if (x[0] == 0.0) {
         x[0] = 1.0;
-        double scale = 1.0; /* the chain at rest around yd (scipy.signal.sosfilt_zi) */
-        for (size_t j = 0; j < d->ns; ++j) {
-            const double *q = d->sos + 6 * j;
-            const double g = (q[0] + q[1] + q[2]) / (q[3] + q[4] + q[5]);
-            s[2 * j] = (q[1] + q[2] - (q[4] + q[5]) * g) * scale * yd;
-            s[2 * j + 1] = (q[2] - q[5] * g) * scale * yd;
-            scale *= g;
-        }
+        sections_rest(d->sos, d->ns, s, yd);
         if (d->latency) { /* the inverse of y_d[0] from the initial solver state */
             double tmp[PIM_DINV_SOLVER_MAX];
             memcpy(tmp, solver, pim_dinv_solver_size(d, rate) * sizeof tmp[0]);
             x[2] = dinv_solve(d, tmp, yd, rate);
         }
     }
-    double fk = yd;
-    for (size_t j = 0; j < d->ns; ++j) { /* transposed direct form II, as sosfilt */
-        const double *q = d->sos + 6 * j;
-        const double y = q[0] * fk + s[2 * j];
-        s[2 * j] = q[1] * fk - q[4] * y + s[2 * j + 1];
-        s[2 * j + 1] = q[2] * fk - q[5] * y;
-        fk = y;
-    }
-    double v;
-    if (!(x[1] < (double)d->latency)) {
+    const double fk = sections_step(d->sos, d->ns, s, yd);
+    const double seen = x[1];
+    double v = x[2];
+    if (!(seen < solve_from)) {
         const double ref = d->frac == 0.0 ? fk : x[3] + (fk - x[3]) * d->frac;
         v = dinv_solve(d, solver, ref, rate);
-    } else {
+        if (d->npost) { /* the filter's inverse, at rest around the first solve */
+            if (seen == solve_from) sections_rest(d->post, d->npost, g, v);
+            v = sections_step(d->post, d->npost, g, v);
+        }
+    }
+    if (seen < (double)d->latency) {
         v = x[2];
-        x[1] += 1.0;
+        x[1] = seen + 1.0;
     }
     x[3] = fk;
     return v;

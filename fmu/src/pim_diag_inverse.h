@@ -13,9 +13,14 @@
  *     ref[k] = f[k] + frac (f[k-1] - f[k])   the delay's fractional part (frac = 0: f[k])
  *     v[k]   = v_rest                        for k < A (latency; v_rest = the solve of y_d[0]
  *                                            from the initial solver state)
- *     v[k]   = root of F_k(v) = ref[k]       for k >= A, on the static part (below)
+ *     x[k]   = root of F_k(v) = ref[k - P]   for k >= A - P, on the static part (below)
+ *     v[k]   = x[k]                          for k >= A without post sections (P = 0), else
+ *     v[k]   = T_np[... T_1[x] ...][k]       the post sections (a filter before the hysteresis,
+ *                                            a Wiener model: its approximate inverse, P = 1),
+ *                                            at rest around x[A - 1]; used from k = A on
  *
- * so that v[k] = DiagnosedInverse.simulate(y_d)[k - A] for k >= A.  The static part, with the
+ * so that v[k] = DiagnosedInverse.simulate(y_d)[k - A] for k >= A (the batch advances the post
+ * sections' output by one sample: the one sample P of latency more).  The static part, with the
  * plays z_i[k-1] of the last solve (at rest at z0, normally 0):
  *
  *     Z_i(v) = clip(z_i[k-1], v - r_i, v + r_i),  h(v) = sum w_i Z_i + c,
@@ -38,7 +43,8 @@
  * 1e-12), 1).  After the solve: plays, creep lags L_j = a_j L_j + (1 - a_j) h0 (L = h0 on the
  * first solve), rate rho_f and the radius family's memory m_i of the plays in contact.
  *
- * State (pim_dinv_state_size doubles): [started, seen, v_rest, f_prev, s[2 ns], solver]
+ * State (pim_dinv_state_size doubles): [started, seen, v_rest, f_prev, s[2 ns], g[2 npost],
+ * solver]
  * with solver = [started, v_prev, guess, z[n], L[m]] and, with a rate effect, [rho_f, m[n],
  * v0_prev, source] where source is a rate-free solver's state (same layout, no rate).  The
  * layout is that of the Python stream's state (inverse_stream._InverseStream.labels).
@@ -59,7 +65,7 @@ extern "C" {
 #define PIM_DINV_HEAD 4
 #define PIM_DINV_SOLVER_MAX (3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS + 2 + PIM_DINV_MAX_PLAYS + \
                              3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS)
-#define PIM_DINV_STATE_MAX (PIM_DINV_HEAD + 2 * PIM_DINV_MAX_SECTIONS + PIM_DINV_SOLVER_MAX)
+#define PIM_DINV_STATE_MAX (PIM_DINV_HEAD + 4 * PIM_DINV_MAX_SECTIONS + PIM_DINV_SOLVER_MAX)
 
 typedef struct {
     size_t n;              /* plays */
@@ -81,6 +87,8 @@ typedef struct {
     const double *sos;     /* ns rows of 6: b0 b1 b2 a0 a1 a2, a0 = 1 */
     size_t latency;        /* A, samples */
     double frac;           /* the delay's fractional part, 0 <= frac < 1 */
+    size_t npost;          /* sections after the solve (a Wiener model's filter inverse; 0: none) */
+    const double *post;    /* npost rows of 6, as sos */
 } pim_dinv;
 
 /* Length of the flat state (layout above). */

@@ -11,7 +11,8 @@
  * diagnosis chose (pim_diagnosed.h): signed play weights and the effect terms in parallel.  Unit 9
  * (DiagnosedInverse) runs its causal feedforward (pim_diag_inverse.h): input y_d, output v, the
  * static part's variables as unit 8's (same names and references), plus the prefilter sections
- * (n_sections, section), latency, delay_fraction and reference_range.  An optional PIM_MODEL_DEFAULTS(u) (defined by a
+ * (n_sections, section), the post sections of a Wiener model's filter inverse (n_post_sections,
+ * post_section), latency, delay_fraction and reference_range.  An optional PIM_MODEL_DEFAULTS(u) (defined by a
  * model-specific model.c, `pimodel fmu build --model`) sets the parameters' start values.
  * Functions return 0 on success, or -1 with the reason in u->msg.
  *
@@ -42,7 +43,8 @@
  * rate_band_gain_hi 1300 + i; the linear part's further elements lti_gain 1400 + i,
  * lti_element_b 1500 + i, lti_element_a 1600 + i; a Wiener model's filter before the plays
  * wiener_element_b 1700 + i, wiener_element_a 1800 + i; DiagnosedInverse: the prefilter's
- * sections section 1900 + i); in FMI 3 an array is one variable.
+ * sections section 1900 + i, the post sections post_section 2000 + i); in FMI 3 an array is
+ * one variable.
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
@@ -142,6 +144,7 @@ typedef enum {
     vr_latency = 68,
     vr_delay_fraction = 69,
     vr_n_sections = 70,
+    vr_n_post_sections = 71,
     vr_p = 100,
     vr_r = 200,
     vr_r_hat = 300,
@@ -160,7 +163,8 @@ typedef enum {
     vr_lti_element_a = 1600,
     vr_wiener_element_b = 1700, /* DiagnosedModel: the filter before the plays (Wiener) */
     vr_wiener_element_a = 1800,
-    vr_section = 1900 /* DiagnosedInverse: the prefilter's sections */
+    vr_section = 1900, /* DiagnosedInverse: the prefilter's sections */
+    vr_post_section = 2000 /* DiagnosedInverse: the post sections (a Wiener filter's inverse) */
 } ValueReference;
 
 typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
@@ -236,8 +240,8 @@ typedef struct {
     /* DiagnosedInverse (pim_diag_inverse.h): the root rule's scale, latency A, the delay's
      * fraction and the prefilter's sections (6 coefficients each: b0 b1 b2 a0 a1 a2) */
     double reference_range, delay_fraction;
-    int latency, n_sections;
-    double section[PIM_NMAX];
+    int latency, n_sections, n_post_sections;
+    double section[PIM_NMAX], post_section[PIM_NMAX];
     double dstate[PIM_DIAG_STATE_MAX]; /* unit 8: pim_diag's state, unit 9: pim_dinv's */
 #endif
     char msg[256]; /* reason of the last failure */
@@ -383,6 +387,8 @@ static const pim_var unit_vars[] = {
     {"delay_fraction", vr_delay_fraction, 'R', PIM_PARAMETER, 1, PIM_AT(delay_fraction)},
     {"n_sections", vr_n_sections, 'I', PIM_PARAMETER, 1, PIM_AT(n_sections)},
     {"section", vr_section, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(section)},
+    {"n_post_sections", vr_n_post_sections, 'I', PIM_PARAMETER, 1, PIM_AT(n_post_sections)},
+    {"post_section", vr_post_section, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(post_section)},
     {"p_hi", vr_p_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p_hi)},
     {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
     {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
@@ -455,7 +461,8 @@ static void unit_defaults(pim_unit *u)
     for (int j = 0; j < PIM_DIAG_MAX_ELEMENTS; ++j)
         u->wiener_element_a[PIM_DIAG_SECTION * j] = 1.0;
     u->half_range = u->rate_scale = u->input_range = 1.0;
-    for (int j = 0; j < PIM_DINV_FMU_SECTIONS; ++j) u->section[6 * j + 3] = 1.0; /* a0 = 1 */
+    for (int j = 0; j < PIM_DINV_FMU_SECTIONS; ++j) /* a0 = 1 */
+        u->section[6 * j + 3] = u->post_section[6 * j + 3] = 1.0;
 #endif
 #ifdef PIM_MODEL_DEFAULTS
     PIM_MODEL_DEFAULTS(u);
@@ -753,8 +760,33 @@ static void unit_dinv(const pim_unit *u, pim_dinv *d)
     d->reference_range = u->reference_range;
     d->ns = u->n_sections > 0 ? (size_t)u->n_sections : 0;
     d->sos = u->section;
+    d->npost = u->n_post_sections > 0 ? (size_t)u->n_post_sections : 0;
+    d->post = u->post_section;
     d->latency = u->latency > 0 ? (size_t)u->latency : 0;
     d->frac = u->delay_fraction;
+}
+
+/* The count (0..PIM_DINV_FMU_SECTIONS) and coefficients of a chain of sections (6 each: b0 b1 b2
+ * a0 a1 a2, a0 = 1, no pole at z = 1), with the variable, index and value in the message. */
+static int unit_check_sections(pim_unit *u, const char *count_name, int count, const char *name,
+                               const double *sos)
+{
+    if (count < 0 || count > PIM_DINV_FMU_SECTIONS)
+        return unit_error(u, "parameter %s = %d out of range: 0 <= %s <= %d", count_name, count,
+                          count_name, PIM_DINV_FMU_SECTIONS);
+    for (int j = 0; j < 6 * count; ++j) {
+        if (!isfinite(sos[j]))
+            return unit_error(u, "section coefficient %s[%d] = %g is not finite", name, j + 1,
+                              sos[j]);
+        if (j % 6 == 3 && sos[j] != 1.0)
+            return unit_error(u, "parameter %s[%d] = %g: each section's a0 must be 1 (b0 b1 b2 "
+                                 "a0 a1 a2 per section)", name, j + 1, sos[j]);
+        if (j % 6 == 5 && sos[j - 2] + sos[j - 1] + sos[j] == 0.0)
+            return unit_error(u, "parameters %s[%d..%d] = (%g, %g, %g): the section has a pole "
+                                 "at z = 1 (a0 + a1 + a2 = 0), no rest state", name, j - 1,
+                              j + 1, sos[j - 2], sos[j - 1], sos[j]);
+    }
+    return 0;
 }
 
 /* The DiagnosedInverse parameter rules, with the variable, index and value in the message. */
@@ -770,21 +802,14 @@ static int unit_check_dinv(pim_unit *u)
     if (!isfinite(u->delay_fraction) || u->delay_fraction < 0.0 || !(u->delay_fraction < 1.0))
         return unit_error(u, "parameter delay_fraction = %g out of range: 0 <= delay_fraction "
                              "< 1", u->delay_fraction);
-    if (u->n_sections < 0 || u->n_sections > PIM_DINV_FMU_SECTIONS)
-        return unit_error(u, "parameter n_sections = %d out of range: 0 <= n_sections <= %d",
-                          u->n_sections, PIM_DINV_FMU_SECTIONS);
-    for (int j = 0; j < 6 * u->n_sections; ++j) {
-        if (!isfinite(u->section[j]))
-            return unit_error(u, "prefilter coefficient section[%d] = %g is not finite", j + 1,
-                              u->section[j]);
-        if (j % 6 == 3 && u->section[j] != 1.0)
-            return unit_error(u, "parameter section[%d] = %g: each section's a0 must be 1 "
-                                 "(b0 b1 b2 a0 a1 a2 per section)", j + 1, u->section[j]);
-        if (j % 6 == 5 && u->section[j - 2] + u->section[j - 1] + u->section[j] == 0.0)
-            return unit_error(u, "parameters section[%d..%d] = (%g, %g, %g): the section has "
-                                 "a pole at z = 1 (a0 + a1 + a2 = 0), no rest state", j - 1,
-                              j + 1, u->section[j - 2], u->section[j - 1], u->section[j]);
-    }
+    if (unit_check_sections(u, "n_sections", u->n_sections, "section", u->section) != 0 ||
+        unit_check_sections(u, "n_post_sections", u->n_post_sections, "post_section",
+                            u->post_section) != 0)
+        return -1;
+    if (u->n_post_sections > 0 && u->latency < 1)
+        return unit_error(u, "parameter latency = %d: post sections (n_post_sections = %d) need "
+                             "a latency >= 1 (their one-sample advance)", u->latency,
+                          u->n_post_sections);
     pim_dinv d;
     unit_dinv(u, &d);
     const char *msg = pim_dinv_check(&d);
@@ -1258,8 +1283,8 @@ static int unit_do_step(pim_unit *u, double t, double h)
  * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
 static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
-    /* FMI 2 array elements: base 100, 200, ..., 1900 plus an index below PIM_NMAX */
-    const unsigned base = elements && vr >= 100 && vr < 2000 ? vr - vr % 100 : vr;
+    /* FMI 2 array elements: base 100, 200, ..., 2000 plus an index below PIM_NMAX */
+    const unsigned base = elements && vr >= 100 && vr < 2100 ? vr - vr % 100 : vr;
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
         if (v->vr != base) continue;
@@ -1357,7 +1382,7 @@ static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
 #define PIM_STATE_VERSION 5u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
-                                prefilter (Wiener); 5: DiagnosedInverse fields */
+                                prefilter (Wiener); 5: DiagnosedInverse fields, post sections */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {

@@ -23,7 +23,7 @@ def register(sub) -> None:
                         "diagnose --export) gives its DiagnosedModel FMU (MODEL_1_"
                         "DiagnosedModel.fmu, input v, output y) and its feedforward's "
                         "DiagnosedInverse FMU (MODEL_1_DiagnosedInverse.fmu, input y_d, output v "
-                        "delayed by the FMU's parameter latency; none for a Wiener model).")
+                        "delayed by the FMU's parameter latency).")
     b.add_argument("--out", required=True, help="output folder")
     b.add_argument("--which", nargs="+", default=None,
                    help="units to build (default: all): PIHysteresis RadiusEstimator InversePI "

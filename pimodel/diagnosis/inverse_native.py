@@ -14,9 +14,11 @@ the fresh rate of a nested rate-free solve), on the model's nearest monotone wei
 (:mod:`.monotone`); the semantics in ``fmu/src/pim_diag_inverse.h``.
 
 Parameters computed here and passed to C: the projected weights, the sections, the latency,
-the delay's fraction and the root rule's scale ``reference_range``. Models with the filter
-before the hysteresis (``dynamics_position = "before"``, a Wiener model) are refused: their
-inverse runs a filter after the solve, which this stream does not have yet.
+the delay's fraction and the root rule's scale ``reference_range``. A model with the filter
+before the hysteresis (``dynamics_position = "before"``, a Wiener model) has no prefilter; its
+filter's approximate inverse (:func:`~pimodel.diagnosis.wiener.inverse_sections`) runs as
+post sections on the solver's output, at rest around the first solve, with one more sample of
+latency (the batch's one-sample advance).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from ..fmu.build import NMAX
 from .inverse_stream import StaticInverse, _delay, _filter, inverse_latency
 from .rate import RATE_FAMILIES
 from .stream import _band_gains
+from .wiener import inverse_sections
 
 __all__ = ["NativeInverse", "inverse_fmu_parameters"]
 
@@ -68,10 +71,6 @@ class NativeInverse:
     def __init__(self, inverse, input_range: float | None = None,
                  reference_range: float | None = None):
         model = inverse.model
-        if model.dynamics_before:
-            raise ValueError(f"params: dynamics_position = {model.params['dynamics_position']!r}"
-                             ": the C feedforward covers dynamics after the hysteresis only (a "
-                             "Wiener model's inverse filter runs after the solve)")
         solver = StaticInverse(model, input_range, reference_range)  # checks, projects
         m, p = solver.model, solver.model.params
         n = solver.n
@@ -104,6 +103,15 @@ class NativeInverse:
                                  f"feedforward takes at most {MAX_SECTIONS}")
             keep["sos"] = sos
             d.ns = sos.shape[0]
+        if model.dynamics_before:  # the filter's approximate inverse after the solve
+            post = inverse_sections(model.params["wiener_elements"], model.dt)
+            if post is not None and post.shape[0] > MAX_SECTIONS:
+                raise ValueError(f"params: wiener_elements: the filter's inverse has "
+                                 f"{post.shape[0]} sections; the C feedforward takes at most "
+                                 f"{MAX_SECTIONS}")
+            if post is not None:
+                keep["post"] = post
+                d.npost = post.shape[0]
         self.latency = inverse_latency(model)
         if self.latency > MAX_LATENCY:
             raise ValueError(f"params: the latency {self.latency} is above {MAX_LATENCY} samples")
@@ -224,6 +232,7 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
     The static part's variables are those of the DiagnosedModel unit
     (:func:`~pimodel.diagnosis.stream.fmu_parameters`) with the projected (monotone) weights;
     the feedforward adds ``n_sections``, ``section[1..6 ns]`` (the prefilter),
+    ``n_post_sections``, ``post_section[1..6 np]`` (a Wiener model's filter inverse),
     ``latency``, ``delay_fraction`` and ``reference_range``.
 
     Parameters
@@ -255,9 +264,10 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
     """
     ni = NativeInverse(inverse, input_range, reference_range)
     d, k = ni.params, ni._keep
-    if 6 * d.ns > NMAX:
-        raise ValueError(f"params: the prefilter has {d.ns} sections; the FMU takes at most "
-                         f"{NMAX // 6}")
+    for what, count in (("the prefilter", d.ns), ("the Wiener filter's inverse", d.npost)):
+        if 6 * count > NMAX:
+            raise ValueError(f"params: {what} has {count} sections; the FMU takes at most "
+                             f"{NMAX // 6}")
 
     def arr(name, values):
         """Plays 1..64 in NAME[i], 65..128 in NAME_hi[i] (other arrays: up to 64)."""
@@ -279,4 +289,6 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
                     "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
     if d.ns:
         out.update({"n_sections": int(d.ns), **arr("section", k["sos"].ravel())})
+    if d.npost:
+        out.update({"n_post_sections": int(d.npost), **arr("post_section", k["post"].ravel())})
     return "DiagnosedInverse", out

@@ -721,8 +721,9 @@ class DiagnosedInverse:
 
         :meth:`simulate` reads the reference ahead (one sample for the dynamics' approximate
         inverse, after the hysteresis or before it, ``d`` for a delay); the block cannot, so it
-        delays ``v`` instead by ``A = block.latency`` samples (:func:`~pimodel.diagnosis.inverse_stream.inverse_latency`,
-        0 without dynamics and delay): fed ``y_d[0..k]`` it outputs ``v[k] = simulate(y_d)[k -
+        delays ``v`` instead by ``A = block.latency`` samples
+        (:func:`~pimodel.diagnosis.inverse_stream.inverse_latency`, 0 without dynamics and
+        delay): fed ``y_d[0..k]`` it outputs ``v[k] = simulate(y_d)[k -
         A]`` for ``k >= A`` and the inverse of ``y_d[0]`` at rest before. A model driven by it
         follows ``y_d[k - A]`` (for a reference at rest over its first ``A + 1`` samples,
         exactly as the batch: ``y[k] = model.simulate(simulate(y_d))[k - A]``, drift aside).

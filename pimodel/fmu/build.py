@@ -367,9 +367,10 @@ _INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset"
 MODELS["DiagnosedInverse"] = {
     "id": 9,
     "description": "The causal feedforward of a diagnosed model: the prefilter (the dynamics' "
-                   "approximate inverse), the delay's fraction and the exact per-sample root "
-                   "of the static part (creep, asymmetry, rate), its output delayed by the "
-                   "latency (pimodel.diagnosis.model.DiagnosedInverse.block, dt = Ts)",
+                   "approximate inverse), the delay's fraction, the exact per-sample root "
+                   "of the static part (creep, asymmetry, rate) and the post sections (the "
+                   "approximate inverse of a filter before the hysteresis), its output delayed "
+                   "by the latency (pimodel.diagnosis.model.DiagnosedInverse.block, dt = Ts)",
     "vars": [*[v for v in MODELS["DiagnosedModel"]["vars"]
                if v.name.split("[")[0] in _INVERSE_SHARED],
              Var("reference_range", 67, "Real", "parameter", "0",
@@ -388,6 +389,14 @@ MODELS["DiagnosedInverse"] = {
                    "1" if i % 6 == 3 and i < 6 * MAX_INVERSE_SECTIONS else "0",
                    "prefilter second-order sections, 6 coefficients each (b0 b1 b2 a0 a1 a2, "
                    f"a0 = 1, as scipy.signal.sosfilt), element {i + 1}") for i in range(NMAX)],
+             Var("n_post_sections", 71, "Integer", "parameter", "0",
+                 f"sections after the solve (a Wiener model's filter inverse, latency >= 1), "
+                 f"0 <= n_post_sections <= {MAX_INVERSE_SECTIONS}"),
+             *[Var(f"post_section[{i + 1}]", 2000 + i, "Real", "parameter",
+                   "1" if i % 6 == 3 and i < 6 * MAX_INVERSE_SECTIONS else "0",
+                   "post second-order sections on the solved input (the approximate inverse of a "
+                   "filter before the hysteresis), 6 coefficients each (b0 b1 b2 a0 a1 a2, a0 = "
+                   f"1), element {i + 1}") for i in range(NMAX)],
              Var("y_d", 10, "Real", "input", "0", "reference y_d (the model's output unit)"),
              Var("v", 11, "Real", "output", "0", "feedforward input v (the model's input "
                  "unit)")],

@@ -160,8 +160,8 @@ def build_inverse_fmu(model, out_dir, *, fmi_version: str = "2.0", stem: str = "
     Raises
     ------
     ValueError
-        A model whose inverse has no FMU (a filter before the hysteresis,
-        ``dynamics_position = "before"``; more than 10 prefilter sections).
+        A model whose inverse has no FMU (more than 10 prefilter sections, or 10 sections of
+        a Wiener filter's inverse; more than 128 plays).
 
     Examples
     --------
