@@ -287,11 +287,11 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
     const double a_rate = rate && d->rate_tau > 0.0 ? exp(-d->dt / d->rate_tau) : 0.0;
     const double step_size = PIM_DIAG_STEP_SHARE * d->input_range;
     dinv_ctx c = {d, z, rate ? mem : NULL, 0.0, 0.0, 0.0, first, rate};
+    double fresh = 0.0;
     if (rate) { /* the fresh rate of sample k from the rate-free inverse v0 */
         const double v0 = dinv_solve(d, source, yk, 0);
         const double dv0 = first ? 0.0 : fabs(v0 - *v0_prev);
-        const double fresh = d->rate_tau > 0.0 || dv0 <= step_size ? dv0 / d->dt / d->rate_scale
-                                                                     : 0.0;
+        fresh = d->rate_tau > 0.0 || dv0 <= step_size ? dv0 / d->dt / d->rate_scale : 0.0;
         *v0_prev = v0;
         c.rho_k = a_rate * *rho_f + (1.0 - a_rate) * fresh;
     }
@@ -394,8 +394,8 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
         lags[j] = first ? h : d->lag_a[j] * lags[j] + (1.0 - d->lag_a[j]) * h;
     if (rate && !first) {
         const double dv = fabs(vk - v_prev);
-        const double rho = dv <= step_size || d->rate_tau > 0.0 ? dv / d->dt / d->rate_scale
-                                                                : 0.0;
+        double rho = dv <= step_size || d->rate_tau > 0.0 ? dv / d->dt / d->rate_scale : 0.0;
+        if (rho > PIM_DINV_RATE_FEEDBACK_CAP * fresh) rho = PIM_DINV_RATE_FEEDBACK_CAP * fresh;
         *rho_f = a_rate * *rho_f + (1.0 - a_rate) * rho;
         for (size_t i = 0; i < n; ++i) {
             const double gap = vk - z[i];

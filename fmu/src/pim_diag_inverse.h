@@ -41,7 +41,8 @@
  * of every segment does); out of reach, the breakpoint closest to the target.  Guess: v[k] after a jump of more
  * than 1 % of span, else 2 v[k] - v[k-1].  span = max(2 r_n, reference_range / max(|sum w|,
  * 1e-12), 1).  After the solve: plays, creep lags L_j = a_j L_j + (1 - a_j) h0 (L = h0 on the
- * first solve), rate rho_f and the radius family's memory m_i of the plays in contact.
+ * first solve), rate rho_f (from the solved input's rate, at most PIM_DINV_RATE_FEEDBACK_CAP
+ * times fresh[k]) and the radius family's memory m_i of the plays in contact.
  *
  * State (pim_dinv_state_size doubles): [started, seen, v_rest, f_prev, s[2 ns], g[2 npost],
  * solver]
@@ -63,6 +64,7 @@ extern "C" {
 #define PIM_DINV_MAX_SECTIONS 32                /* prefilter sections */
 #define PIM_DINV_MAX_LATENCY 1000000            /* samples */
 #define PIM_DINV_HEAD 4
+#define PIM_DINV_RATE_FEEDBACK_CAP 2.0          /* inverse_stream.RATE_FEEDBACK_CAP */
 #define PIM_DINV_SOLVER_MAX (3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS + 2 + PIM_DINV_MAX_PLAYS + \
                              3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS)
 #define PIM_DINV_STATE_MAX (PIM_DINV_HEAD + 4 * PIM_DINV_MAX_SECTIONS + PIM_DINV_SOLVER_MAX)

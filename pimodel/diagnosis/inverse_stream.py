@@ -49,6 +49,8 @@ from .wiener import inverse_sections
 
 __all__ = ["StaticInverse", "inverse_block", "inverse_latency"]
 
+RATE_FEEDBACK_CAP = 2.0  # the solved input's rate fed back: at most this times the fresh rate
+
 
 def inverse_latency(model) -> int:
     """Samples by which :func:`inverse_block` delays the feedforward (module docstring).
@@ -302,6 +304,7 @@ class StaticInverse:
         if self.rate and not first:
             dv = abs(vk - v_prev)
             rho = dv / m.dt / p["rate_scale"] if dv <= self.step_size or self.tau > 0 else 0.0
+            rho = min(rho, RATE_FEEDBACK_CAP * fresh)  # (module docstring of .model)
             rho_f = self.a_rate * rho_f + (1 - self.a_rate) * rho
             gap = vk - z_new
             contact = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
