@@ -196,3 +196,26 @@ def test_wiener_inverse_block_then_model_block_tracks_as_the_batch():
     e_loop = res.outputs[0][a:] - y_d[:y_d.size - a]
     assert np.max(np.abs(e_loop - e_batch[:y_d.size - a])) < 1e-9
     assert np.sqrt(np.mean(e_batch**2)) < 0.05 * np.ptp(y_d)
+
+
+@pytest.mark.parametrize("tau", [1e-3, 4e-3, 1e-2])
+def test_strong_filtered_rate_inverse_stays_bounded(tau):
+    """A filtered radius-family rate with strong gains: the exact inverse is unstable, and the
+    solved input's rate fed back to the rate filter made the feedforward diverge (v up to 180
+    for inputs within 1.2). With that feedback capped at RATE_FEEDBACK_CAP times the fresh
+    rate it stays within the span of the input that made the reference."""
+    from pimodel.diagnosis.inverse_stream import RATE_FEEDBACK_CAP
+
+    assert RATE_FEEDBACK_CAP == 2.0
+    m = DiagnosedModel([0.0, 0.1, 0.3, 0.6, 0.9, 1.2], [0.9, 0.35, 0.3, 0.2, 0.15, 0.1], 0.05,
+                       dt=DT, effects=("rate",), params={
+                           "rate_scale": 8.0, "rate_gains": [0.15, 0.05], "rate_family": "radius",
+                           "rate_time_constant_s": tau})
+    t = np.arange(600) * DT
+    v_true = 0.9 * np.sin(2 * np.pi * 2.5 * t) + 0.25 * np.sin(2 * np.pi * 11.0 * t + 0.4)
+    v_true[:10] = 0.0
+    v_true[10:] -= v_true[10]
+    y_d = m.simulate(v_true, input_range=2.4)
+    v = m.inverse().simulate(y_d)
+    assert np.max(np.abs(v)) < 2 * np.max(np.abs(v_true))
+    assert np.sqrt(np.mean((m.simulate(v, input_range=2.4) - y_d) ** 2)) < 0.5 * np.ptp(y_d)

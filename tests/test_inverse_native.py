@@ -50,8 +50,9 @@ CASES = {
     "asymmetry": (("asymmetry",), {}),
     "creep_asymmetry": (("creep", "asymmetry"), {}),
     "rate_radius": (("rate",), {}),
-    # (with the gains of PARAMS and a filter the radius family's inverse diverges on these
-    # references, v up to 180 for |v| <= 1.2 in both implementations: docs/notes/inverse-fmu.md)
+    # (with the gains of PARAMS and a filter the radius family's inverse diverged on these
+    # references, v up to 180 for |v| <= 1.2, before the rate feedback cap; bounded now:
+    # tests/test_inverse_block.py, but its rounding differences are amplified there)
     "rate_radius_filtered": (("rate",), {"rate_time_constant_s": 4e-3,
                                          "rate_gains": [0.05, 0.02]}),
     "rate_weight": (("rate",), {"rate_family": "weight"}),
