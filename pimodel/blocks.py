@@ -92,6 +92,42 @@ class _Block(control.NonlinearIOSystem):
         return self._own_state(self.params)
 
 
+def _stepped_block(settings: _Settings, step: Callable, *, own_state: Callable[[dict], np.ndarray],
+                   states: list[str], dt: float, name: str, input: str, output: str,
+                   memo: bool = False, block_class: type | None = None
+                   ) -> control.NonlinearIOSystem:
+    """A discrete one-input, one-output block around one sample function.
+
+    ``step(obj, x, u, t) -> (y, x_next)`` with ``obj = settings.get(params)`` (the object the
+    block's settings build), ``x`` a float copy of the state after sample k - 1 (``step`` may
+    advance it in place and return it), ``u`` the input sample and ``t`` python-control's time:
+    ``outfcn`` gives ``y[k]`` (direct feedthrough), ``updfcn`` the state after sample k. With
+    ``memo`` the last sample's result is kept, so a dear ``step`` (a root solve) runs once per
+    sample although python-control calls ``outfcn`` and ``updfcn`` each.
+    """
+    cache: dict = {}
+
+    def run(t, x, u, params):
+        obj = settings.get(params)
+        if memo:
+            key = (np.asarray(x, float).tobytes(), float(u[0]), float(t), id(obj))
+            if key not in cache:
+                cache.clear()
+                cache[key] = step(obj, np.array(x, dtype=float), float(u[0]), float(t))
+            return cache[key]
+        return step(obj, np.array(x, dtype=float), float(u[0]), float(t))
+
+    def upd(t, x, u, params):
+        return run(t, x, u, params)[1]
+
+    def out(t, x, u, params):
+        return np.array([run(t, x, u, params)[0]])
+
+    return (block_class or _Block)(upd, out, own_state=own_state, inputs=[input],
+                                   outputs=[output], states=states, dt=dt, name=name,
+                                   params=settings.params)
+
+
 def _labels(base: str, n: int) -> list[str]:
     return [f"{base}[{i}]" for i in range(1, n + 1)]
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from . import _native
 from .asymmetric import AsymmetricPI
-from .blocks import _Settings
+from .blocks import _Settings, _stepped_block
 from .checks import positive_scalar
 from .creep import CreepOperator
 from .generalized import GeneralizedPI
@@ -94,23 +94,14 @@ def _make_block(settings: _Settings, step: Callable, *, n_states: int, labels: l
                 dt: float, name: str, input: str, output: str) -> _OperatorBlock:
     """``step(op, x, u) -> (y, x_next)``; the block checks the state size."""
 
-    def run(t, x, u, params):
-        op = settings.get(params)
-        if not np.isfinite(u[0]):
-            raise ValueError(f"{input}: input sample is {u[0]!r}; expected a finite number")
-        return step(op, np.array(x, dtype=float), float(u[0]))
+    def checked(op, x, u, t):
+        if not np.isfinite(u):
+            raise ValueError(f"{input}: input sample is {u!r}; expected a finite number")
+        return step(op, x, u)
 
-    def upd(t, x, u, params):
-        return run(t, x, u, params)[1]
-
-    def out(t, x, u, params):
-        return np.array([run(t, x, u, params)[0]])
-
-    def own_state(params):
-        return _state_of(settings.get(params))
-
-    return _OperatorBlock(upd, out, own_state=own_state, inputs=[input], outputs=[output],
-                          states=labels, dt=dt, name=name, params=settings.params)
+    return _stepped_block(settings, checked, own_state=lambda params: _state_of(
+        settings.get(params)), states=labels, dt=dt, name=name, input=input, output=output,
+        block_class=_OperatorBlock)
 
 
 def _state_of(op) -> np.ndarray:

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from pimodel.blocks import initial_state
-from pimodel.diagnosis.inverse_stream import StaticInverse, inverse_latency
-from pimodel.diagnosis.model import DiagnosedModel, _solve
+from pimodel.diagnosis.inverse_stream import StaticInverse, inverse_latency, solve_static
+from pimodel.diagnosis.model import DiagnosedModel
 
 DT = 1e-3
 RADII = [0.0, 0.15, 0.4, 0.7, 1.0]
@@ -63,7 +63,7 @@ def test_per_sample_solver_resumes_from_its_state_and_inverts(case):
     m = model(effects, **STATIC_CASES[case])
     y_d = reference(m)
     rng = 2 * RADII[-1]
-    want = _solve(m, y_d, rng)
+    want = solve_static(m, y_d, rng)
     inv = StaticInverse(m, rng, float(np.ptp(y_d)))
     x = inv.initial_state()
     half = y_d.size // 2

@@ -40,14 +40,13 @@ import control
 import numpy as np
 from scipy.signal import sosfilt_zi
 
-from ..blocks import _Block, _labels, _Settings
+from ..blocks import _labels, _Settings, _stepped_block
 from .lti import inverse_sos
-from .model import _rate_params, _roots
 from .monotone import monotone_model
-from .rate import STEP_SHARE, play_bands
+from .rate import STEP_SHARE, play_bands, rate_params
 from .wiener import inverse_sections
 
-__all__ = ["StaticInverse", "inverse_block", "inverse_latency"]
+__all__ = ["StaticInverse", "inverse_block", "inverse_latency", "solve_static"]
 
 RATE_FEEDBACK_CAP = 2.0  # the solved input's rate fed back: at most this times the fresh rate
 
@@ -103,6 +102,75 @@ def _advance_of(model) -> int:
     return _filter(model)[1]
 
 
+def solve_static(m, yd: np.ndarray, input_range: float, z0=None) -> np.ndarray:
+    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring of :mod:`.model`), the plays
+    starting from ``z0`` (None: at rest at 0): :class:`StaticInverse` over the record, its root
+    rule scaled by the reference's range (``DiagnosedInverse.simulate``'s solver).
+
+    Parameters
+    ----------
+    m : DiagnosedModel
+        The model (its dynamics and delay ignored).
+    yd : numpy.ndarray
+        The (prefiltered) reference.
+    input_range : float
+        Range of the rate effect's step rule.
+    z0 : array_like, optional
+        Start memory of the plays.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``v[k]`` for ``yd[0..k]``.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> solve_static(m, np.array([0.1, 1.35, 0.35]), 1.0).round(9).tolist()
+    [0.0, 1.0, 0.0]
+    """
+    inv = StaticInverse(m, input_range, float(np.ptp(yd)))
+    x = inv.initial_state(z0)
+    return np.array([inv.step(x, float(y)) for y in yd])
+
+
+_NODES = {False: np.array([0.25, 0.75]), True: np.array([0.125, 0.375, 0.625, 0.875])}
+
+
+def _roots(F, b: np.ndarray, target: float, *, cubic: bool) -> np.ndarray:
+    """Roots of ``F - target`` between the breakpoints ``b``. Inside each segment ``F`` is a
+    polynomial (linear, or cubic with the asymmetry) whose values at the breakpoints may jump
+    (a play starts to move), so it is interpolated from interior nodes."""
+    lo, width = b[:-1], np.diff(b)
+    s = _NODES[cubic]
+    vals = (F((lo[:, None] + s[None, :] * width[:, None]).ravel()) - target).reshape(lo.size,
+                                                                                       s.size)
+    coef = np.linalg.solve(np.vander(s, s.size), vals.T).T  # highest power first
+    out = []
+    if not cubic:
+        slope, c0 = coef[:, 0], coef[:, 1]
+        ok = slope != 0
+        x = np.where(ok, -c0 / np.where(ok, slope, 1.0), -1.0)
+        keep = ok & (x >= 0) & (x <= 1)
+        return lo[keep] + x[keep] * width[keep]
+    # a segment holds a root when the polynomial changes sign between its ends and its
+    # extrema inside (closed form of the derivative's roots)
+    a3, a2, a1 = coef[:, 0], coef[:, 1], coef[:, 2]
+    disc = np.sqrt(np.maximum(4 * a2**2 - 12 * a3 * a1, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ext = np.column_stack(((-2 * a2 + disc) / (6 * a3), (-2 * a2 - disc) / (6 * a3),
+                               -a1 / (2 * a2)))
+    ext = np.where(np.isfinite(ext) & (ext > 0) & (ext < 1), ext, 0.0)
+    pts = np.column_stack((np.zeros(lo.size), np.ones(lo.size), ext))
+    vals = ((a3[:, None] * pts + a2[:, None]) * pts + a1[:, None]) * pts + coef[:, 3:4]
+    for i in np.flatnonzero((vals.min(axis=1) <= 0) & (vals.max(axis=1) >= 0)):
+        rts = np.roots(np.trim_zeros(coef[i], "f")) if np.any(coef[i]) else np.array([0.0])
+        real = rts[np.abs(rts.imag) < 1e-9].real
+        out.extend(lo[i] + x * width[i] for x in real[(real >= -1e-12) & (real <= 1 + 1e-12)])
+    return np.asarray(out, float)
+
+
 class StaticInverse:
     """The exact inverse of a model's static part, one sample at a time: the per-sample form of
     ``DiagnosedInverse.simulate``'s solver on an already prefiltered reference (the module
@@ -153,7 +221,7 @@ class StaticInverse:
         self.asym = "asymmetry" in e
         self.rate = "rate" in e
         if self.rate:
-            gains, family, tau = _rate_params(p)
+            gains, family, tau = rate_params(p)
             self.rg, self.rw = np.zeros(n), np.zeros(n)  # per play: g_b r_i or g_b w0_i
             for g, idx in zip(gains, play_bands(n, gains.size), strict=True):
                 if family == "radius":
@@ -439,24 +507,12 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
                 "reference_range": 0.0 if reference_range is None else float(reference_range)}
     settings = _Settings(name, defaults, lambda s: _InverseStream(model, s["input_range"],
                                                                   s["reference_range"]))
-    cache: dict = {}
 
-    def run(x, u, params):
-        key = (np.asarray(x, float).tobytes(), float(u[0]), id(settings.get(params)))
-        if key not in cache:
-            xs = np.array(x, dtype=float)
-            cache.clear()
-            cache[key] = (settings.get(params).step(xs, float(u[0])), xs)
-        return cache[key]
+    def step(inv, x, yd, t):
+        return inv.step(x, yd), x
 
-    def upd(t, x, u, params):
-        return run(x, u, params)[1]
-
-    def out(t, x, u, params):
-        return np.array([run(x, u, params)[0]])
-
-    blk = _Block(upd, out, own_state=lambda params: np.zeros(stream.size), inputs=[input],
-                 outputs=[output], states=stream.labels(), dt=model.dt, name=name,
-                 params=settings.params)
+    blk = _stepped_block(settings, step, own_state=lambda params: np.zeros(stream.size),
+                         states=stream.labels(), dt=model.dt, name=name, input=input,
+                         output=output, memo=True)
     blk.latency = stream.latency
     return blk

@@ -93,8 +93,9 @@ from scipy.optimize import brentq
 from ..operator import PIOperator
 from .drift import drift_term
 from .effects import lag, mode, shift
+from .inverse_stream import inverse_block, solve_static
 from .lti import approximate_inverse, lti_columns
-from .rate import RATE_FAMILIES, rate_columns
+from .rate import rate_columns, rate_params
 from .wiener import inverse_prefilter, prefilter
 
 if TYPE_CHECKING:
@@ -277,7 +278,7 @@ class DiagnosedModel:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
         if "rate" in e:
-            gains, family, tau = _rate_params(p)
+            gains, family, tau = rate_params(p)
             R = rate_columns(Z, self.radii, v, self.dt, p["rate_scale"], self.reference_weights,
                              tau, family, gains.size, input_range=input_range)
             y = y + R @ gains
@@ -709,7 +710,7 @@ class DiagnosedInverse:
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
         x = self.prefilter(yd)
         z0 = self.initial_memory(x[0]) if state == "unknown" else None
-        x = _solve(self.model.static_part(), x, rng, z0)
+        x = solve_static(self.model.static_part(), x, rng, z0)
         if self.model.dynamics_before:  # the filter's output -> its input (approximate)
             return inverse_prefilter(x, self.model.params["wiener_elements"], self.model.dt)
         return x
@@ -768,8 +769,6 @@ class DiagnosedInverse:
         >>> m.inverse().simulate(y_d).round(9).tolist()
         [0.0, 1.0, 0.0, 0.0, 0.0]
         """
-        from .inverse_stream import inverse_block
-
         return inverse_block(self, dt, name=name, input=input, output=output,
                              input_range=input_range, reference_range=reference_range)
 
@@ -778,68 +777,3 @@ def _advance(x, d):
     """``x[k + d]`` (linear interpolation, the last sample held)."""
     k = np.arange(x.size) + d
     return np.interp(k, np.arange(x.size), x)
-
-
-def _solve(m: DiagnosedModel, yd: np.ndarray, input_range: float, z0=None) -> np.ndarray:
-    """Per-sample root of ``F_k(v) = yd[k]`` (module docstring), the plays starting from
-    ``z0`` (None: at rest at 0): the per-sample solver
-    :class:`~pimodel.diagnosis.inverse_stream.StaticInverse` over the record, its root rule
-    scaled by the reference's range."""
-    from .inverse_stream import StaticInverse  # it builds on this module's root finder
-
-    inv = StaticInverse(m, input_range, float(np.ptp(yd)))
-    x = inv.initial_state(z0)
-    return np.array([inv.step(x, float(y)) for y in yd])
-
-
-_NODES = {False: np.array([0.25, 0.75]), True: np.array([0.125, 0.375, 0.625, 0.875])}
-
-
-def _roots(F, b: np.ndarray, target: float, *, cubic: bool) -> np.ndarray:
-    """Roots of ``F - target`` between the breakpoints ``b``. Inside each segment ``F`` is a
-    polynomial (linear, or cubic with the asymmetry) whose values at the breakpoints may jump
-    (a play starts to move), so it is interpolated from interior nodes."""
-    lo, width = b[:-1], np.diff(b)
-    s = _NODES[cubic]
-    vals = (F((lo[:, None] + s[None, :] * width[:, None]).ravel()) - target).reshape(lo.size,
-                                                                                       s.size)
-    coef = np.linalg.solve(np.vander(s, s.size), vals.T).T  # highest power first
-    out = []
-    if not cubic:
-        slope, c0 = coef[:, 0], coef[:, 1]
-        ok = slope != 0
-        x = np.where(ok, -c0 / np.where(ok, slope, 1.0), -1.0)
-        keep = ok & (x >= 0) & (x <= 1)
-        return lo[keep] + x[keep] * width[keep]
-    # a segment holds a root when the polynomial changes sign between its ends and its
-    # extrema inside (closed form of the derivative's roots)
-    a3, a2, a1 = coef[:, 0], coef[:, 1], coef[:, 2]
-    disc = np.sqrt(np.maximum(4 * a2**2 - 12 * a3 * a1, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ext = np.column_stack(((-2 * a2 + disc) / (6 * a3), (-2 * a2 - disc) / (6 * a3),
-                               -a1 / (2 * a2)))
-    ext = np.where(np.isfinite(ext) & (ext > 0) & (ext < 1), ext, 0.0)
-    pts = np.column_stack((np.zeros(lo.size), np.ones(lo.size), ext))
-    vals = ((a3[:, None] * pts + a2[:, None]) * pts + a1[:, None]) * pts + coef[:, 3:4]
-    for i in np.flatnonzero((vals.min(axis=1) <= 0) & (vals.max(axis=1) >= 0)):
-        rts = np.roots(np.trim_zeros(coef[i], "f")) if np.any(coef[i]) else np.array([0.0])
-        real = rts[np.abs(rts.imag) < 1e-9].real
-        out.extend(lo[i] + x * width[i] for x in real[(real >= -1e-12) & (real <= 1 + 1e-12)])
-    return np.asarray(out, float)
-
-
-def _rate_params(p: dict) -> tuple[np.ndarray, str, float]:
-    """Gains, family and filter time constant [s] of a rate effect."""
-    if "rate_band_gains" in p:
-        raise ValueError("params: 'rate_band_gains' is the rate effect of an earlier version "
-                         "(radii growing with the unfiltered rate, pushed plays); diagnose the "
-                         "records again for 'rate_gains', 'rate_family' and "
-                         "'rate_time_constant_s'")
-    missing = [k for k in ("rate_gains", "rate_family", "rate_time_constant_s") if k not in p]
-    if missing:
-        raise ValueError(f"params: the rate effect needs {missing}")
-    if p["rate_family"] not in RATE_FAMILIES:
-        raise ValueError(f"params: rate_family expected one of {RATE_FAMILIES}, got "
-                         f"{p['rate_family']!r}")
-    return (np.asarray(p["rate_gains"], float), str(p["rate_family"]),
-            float(p["rate_time_constant_s"]))

@@ -7,9 +7,9 @@ last reversal the plays with ``2 r_i < l`` move and the branch's slope is ``S_m`
 ``m = #{i: 2 r_i < l}``; within one sample the slope of ``y[k]``
 in ``v[k]`` is such a partial sum too (the moving plays are always the smallest radii). A
 partial sum ``S_m <= 0`` makes the branch turn back (fold): the per-sample root of
-:func:`pimodel.diagnosis.model._solve` then vanishes where the branch folds, and the inverse
-jumps to a far root (on the shared real record: 14.8 V in one sample, where the reference input
-moves 0.19 V).
+:func:`pimodel.diagnosis.inverse_stream.solve_static` then vanishes where the branch folds, and
+the inverse jumps to a far root (on the shared real record: 14.8 V in one sample, where the
+reference input moves 0.19 V).
 
 The projection keeps the branch curve of the model, not its slopes. The branch curve, sampled
 at the radii, is ``Phi_0 = 0``, ``Phi_j = sum_{m <= j} S_m (r_{m+1} - r_m)`` (half the

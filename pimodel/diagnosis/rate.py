@@ -41,7 +41,7 @@ RATE_FAMILIES = ("radius", "weight")  # radii or weights growing with the rate
 STEP_SHARE = 0.05  # without a filter, a one-sample jump above this share of the range is a step
 
 __all__ = ["RATE_BANDS", "RATE_FAMILIES", "RATE_TAU_REFINE", "RATE_TAUS", "RateBasis",
-           "filtered_rate", "input_rate", "play_bands", "rate_columns"]
+           "filtered_rate", "input_rate", "play_bands", "rate_columns", "rate_params"]
 
 
 def input_rate(v: np.ndarray, dt: float, rate_scale: float, tau: float,
@@ -318,3 +318,41 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
     """
     return RateBasis(Z, radii, v, dt, rate_scale, weights, bands,
                      input_range=input_range).columns(tau, family)
+
+
+def rate_params(p: dict) -> tuple[np.ndarray, str, float]:
+    """Gains, family and filter time constant [s] of a model's rate effect.
+
+    Parameters
+    ----------
+    p : dict
+        The model's ``params`` (``rate_gains``, ``rate_family``, ``rate_time_constant_s``).
+
+    Returns
+    -------
+    (numpy.ndarray, str, float)
+
+    Raises
+    ------
+    ValueError
+        A missing key (named), an unknown family, or the rate parameters of an earlier version
+        (``rate_band_gains``).
+
+    Examples
+    --------
+    >>> rate_params({"rate_gains": [0.1], "rate_family": "weight", "rate_time_constant_s": 0.0})
+    (array([0.1]), 'weight', 0.0)
+    """
+    if "rate_band_gains" in p:
+        raise ValueError("params: 'rate_band_gains' is the rate effect of an earlier version "
+                         "(radii growing with the unfiltered rate, pushed plays); diagnose the "
+                         "records again for 'rate_gains', 'rate_family' and "
+                         "'rate_time_constant_s'")
+    missing = [k for k in ("rate_gains", "rate_family", "rate_time_constant_s") if k not in p]
+    if missing:
+        raise ValueError(f"params: the rate effect needs {missing}")
+    if p["rate_family"] not in RATE_FAMILIES:
+        raise ValueError(f"params: rate_family expected one of {RATE_FAMILIES}, got "
+                         f"{p['rate_family']!r}")
+    return (np.asarray(p["rate_gains"], float), str(p["rate_family"]),
+            float(p["rate_time_constant_s"]))

@@ -50,12 +50,12 @@ import control
 import numpy as np
 
 from .. import _native
-from ..blocks import _Block, _labels, _Settings
+from ..blocks import _labels, _Settings, _stepped_block
 from ..fmu.build import MAX_LTI_ELEMENTS as MAX_ELEMENTS
 from ..fmu.build import NMAX
 from .effects import mode_coefficients
 from .lti import ELEMENT_K, element_coefficients
-from .rate import RATE_FAMILIES, play_bands
+from .rate import RATE_FAMILIES, play_bands, rate_params
 from .wiener import ELEMENT_K as WIENER_K
 
 __all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",
@@ -260,8 +260,6 @@ class NativeModel:
     """
 
     def __init__(self, model, input_range: float | None = None):
-        from .model import _rate_params
-
         e, p, r = model.effects, model.params, model.radii
         n = r.size
         self.model = model
@@ -281,7 +279,7 @@ class NativeModel:
             d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
             d.center, d.half = p["center"], p["half_range"]
         if "rate" in e:
-            gains, family, tau = _rate_params(p)
+            gains, family, tau = rate_params(p)
             keep["rate_w"] = _band_gains(gains, n)
             d.rate_family, d.rate_tau = RATE_FAMILIES.index(family), tau
             d.rate_scale, d.input_range = p["rate_scale"], self.input_range
@@ -563,21 +561,12 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
                 "input_range": native.input_range, **params}
     settings = _Settings(name, defaults, build)
 
-    def run(t, x, u, params):
-        nm = settings.get(params)
-        xs = np.array(x, dtype=float)
-        y = nm.step(xs, float(u[0]), float(t))
-        return y, xs
+    def step(nm, x, v, t):
+        return nm.step(x, v, t), x
 
-    def upd(t, x, u, params):
-        return run(t, x, u, params)[1]
-
-    def out(t, x, u, params):
-        return np.array([run(t, x, u, params)[0]])
-
-    return _Block(upd, out, own_state=lambda params: settings.get(params).initial_state(),
-                  inputs=[input], outputs=[output], states=labels, dt=model.dt, name=name,
-                  params=settings.params)
+    return _stepped_block(settings, step, own_state=lambda params: settings.get(params)
+                          .initial_state(), states=labels, dt=model.dt, name=name, input=input,
+                          output=output)
 
 
 def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dict]:
