@@ -219,3 +219,26 @@ def test_strong_filtered_rate_inverse_stays_bounded(tau):
     v = m.inverse().simulate(y_d)
     assert np.max(np.abs(v)) < 2 * np.max(np.abs(v_true))
     assert np.sqrt(np.mean((m.simulate(v, input_range=2.4) - y_d) ** 2)) < 0.5 * np.ptp(y_d)
+
+
+def test_unknown_start_memory_of_a_folding_model_is_that_of_its_projection():
+    """A folding model is solved through its nearest monotone model; its start memory comes
+    from that model too, so the stage is taken to sit at y_d[0] with the input 0: the first
+    input is 0 (from the fitted model's memory it was 0.02 off)."""
+    from pimodel.diagnosis.monotone import is_monotone, monotone_model
+
+    m = DiagnosedModel([0.0, 0.1, 0.3, 0.6, 0.9, 1.2], [0.5, -0.6, 0.5, 0.3, 0.2, 0.1], 0.05,
+                       dt=DT)
+    assert not is_monotone(m.weights)
+    projected = monotone_model(m)
+    t = np.arange(400) * DT
+    v_true = 0.9 * np.sin(2 * np.pi * 2.5 * t)
+    y_d = m.simulate(v_true) - 0.3  # the stage does not rest at the model's output at rest
+    inv = m.inverse()
+    z0 = inv.initial_memory(float(y_d[0]))
+    assert abs(projected.simulate(np.zeros(2))[0] - y_d[0]) > 0.1  # the memory matters
+    v = inv.simulate(y_d, initial_state="unknown")
+    assert abs(v[0]) < 1e-9 and np.max(np.abs(z0)) > 0.1
+    # the projected model, from that memory at the input 0, puts out y_d[0]
+    h = np.clip(z0, -projected.radii, projected.radii) @ projected.weights + projected.offset
+    assert abs(h - y_d[0]) < 1e-9

@@ -95,6 +95,7 @@ from .drift import drift_term
 from .effects import lag, mode, shift
 from .inverse_stream import inverse_block, solve_static
 from .lti import approximate_inverse, lti_columns
+from .monotone import monotone_model
 from .rate import rate_columns, rate_params
 from .wiener import inverse_prefilter, prefilter
 
@@ -624,7 +625,7 @@ class DiagnosedInverse:
         >>> m.inverse().initial_memory(0.0).tolist()  # the output at rest: at rest
         [0.0, 0.0]
         """
-        m = self.model.static_part()
+        m = monotone_model(self.model.static_part())  # the model the solver inverts
         r = m.radii
         p = m.params
 
