@@ -94,8 +94,7 @@ class _Block(control.NonlinearIOSystem):
 
 def _stepped_block(settings: _Settings, step: Callable, *, own_state: Callable[[dict], np.ndarray],
                    states: list[str], dt: float, name: str, input: str, output: str,
-                   memo: bool = False, block_class: type | None = None
-                   ) -> control.NonlinearIOSystem:
+                   memo: bool = False) -> control.NonlinearIOSystem:
     """A discrete one-input, one-output block around one sample function.
 
     ``step(obj, x, u, t) -> (y, x_next)`` with ``obj = settings.get(params)`` (the object the
@@ -123,9 +122,8 @@ def _stepped_block(settings: _Settings, step: Callable, *, own_state: Callable[[
     def out(t, x, u, params):
         return np.array([run(t, x, u, params)[0]])
 
-    return (block_class or _Block)(upd, out, own_state=own_state, inputs=[input],
-                                   outputs=[output], states=states, dt=dt, name=name,
-                                   params=settings.params)
+    return _Block(upd, out, own_state=own_state, inputs=[input], outputs=[output],
+                  states=states, dt=dt, name=name, params=settings.params)
 
 
 def _labels(base: str, n: int) -> list[str]:

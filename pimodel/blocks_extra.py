@@ -29,7 +29,7 @@ import numpy as np
 
 from . import _native
 from .asymmetric import AsymmetricPI
-from .blocks import _Settings, _stepped_block
+from .blocks import _Block, _labels, _Settings, _stepped_block
 from .checks import positive_scalar
 from .creep import CreepOperator
 from .generalized import GeneralizedPI
@@ -43,18 +43,6 @@ __all__ = [
     "rate_dependent_inverse_block",
     "rate_dependent_pi_block",
 ]
-
-
-class _OperatorBlock(control.NonlinearIOSystem):
-    """A block that knows its own initial state (``_own_state(params)``)."""
-
-    def __init__(self, updfcn, outfcn, *, own_state: Callable[[dict], np.ndarray], **kwargs):
-        super().__init__(updfcn, outfcn, **kwargs)
-        self._own_state = own_state
-
-
-def _labels(base: str, n: int) -> list[str]:
-    return [f"{base}[{i}]" for i in range(1, n + 1)]
 
 
 def block_initial_state(sys: control.InputOutputSystem, params: dict | None = None) -> np.ndarray:
@@ -91,7 +79,7 @@ def block_initial_state(sys: control.InputOutputSystem, params: dict | None = No
 
 
 def _make_block(settings: _Settings, step: Callable, *, n_states: int, labels: list[str],
-                dt: float, name: str, input: str, output: str) -> _OperatorBlock:
+                dt: float, name: str, input: str, output: str) -> _Block:
     """``step(op, x, u) -> (y, x_next)``; the block checks the state size."""
 
     def checked(op, x, u, t):
@@ -100,8 +88,7 @@ def _make_block(settings: _Settings, step: Callable, *, n_states: int, labels: l
         return step(op, x, u)
 
     return _stepped_block(settings, checked, own_state=lambda params: _state_of(
-        settings.get(params)), states=labels, dt=dt, name=name, input=input, output=output,
-        block_class=_OperatorBlock)
+        settings.get(params)), states=labels, dt=dt, name=name, input=input, output=output)
 
 
 def _state_of(op) -> np.ndarray:
