@@ -5,8 +5,8 @@
 Examples
 --------
 >>> from pimodel.fmu import MODELS
->>> sorted(MODELS)[:3]
-['AsymmetricPI', 'CreepOperator', 'DiagnosedModel']
+>>> sorted(MODELS)[:4]
+['AsymmetricPI', 'CreepOperator', 'DiagnosedInverse', 'DiagnosedModel']
 """
 
 from .build import MODELS, build_fmus
