@@ -9,12 +9,12 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from pimodel.loops.compiled.actuators import stage_dynamics
+from pimodel.loops.compiled.compiled import PID, loop_system, run_loop
+from pimodel.loops.compiled.simulation import simulate
 
-from pimodel.actuators import stage_dynamics
-from pimodel.compensation import STAGE
-from pimodel.loops import PID, loop_system, run_loop
+from pimodel.experiments.compensation import STAGE
 from pimodel.signals import sinusoid
-from pimodel.simulation import simulate
 
 
 def main() -> None:

@@ -6,10 +6,17 @@ from __future__ import annotations
 import control
 import numpy as np
 import pytest
+from pimodel.loops.compiled.actuators import (
+    creep_lags,
+    creep_per_decade,
+    second_order_mode,
+    stage_dynamics,
+)
+from pimodel.loops.compiled.compiled import PID, loop_system, run_loop
+from pimodel.loops.compiled.simulation import simulate
 
 from pimodel import PIOperator
-from pimodel.actuators import creep_lags, creep_per_decade, second_order_mode, stage_dynamics
-from pimodel.blocks import (
+from pimodel.blocks.pi import (
     adaptive_compensator_block,
     estimator_block,
     inverse_pi_block,
@@ -17,10 +24,8 @@ from pimodel.blocks import (
     pid_block,
     radius_estimator,
 )
-from pimodel.compensation import STAGE, compensation_table, identified_models, reference
-from pimodel.loops import PID, loop_system, run_loop
+from pimodel.experiments.compensation import STAGE, compensation_table, identified_models, reference
 from pimodel.signals import sinusoid, triangle
-from pimodel.simulation import simulate
 
 DT = 1e-4
 

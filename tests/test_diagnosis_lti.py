@@ -19,8 +19,8 @@ from pimodel.diagnosis.lti import (
     lti_columns,
 )
 from pimodel.diagnosis.model import load_diagnosed_model
-from pimodel.truth import excitation, random_truth
-from pimodel.truth_alt import excitations, random_alt_truth
+from pimodel.stages.pi_stage import excitation, random_truth
+from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
 ONE_MODE_SHRINK_TODAY = 0.75  # truth_alt dynamics, seed 0, with the one-mode candidate
 
@@ -150,7 +150,7 @@ def test_two_mode_model_exports_to_a_block_and_an_fmu_equal_to_simulate(alt_dyna
     inverse's block equals its simulate delayed by one sample."""
     from fmpy.validation import validate_fmu
 
-    from pimodel.blocks import initial_state
+    from pimodel.blocks.framework import initial_state
     from pimodel.cli.diagnose import export_models
     from pimodel.diagnosis.stream import stream_simulate
     from pimodel.fmu.model_fmu import cosimulate_chain

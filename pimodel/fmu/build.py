@@ -17,6 +17,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import escape
 
+__all__ = [
+    "build_description",
+    "build_fmus",
+    "check_fmi_version",
+    "find_compiler",
+    "fmi_headers",
+    "fmu_filename",
+    "guid",
+    "model_description",
+    "source_dir",
+    "spec_of",
+    "Var",
+]
+
 NMAX = 64  # declared array size per FMU (p[1..64] ...); PIM_NMAX in fmu/src/pim_unit.h
 MAX_SUBSTEPS = 10_000_000  # samples per doStep; PIM_MAX_SUBSTEPS in fmu/src/pim_unit.h
 MAX_LTI_ELEMENTS = 8  # further elements of a DiagnosedModel's linear part; PIM_DIAG_MAX_ELEMENTS
@@ -221,7 +235,7 @@ MODELS: dict[str, dict] = {
     "GeneralizedPI": {
         "id": 4,
         "description": "Generalized PI y = g(sum p_i Gamma_{r_i}[h(v)]) or its exact inverse "
-                       "(pimodel.generalized.GeneralizedPI)",
+                       "(pimodel.operators.generalized.GeneralizedPI)",
         "vars": [*_common(), *_arrays("r", 200, "parameter", "0",
                                       "radius r (>= 0, sorted, envelope units), play"),
                  _inverse_flag("v, y = y", "y_d, y = v"),
@@ -232,7 +246,7 @@ MODELS: dict[str, dict] = {
     "AsymmetricPI": {
         "id": 5,
         "description": "Asymmetric generalized PI (ascending/descending envelopes a phi + d) or "
-                       "its exact inverse (pimodel.asymmetric.AsymmetricPI)",
+                       "its exact inverse (pimodel.operators.asymmetric.AsymmetricPI)",
         "vars": [*_common(z0="initial play state (unit of phi)",
                           weights=("p", "1", "weight p (>= 0), play")),
                  *_arrays("r", 200, "parameter", "0", "radius r (>= 0, sorted), play"),
@@ -248,7 +262,7 @@ MODELS: dict[str, dict] = {
     "RateDependentPI": {
         "id": 6,
         "description": "Rate-dependent PI, radii alpha_i (1 + beta rate), or its exact inverse "
-                       "(pimodel.rate_dependent.RateDependentPI, dt = Ts)",
+                       "(pimodel.operators.rate_dependent.RateDependentPI, dt = Ts)",
         "vars": [*_common(), *_arrays("r", 200, "parameter", "0",
                                       "base radius alpha (>= 0, sorted), play"),
                  _inverse_flag("v, y = y", "y_d, y = v"),
@@ -262,7 +276,7 @@ MODELS: dict[str, dict] = {
     "CreepOperator": {
         "id": 7,
         "description": "Creep: sum of ZOH first-order lags with feedthrough 1, or its exact "
-                       "inverse (pimodel.creep.CreepOperator, dt = Ts)",
+                       "inverse (pimodel.operators.creep.CreepOperator, dt = Ts)",
         "vars": [*_common(elements="lags", z0="initial lag state x_i[0]",
                           weights=("c", "0.05", "gain c (> 0), lag")),
                  *_arrays("tau", 200, "parameter", "1", "time constant tau [s] (> 0), lag"),

@@ -3,7 +3,7 @@ native compiled loop, side by side (used by ``pimodel demo`` and ``studies/cosim
 
 Loop: a 5 Hz triangle of the stage's own output as reference (10 kHz), the stage's hysteresis
 (PIHysteresis FMU) followed by a 1 kHz mode (damping 0.05), the RadiusEstimator FMU and the
-adaptive InversePI FMU; the native loop is :func:`pimodel.loops.run_loop` with the same
+adaptive InversePI FMU; the native loop is :func:`pimodel.loops.compiled.run_loop` with the same
 estimator settings.
 """
 
@@ -15,13 +15,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..actuators import stage_dynamics
-from ..blocks import radius_estimator
-from ..compensation import STAGE
-from ..loops import LoopResult, run_loop
+from ..blocks.pi import radius_estimator
+from ..experiments.compensation import STAGE
+from ..loops.actuators import stage_dynamics
+from ..loops.compiled import LoopResult, run_loop
 from ..plotting import new_figure, save_figure
 from ..signals import triangle
 from .cosim import cosimulate_adaptive_loop
+
+__all__ = [
+    "compare_with_native",
+    "CosimComparison",
+    "plot_comparison",
+]
 
 DT = 1e-4  # s
 
@@ -35,7 +41,7 @@ class CosimComparison:
     cosim : LoopResult
         The FMU co-simulation (``radii`` from the RadiusEstimator FMU).
     native : LoopResult
-        The native compiled loop (:func:`pimodel.loops.run_loop`).
+        The native compiled loop (:func:`pimodel.loops.compiled.run_loop`).
     max_difference : float
         ``max_k |y_cosim[k] - y_native[k]|`` [um].
     cosim_steps_per_s : float
@@ -49,8 +55,8 @@ class CosimComparison:
     :func:`compare_with_native`):
 
     >>> from pimodel.blocks import radius_estimator
-    >>> from pimodel.compensation import STAGE
-    >>> from pimodel.loops import run_loop
+    >>> from pimodel.experiments.compensation import STAGE
+    >>> from pimodel.loops.compiled import run_loop
     >>> yd = STAGE.simulate(np.sin(np.linspace(0, 2 * np.pi, 100)))
     >>> est = radius_estimator(STAGE.weights, dt=DT, gains=20.0,
     ...                        initial_radii=[0.0, 0.1, 0.3, 0.5], linear_play=True)
@@ -104,7 +110,7 @@ def compare_with_native(fmu_dir, *, duration: float, weights, initial_radii,
     The FMUs must be built first (a compile of a few seconds), hence skipped here:
 
     >>> import tempfile
-    >>> from pimodel.compensation import STAGE
+    >>> from pimodel.experiments.compensation import STAGE
     >>> from pimodel.fmu import build_fmus
     >>> fmu_dir = tempfile.mkdtemp()
     >>> _ = build_fmus(fmu_dir, ["PIHysteresis", "RadiusEstimator", "InversePI"])  # doctest: +SKIP
@@ -149,8 +155,8 @@ def plot_comparison(cmp: CosimComparison, path) -> Path:
     --------
     >>> import tempfile, pathlib
     >>> from pimodel.blocks import radius_estimator
-    >>> from pimodel.compensation import STAGE
-    >>> from pimodel.loops import run_loop
+    >>> from pimodel.experiments.compensation import STAGE
+    >>> from pimodel.loops.compiled import run_loop
     >>> yd = STAGE.simulate(np.sin(np.linspace(0, 2 * np.pi, 100)))
     >>> est = radius_estimator(STAGE.weights, dt=DT, gains=20.0,
     ...                        initial_radii=[0.0, 0.1, 0.3, 0.5], linear_play=True)

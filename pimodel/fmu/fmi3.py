@@ -9,6 +9,11 @@ from xml.sax.saxutils import escape
 
 from .build import LOG_CATEGORIES, MODEL_UNITS, NMAX, spec_of
 
+__all__ = [
+    "model_description3",
+    "token",
+]
+
 TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
 PLATFORM = "x86_64-linux"
 
