@@ -9,11 +9,11 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from pimodel.loops.compiled.actuators import stage_dynamics
-from pimodel.loops.compiled.compiled import PID, loop_system, run_loop
-from pimodel.loops.compiled.simulation import simulate
 
 from pimodel.experiments.compensation import STAGE
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import PID, loop_system, run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid
 
 

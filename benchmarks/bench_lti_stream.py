@@ -16,7 +16,7 @@ from dataclasses import replace
 import control
 import numpy as np
 
-from pimodel.blocks.framework import initial_state
+from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.stream import stream_simulate
 

@@ -92,7 +92,7 @@ STRICT_MODULES = [
     "pimodel.fmu.fmi3",
     "pimodel.fmu.unit",
     "pimodel.fmu.cosim",
-    "pimodel.fmu.compare",
+    "pimodel.experiments.fmu_comparison",
     "pimodel.experiments.demo",
     "pimodel.reference.extended_operators",
     "pimodel.fmu",

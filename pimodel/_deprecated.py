@@ -33,6 +33,7 @@ MOVED: dict[str, str] = {
     "pimodel.reference_operators": "pimodel.reference.extended_operators",
     "pimodel.estimator_reference": "pimodel.reference.radius_estimator",
     "pimodel.identify": "pimodel.identification.chain",
+    "pimodel.fmu.compare": "pimodel.experiments.fmu_comparison",
     "pimodel.slopes": "pimodel.identification.slopes",
     "pimodel.segmented": "pimodel.identification.piecewise_linear",
     "pimodel.conventional": "pimodel.identification.conventional",

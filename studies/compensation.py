@@ -10,9 +10,6 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from pimodel.loops.compiled.actuators import stage_dynamics  # noqa: E402
-from pimodel.loops.compiled.compiled import run_loop  # noqa: E402
-
 from pimodel.experiments.compensation import (
     STAGE,
     chord_gain,
@@ -21,6 +18,8 @@ from pimodel.experiments.compensation import (
     reference,
 )
 from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
+from pimodel.loops.actuators import stage_dynamics  # noqa: E402
+from pimodel.loops.compiled import run_loop  # noqa: E402
 from pimodel.plotting import new_figure, save_figure  # noqa: E402
 
 

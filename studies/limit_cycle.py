@@ -23,18 +23,18 @@ from pathlib import Path
 
 import control
 import numpy as np
-from pimodel.loops.compiled.actuators import stage_dynamics
-from pimodel.loops.compiled.compiled import PID, run_loop
-from pimodel.loops.compiled.describing import (
+
+from pimodel.experiments.compensation import STAGE
+from pimodel.experiments.studies import StudyResult, Table, study_main
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import PID, run_loop
+from pimodel.loops.describing import (
     circle_criterion,
     harmonic_balance,
     residual_hysteresis,
     sector,
     static_gain,
 )
-
-from pimodel.experiments.compensation import STAGE
-from pimodel.experiments.studies import StudyResult, Table, study_main
 from pimodel.operators.pi import PIOperator
 from pimodel.plotting import new_figure, save_figure
 

@@ -6,17 +6,9 @@ from __future__ import annotations
 import control
 import numpy as np
 import pytest
-from pimodel.loops.compiled.actuators import (
-    creep_lags,
-    creep_per_decade,
-    second_order_mode,
-    stage_dynamics,
-)
-from pimodel.loops.compiled.compiled import PID, loop_system, run_loop
-from pimodel.loops.compiled.simulation import simulate
 
 from pimodel import PIOperator
-from pimodel.blocks.pi import (
+from pimodel.blocks import (
     adaptive_compensator_block,
     estimator_block,
     inverse_pi_block,
@@ -25,6 +17,14 @@ from pimodel.blocks.pi import (
     radius_estimator,
 )
 from pimodel.experiments.compensation import STAGE, compensation_table, identified_models, reference
+from pimodel.loops.actuators import (
+    creep_lags,
+    creep_per_decade,
+    second_order_mode,
+    stage_dynamics,
+)
+from pimodel.loops.compiled import PID, loop_system, run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid, triangle
 
 DT = 1e-4

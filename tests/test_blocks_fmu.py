@@ -9,10 +9,9 @@ import control
 import numpy as np
 import pytest
 from fmpy import read_model_description
-from pimodel.loops.compiled.compiled import run_loop
 
 from pimodel import PIOperator
-from pimodel.blocks.pi import (
+from pimodel.blocks import (
     adaptive_compensator_block,
     estimator_block,
     initial_state,
@@ -21,6 +20,7 @@ from pimodel.blocks.pi import (
 )
 from pimodel.fmu import build_fmus
 from pimodel.fmu.block import fmu_block
+from pimodel.loops.compiled import run_loop
 from pimodel.signals import sinusoid
 
 STAGE = PIOperator([6.3460, 1.6735, 1.1552, 0.4477], [0.0, 0.1945, 0.4826, 0.5707])

@@ -11,14 +11,12 @@ import warnings
 import control
 import numpy as np
 import pytest
-from pimodel.loops.compiled.actuators import stage_dynamics
-from pimodel.loops.compiled.compiled import PID, loop_system, run_loop
-from pimodel.loops.compiled.simulation import simulate
 
-import pimodel.blocks
+import pimodel.blocks.framework
+import pimodel.blocks.pi
 import pimodel.loops.simulation
 from pimodel import PIOperator
-from pimodel.blocks.pi import (
+from pimodel.blocks import (
     InitialStateWarning,
     adaptive_compensator_block,
     estimator_block,
@@ -28,6 +26,9 @@ from pimodel.blocks.pi import (
     pid_block,
     radius_estimator,
 )
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import PID, loop_system, run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid, triangle
 
 DT = 1e-4
@@ -279,7 +280,8 @@ def test_deprecated_names_still_work():
         close(res["pi_z2"], res["z[2]"])
 
 
-@pytest.mark.parametrize("module", [pimodel.blocks, pimodel.loops.simulation])
+@pytest.mark.parametrize("module", [pimodel.blocks.framework, pimodel.blocks.pi,
+                                    pimodel.loops.simulation])
 def test_docstring_examples_run(module):
     failures, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
     assert tried > 0 and failures == 0

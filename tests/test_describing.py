@@ -7,7 +7,9 @@ from __future__ import annotations
 import control
 import numpy as np
 import pytest
-from pimodel.loops.compiled.describing import (
+
+from pimodel.experiments.compensation import STAGE
+from pimodel.loops.describing import (
     PIDescribingFunction,
     circle_criterion,
     harmonic_balance,
@@ -16,8 +18,6 @@ from pimodel.loops.compiled.describing import (
     sector,
     static_gain,
 )
-
-from pimodel.experiments.compensation import STAGE
 from pimodel.operators.pi import PIOperator
 
 SIGNED = STAGE.inverse()  # signed weights, radii in um

@@ -150,7 +150,7 @@ def test_two_mode_model_exports_to_a_block_and_an_fmu_equal_to_simulate(alt_dyna
     inverse's block equals its simulate delayed by one sample."""
     from fmpy.validation import validate_fmu
 
-    from pimodel.blocks.framework import initial_state
+    from pimodel.blocks import initial_state
     from pimodel.cli.diagnose import export_models
     from pimodel.diagnosis.stream import stream_simulate
     from pimodel.fmu.model_fmu import cosimulate_chain

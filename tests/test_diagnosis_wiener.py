@@ -14,7 +14,7 @@ import pytest
 from scipy.signal import lfilter, lfilter_zi
 
 from pimodel import Record
-from pimodel.blocks.framework import initial_state
+from pimodel.blocks import initial_state
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.model import DiagnosedModel, load_diagnosed_model
 from pimodel.diagnosis.wiener import inverse_prefilter, prefilter, search_filter

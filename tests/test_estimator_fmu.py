@@ -11,11 +11,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from pimodel.loops.compiled.simulation import simulate
 
 from pimodel import PIOperator, estimate_radii
-from pimodel.blocks.pi import estimator_block
+from pimodel.blocks import estimator_block
 from pimodel.fmu.unit import FMUUnit
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])

@@ -7,7 +7,6 @@ from __future__ import annotations
 import control
 import numpy as np
 import pytest
-from pimodel.loops.compiled.actuators import creep_per_decade
 
 from pimodel import PIOperator
 from pimodel.identification.extended_operators import (
@@ -16,6 +15,7 @@ from pimodel.identification.extended_operators import (
     fit_generalized,
     fit_rate_dependent,
 )
+from pimodel.loops.actuators import creep_per_decade
 from pimodel.stages.pi_stage import STAGE_RADII, STAGE_WEIGHTS, Truth, excitation
 
 

@@ -13,9 +13,6 @@ import fmpy
 import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
-from pimodel.loops.compiled.actuators import stage_dynamics
-from pimodel.loops.compiled.compiled import run_loop
-from pimodel.loops.compiled.simulation import simulate
 
 from pimodel import PIOperator, RadiusEstimator, estimate_radii
 from pimodel.fmu import MODELS, build_fmus
@@ -23,6 +20,9 @@ from pimodel.fmu.block import fmu_block
 from pimodel.fmu.build import NMAX
 from pimodel.fmu.cosim import cosimulate_adaptive_loop
 from pimodel.fmu.unit import FMUUnit
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid, triangle
 
 P, R = [1.0, 0.5, 0.3], [0.0, 0.2, 0.6]

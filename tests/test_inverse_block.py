@@ -13,7 +13,7 @@ import control
 import numpy as np
 import pytest
 
-from pimodel.blocks.framework import initial_state
+from pimodel.blocks import initial_state
 from pimodel.diagnosis.inverse_stream import StaticInverse, inverse_latency, solve_static
 from pimodel.diagnosis.model import DiagnosedModel
 

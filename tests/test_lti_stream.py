@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
-from pimodel.blocks.framework import initial_state
+from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.stream import (
     MAX_ELEMENTS,

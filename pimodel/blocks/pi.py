@@ -24,7 +24,6 @@ Each block is a self-sufficient python-control system:
 
 from __future__ import annotations
 
-import ctypes
 import inspect
 import math
 import warnings
@@ -58,9 +57,6 @@ __all__ = [
     "radius_estimator",
 ]
 
-_native.lib.pim_adaptive_inverse_step.restype = ctypes.c_double
-_native.lib.pim_adaptive_inverse_step.argtypes = [ctypes.c_size_t, _native.F64, _native.F64,
-                                                  _native.F64, ctypes.c_double]
 
 
 def _operator_settings(op: PIOperator, name: str):
@@ -84,10 +80,7 @@ def _operator_settings(op: PIOperator, name: str):
 
 # pim_pi_step on raw pointers: the blocks call it a few times per sample, and numpy's checked
 # argument conversion (pimodel._native.pi_step) costs more than the step itself.
-_raw_pi_step = _native.lib["pim_pi_step"]
-_raw_pi_step.restype = ctypes.c_double
-_raw_pi_step.argtypes = [ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
-                         ctypes.c_double]
+_raw_pi_step = _native.raw_pi_step
 
 
 class _Stepper:
@@ -97,9 +90,9 @@ class _Stepper:
         self.op = op
         self.n = op.n
         self.initial_state = op.initial_state
-        self._p, self._r = op.weights.ctypes.data, op.radii.ctypes.data
+        self._p, self._r = _native.address(op.weights), _native.address(op.radii)
         self._z = np.empty(op.n)
-        self._zp = self._z.ctypes.data
+        self._zp = _native.address(self._z)
 
     def step(self, x, v) -> tuple[float, np.ndarray]:
         """``(y[k], z[k])`` from the play states ``x = z[k-1]`` and the input ``v = v[k]``."""

@@ -211,8 +211,8 @@ def step_fmu(out: Path, weights) -> tuple[dict, str]:
     >>> r, text = step_fmu(Path("pimodel-demo"), [1.0, 0.5, 0.3, 0.2])  # doctest: +SKIP
     """
     from ..fmu import build_fmus
-    from ..fmu.compare import compare_with_native, plot_comparison
     from ..fmu.cosim import LOOP_UNITS
+    from .fmu_comparison import compare_with_native, plot_comparison
 
     fmu_dir = out / "fmus"
     t0 = time.perf_counter()

@@ -7,13 +7,12 @@ smaller than the threshold.
 
 from __future__ import annotations
 
-import ctypes
 from dataclasses import dataclass
 
 import numpy as np
 
-from .._native import F64
 from .._native import lib as _lib
+from .._native import reversal_scanner
 
 __all__ = [
     "Branch",
@@ -22,13 +21,6 @@ __all__ = [
     "split_branches",
 ]
 
-_lib.pim_rev_scan_sizeof.restype = ctypes.c_size_t
-_lib.pim_rev_scan_init.restype = None
-_lib.pim_rev_scan_init.argtypes = [ctypes.c_void_p]
-_lib.pim_rev_scan_run.restype = ctypes.c_size_t
-_I64 = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
-_lib.pim_rev_scan_run.argtypes = [ctypes.c_void_p, ctypes.c_size_t, F64, ctypes.c_double, _I64,
-                                  _I64]
 
 
 @dataclass(frozen=True)
@@ -91,8 +83,7 @@ class ReversalScanner:
         if not np.isfinite(threshold) or threshold < 0:
             raise ValueError(f"threshold: expected a finite number >= 0, got {threshold!r}")
         self.threshold = float(threshold)
-        self._buf = ctypes.create_string_buffer(_lib.pim_rev_scan_sizeof())
-        _lib.pim_rev_scan_init(self._buf)
+        self._buf = reversal_scanner()
 
     def scan(self, v: np.ndarray) -> np.ndarray:
         """Reversals declared within the next chunk of the input.

@@ -12,7 +12,6 @@ in adaptive mode the estimator takes ``(v[k], y[k])``. :func:`run_loop` is the f
 
 from __future__ import annotations
 
-import ctypes
 from dataclasses import dataclass
 
 import control
@@ -37,35 +36,8 @@ __all__ = [
     "run_loop",
 ]
 
-MAX_PLAYS, MAX_DYN = 64, 16
-_lib = _native.lib
-_lib.pim_est_sizeof.restype = ctypes.c_size_t
-_EST_WORDS = _lib.pim_est_sizeof() // 8
-_D64 = ctypes.c_double * MAX_PLAYS
-
-
-class _Loop(ctypes.Structure):
-    _fields_ = [
-        ("n", ctypes.c_size_t), ("p", _D64), ("r", _D64), ("z", _D64),
-        ("nx", ctypes.c_size_t), ("A", ctypes.c_double * (MAX_DYN * MAX_DYN)),
-        ("B", ctypes.c_double * MAX_DYN), ("C", ctypes.c_double * MAX_DYN),
-        ("D", ctypes.c_double), ("xd", ctypes.c_double * MAX_DYN),
-        ("ff_mode", ctypes.c_int), ("ff_gain", ctypes.c_double),
-        ("ni", ctypes.c_size_t), ("pinv", _D64), ("rinv", _D64), ("zinv", _D64),
-        ("nm", ctypes.c_size_t), ("pm", _D64), ("zm", _D64),
-        ("est", ctypes.c_double * _EST_WORDS),
-        ("pid_on", ctypes.c_int), ("kp", ctypes.c_double), ("ki", ctypes.c_double),
-        ("kd", ctypes.c_double), ("tf", ctypes.c_double), ("dt", ctypes.c_double),
-        ("integ", ctypes.c_double), ("dfilt", ctypes.c_double), ("e_prev", ctypes.c_double),
-    ]
-
-
-_lib.pim_loop_sizeof.restype = ctypes.c_size_t
-if ctypes.sizeof(_Loop) != _lib.pim_loop_sizeof():  # pragma: no cover - build mismatch guard
-    raise ImportError("pimodel: the ctypes layout of pim_loop does not match the C core")
-_lib.pim_loop_run.restype = ctypes.c_int
-_lib.pim_loop_run.argtypes = [ctypes.POINTER(_Loop), ctypes.c_size_t, _native.F64, _native.F64,
-                              _native.F64_OR_NULL, _native.F64_OR_NULL, _native.F64_OR_NULL]
+MAX_PLAYS, MAX_DYN = _native.LOOP_MAX_PLAYS, _native.LOOP_MAX_DYN
+_Loop = _native.Loop
 
 
 @dataclass(frozen=True)
@@ -277,8 +249,7 @@ def run_loop(ref, plant: PIOperator, dt: float, *, dynamics=None, feedforward="n
         nm = estimator.n
         L.ff_mode, L.nm = 2, nm
         _fill(L.pm, estimator.weights)
-        ctypes.memmove(ctypes.addressof(L) + _Loop.est.offset,
-                       ctypes.addressof(estimator._buf), ctypes.sizeof(L.est))
+        _native.loop_take_estimator(L, estimator._buf)
     elif feedforward == "none":
         L.ff_mode = 0
         L.ff_gain = 1.0 / float(plant.weights.sum()) if ff_gain is None else float(ff_gain)
@@ -292,7 +263,7 @@ def run_loop(ref, plant: PIOperator, dt: float, *, dynamics=None, feedforward="n
     N = r.size
     y, v, e = np.empty(N), np.empty(N), np.empty(N)
     R = np.empty((N, nm)) if nm else None
-    if _lib.pim_loop_run(ctypes.byref(L), N, r, y, v, e, R) != 0:
+    if _native.loop_run(L, r, y, v, e, R) != 0:
         raise ValueError("adaptive inverse failed: estimated radii not invertible")
     return LoopResult(np.arange(N) * dt, r, y, v, e, R)
 

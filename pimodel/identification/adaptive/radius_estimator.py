@@ -55,7 +55,6 @@ of the result (:mod:`pimodel.identification.adaptive.health`).
 
 from __future__ import annotations
 
-import ctypes
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -83,33 +82,9 @@ __all__ = [
 ]
 
 _lib = _native.lib
-_F64 = _native.F64
-_F64N = _native.F64_OR_NULL
-_lib.pim_est_sizeof.restype = ctypes.c_size_t
-_lib.pim_est_init.restype = ctypes.c_char_p
-_lib.pim_est_init.argtypes = [ctypes.c_void_p, ctypes.c_size_t, _F64, _F64, _F64, ctypes.c_double,
-                              ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
-                              ctypes.c_double, ctypes.c_int]
-_lib.pim_est_step.restype = ctypes.c_int
-_D = ctypes.POINTER(ctypes.c_double)
-_lib.pim_est_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, _F64N, _D, _D,
-                              _D]
-_lib.pim_est_run.restype = ctypes.c_long
-_lib.pim_est_run.argtypes = [ctypes.c_void_p, ctypes.c_size_t, _F64, _F64, _F64N, _F64, _F64,
-                             _F64, _F64N]
-_lib.pim_est_get_state.restype = None
-_lib.pim_est_get_state.argtypes = [ctypes.c_void_p, _F64]
-_lib.pim_est_set_state.restype = ctypes.c_char_p
-_lib.pim_est_set_state.argtypes = [ctypes.c_void_p, _F64]
-_lib.pim_est_set_slope_check.restype = ctypes.c_char_p
-_lib.pim_est_set_slope_check.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_double]
 EST_WINDOW = 64  # PIM_EST_WIN in pim_estimator.h
 EST_BINS = 256  # PIM_EST_BINS
-_lib.pim_est_set_law.restype = ctypes.c_char_p
-_lib.pim_est_set_law.argtypes = [ctypes.c_void_p, ctypes.c_int]
 LAWS = {"data": 0, "paper": 1}  # PIM_LAW_DATA, PIM_LAW_PAPER in pim_estimator.h
-_lib.pim_project_ordered.restype = None
-_lib.pim_project_ordered.argtypes = [ctypes.c_size_t, _F64, _F64, ctypes.c_int]
 
 MAX_PLAYS = 64
 
@@ -339,7 +314,7 @@ class RadiusEstimator:
         self.weights = p
         self.gains = np.ascontiguousarray(g, dtype=float)
         self.linear_play = bool(linear_play)
-        self._buf = ctypes.create_string_buffer(_lib.pim_est_sizeof())
+        self._buf = _native.estimator_buffer()
         msg = _lib.pim_est_init(self._buf, n, p, self.gains, np.ascontiguousarray(r0), self.dt,
                                 float(initial_state), float(threshold), ms, at, float(guard),
                                 int(self.linear_play))
@@ -441,12 +416,10 @@ class RadiusEstimator:
         >>> rhat, yhat, round(e, 12)
         (array([0.15, 0.15]), 0.7, -0.3)
         """
-        yh, e, ed = ctypes.c_double(), ctypes.c_double(), ctypes.c_double()
-        rc = _lib.pim_est_step(self._buf, float(v), float(y), None, ctypes.byref(yh),
-                               ctypes.byref(e), ctypes.byref(ed))
+        rc, yh, e, ed = _native.estimator_step(self._buf, float(v), float(y))
         if rc < 0:
             raise ValueError(f"v, y: samples must be finite, got v={v!r}, y={y!r}")
-        return self.radii, yh.value, e.value, ed.value
+        return self.radii, yh, e, ed
 
     def run(self, v, y) -> RadiusEstimate:
         """Process whole arrays from the current state (batch, C loop).

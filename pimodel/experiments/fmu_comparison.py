@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 
 from ..blocks.pi import radius_estimator
-from ..experiments.compensation import STAGE
+from ..fmu.cosim import cosimulate_adaptive_loop
 from ..loops.actuators import stage_dynamics
 from ..loops.compiled import LoopResult, run_loop
 from ..plotting import new_figure, save_figure
 from ..signals import triangle
-from .cosim import cosimulate_adaptive_loop
+from .compensation import STAGE
 
 __all__ = [
     "compare_with_native",
