@@ -47,7 +47,7 @@ numpydoc_attributes_as_param_list = False
 # names: summary, Parameters, Returns, Examples). Add a module here once its docstrings are done.
 STRICT_MODULES = [
     "pimodel",  # the package docstring: the API map
-    "pimodel.reference",
+    "pimodel.reference.operators",
     "pimodel.signals",
     "pimodel.identification.conventional",
     "pimodel.identification.slopes",
@@ -58,7 +58,10 @@ STRICT_MODULES = [
     "pimodel.plotting",
     "pimodel.identification.plots",
     "pimodel.identification.branches",
-    "pimodel.blocks",
+    "pimodel.blocks.framework",
+    "pimodel.blocks.pi",
+    "pimodel.operators.describing_function",
+    "pimodel._deprecated",
     "pimodel.loops.describing",
     "pimodel.operators.pi",
     "pimodel.identification.adaptive.health",

@@ -37,6 +37,7 @@ class InitialStateWarning(UserWarning):
     --------
     >>> import warnings, control
     >>> from pimodel import PIOperator
+    >>> from pimodel.blocks import pi_block
     >>> pb = pi_block(PIOperator([1.0, 0.5], [0.0, 0.3], initial_state=0.7), 1e-3)
     >>> t = np.arange(3) * 1e-3
     >>> with warnings.catch_warnings(record=True) as caught:
@@ -48,7 +49,30 @@ class InitialStateWarning(UserWarning):
 
 
 class Block(control.NonlinearIOSystem):
-    """A pimodel block: a ``NonlinearIOSystem`` that knows its own initial state."""
+    """A pimodel block: a ``NonlinearIOSystem`` that knows its own initial state.
+
+    Parameters
+    ----------
+    updfcn, outfcn : callable
+        python-control's ``updfcn(t, x, u, params) -> x[k+1]`` and
+        ``outfcn(t, x, u, params) -> y[k]``.
+    own_state : callable
+        ``own_state(params) -> x0``: the block's own initial state for the given params (what
+        :func:`initial_state` returns).
+    aliases : dict, optional
+        Deprecated state names mapped to current ones (old result keys keep working).
+    **kwargs
+        Passed to ``control.NonlinearIOSystem`` (``inputs``, ``outputs``, ``states``, ``dt``,
+        ``name``, ``params``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> b = Block(lambda t, x, u, p: x + u, lambda t, x, u, p: x, own_state=lambda p: [1.0],
+    ...           inputs=["u"], outputs=["y"], states=["x"], dt=1.0, name="acc")
+    >>> initial_state(b)
+    array([1.])
+    """
 
     def __init__(self, updfcn, outfcn, *, own_state: Callable[[dict], np.ndarray],
                  aliases: dict[str, str] | None = None, **kwargs):
@@ -77,6 +101,39 @@ def stepped_block(settings: BlockSettings, step: Callable, *,
     ``outfcn`` gives ``y[k]`` (direct feedthrough), ``updfcn`` the state after sample k. With
     ``memo`` the last sample's result is kept, so a dear ``step`` (a root solve) runs once per
     sample although python-control calls ``outfcn`` and ``updfcn`` each.
+
+    Parameters
+    ----------
+    settings : BlockSettings
+        The block's settings; ``settings.get(params)`` is the object passed to ``step``.
+    step : callable
+        ``step(obj, x, u, t) -> (y, x_next)``, one sample.
+    own_state : callable
+        ``own_state(params) -> x0``, the block's own initial state.
+    states : list of str
+        State names (use :func:`signal_labels` for vectors).
+    dt : float
+        Sample time [s].
+    name, input, output : str
+        Block name and its one input and one output signal.
+    memo : bool, optional
+        Keep the last sample's result (for a costly ``step``). Default False.
+
+    Returns
+    -------
+    Block
+        The discrete-time block.
+
+    Examples
+    --------
+    >>> import control, numpy as np
+    >>> gain = BlockSettings("g", {"k": 2.0}, lambda s: float(s["k"]))
+    >>> blk = stepped_block(gain, lambda k, x, u, t: (k * u + x[0], np.array([u])),
+    ...                     own_state=lambda p: np.zeros(1), states=["u_prev"], dt=1.0,
+    ...                     name="g", input="u", output="y")
+    >>> res = control.input_output_response(blk, np.arange(3.0), [1.0, 2.0, 3.0])
+    >>> res.outputs.tolist()
+    [2.0, 5.0, 8.0]
     """
     cache: dict = {}
 
@@ -101,6 +158,25 @@ def stepped_block(settings: BlockSettings, step: Callable, *,
 
 
 def signal_labels(base: str, n: int) -> list[str]:
+    """1-based labels of a vector signal, ``base[1]..base[n]`` (as the FMUs and the paper).
+
+    Parameters
+    ----------
+    base : str
+        The signal's name.
+    n : int
+        Its length.
+
+    Returns
+    -------
+    list of str
+        ``n`` labels.
+
+    Examples
+    --------
+    >>> signal_labels("z", 3)
+    ['z[1]', 'z[2]', 'z[3]']
+    """
     return [f"{base}[{i}]" for i in range(1, n + 1)]
 
 
@@ -130,6 +206,21 @@ class BlockSettings:
     ``build(settings)`` validates them and returns what the update function needs; it runs at
     construction and again only when a value changes, so reading params costs a comparison of
     fingerprints (a few microseconds).
+
+    Parameters
+    ----------
+    name : str
+        The block's name (the params prefix).
+    defaults : dict
+        Setting name -> value at construction (the block's ``sys.params``).
+    build : callable
+        ``build(values) -> object``; raises ValueError or TypeError on a bad value.
+
+    Examples
+    --------
+    >>> s = BlockSettings("pi", {"gain": 2.0}, lambda v: 10 * v["gain"])
+    >>> s.get({}), s.get({"pi.gain": 3.0}), s.params
+    (20.0, 30.0, {'pi.gain': 2.0})
     """
 
     def __init__(self, name: str, defaults: dict, build: Callable[[dict], object]):
@@ -174,7 +265,28 @@ class BlockSettings:
         self._last_keys = set(params.keys())
 
     def get(self, params: dict | None):
-        """The built settings for ``params`` (missing keys: construction values)."""
+        """The built settings for ``params`` (missing keys: construction values).
+
+        Parameters
+        ----------
+        params : dict or None
+            python-control's params (keys ``"<name>.<setting>"``).
+
+        Returns
+        -------
+        object
+            What ``build`` returned for these values (cached while they do not change).
+
+        Raises
+        ------
+        ValueError
+            An unknown ``"<name>.*"`` key, or a value ``build`` refuses.
+
+        Examples
+        --------
+        >>> BlockSettings("b", {"k": 1.0}, lambda v: v["k"] + 1).get({"b.k": 4.0})
+        5.0
+        """
         params = params or {}
         if params is self._last_params and self._immutable:
             return self.value  # python-control passes one dict to a block's every call
@@ -195,7 +307,29 @@ class BlockSettings:
 
 
 def warn_if_zero_start(name: str, t, x, own: np.ndarray) -> None:
-    """Cheap first-sample check: all zeros at t = 0 while the block's own state is not."""
+    """Cheap first-sample check: warn when ``x`` is all zeros at t = 0 while the block's own
+    state is not (python-control's default initial state used by mistake).
+
+    Parameters
+    ----------
+    name : str
+        The block's name (for the message).
+    t : float
+        python-control's time.
+    x : array_like
+        The state python-control passes.
+    own : numpy.ndarray
+        The block's own initial state.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_if_zero_start("pi", 0.0, [0.0], np.array([0.5]))
+    >>> caught[0].category.__name__
+    'InitialStateWarning'
+    """
     if t == 0 and np.any(own) and not np.any(x):
         warnings.warn(f"block {name!r} starts from an all-zero state but its own initial state "
                       f"is {np.array2string(np.asarray(own), precision=4)}; pass "

@@ -45,7 +45,7 @@ __all__ = [
 ]
 
 
-class PILike(Protocol):
+class _PILike(Protocol):
     """What this module reads of a :class:`~pimodel.operators.pi.PIOperator` (annotation only)."""
 
     weights: np.ndarray
@@ -103,7 +103,7 @@ def play_describing_function(radius: float, A) -> np.ndarray | complex:
     return complex(out) if out.ndim == 0 else out
 
 
-def sector(op: PILike) -> tuple[float, float]:
+def sector(op: _PILike) -> tuple[float, float]:
     """Sector of incremental gains of a PI operator (paper Lemma 1).
 
     Parameters
@@ -130,7 +130,7 @@ def sector(op: PILike) -> tuple[float, float]:
     return float(s.min()), float(s.max())
 
 
-def static_gain(op: PILike, A) -> np.ndarray | float:
+def static_gain(op: _PILike, A) -> np.ndarray | float:
     """Static (chord) gain ``phi(A) / A`` of the symmetric loop of amplitude ``A``.
 
     In the periodic steady state of an input oscillating between ``v0 - A`` and ``v0 + A``
@@ -179,7 +179,7 @@ def _pi_class(op) -> type:
     raise TypeError(f"op: expected a PIOperator, got {type(op).__name__}")
 
 
-def _operator(op) -> PILike:
+def _operator(op) -> _PILike:
     _pi_class(op)
     return op
 
@@ -207,7 +207,7 @@ class PIDescribingFunction(control.DescribingFunctionNonlinearity):
     (1.4288-0.1019j)
     """
 
-    def __init__(self, op: PILike):
+    def __init__(self, op: _PILike):
         super().__init__()
         op = _operator(op)
         self.operator = _pi_class(op)(op.weights, op.radii, initial_state=op.initial_state,

@@ -111,8 +111,8 @@ def noisy_output_chunks(op: PIOperator, input_at: Callable[[np.ndarray], np.ndar
 
     See Also
     --------
-    pimodel.identification.adaptive.radius_estimator.stream_tail_average : consumes such chunks
-    with a RadiusEstimator.
+    pimodel.identification.adaptive.radius_estimator.stream_tail_average
+        Consumes such chunks with a RadiusEstimator.
 
     Examples
     --------
