@@ -1,5 +1,5 @@
 """The C feedforward (fmu/src/pim_diag_inverse.c, ``NativeInverse``) equals the Python stream of
-``DiagnosedInverse.block()`` (``inverse_stream._InverseStream``, output and whole state) and the
+``DiagnosedInverse.block()`` (``reference_inverse._InverseStream``, output and whole state) and the
 batch ``DiagnosedInverse.simulate`` delayed by the latency, to 1e-9: each static effect alone and
 together, dynamics with a further element, whole and fractional delays, a folding model (the
 monotone projection), a start from the unknown memory, and models diagnosed on records of
@@ -16,10 +16,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-import pimodel.diagnosis.inverse_stream as inverse_stream
+import pimodel.diagnosis.reference_inverse as reference_inverse
 from pimodel.diagnosis import diagnose
-from pimodel.diagnosis.inverse_native import NativeInverse, inverse_fmu_parameters
-from pimodel.diagnosis.inverse_stream import _InverseStream, inverse_latency
+from pimodel.diagnosis.native_inverse import NativeInverse, inverse_fmu_parameters
+from pimodel.diagnosis.reference_inverse import _InverseStream, inverse_latency
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.monotone import is_monotone
 from pimodel.records import Record
@@ -100,7 +100,7 @@ def single_roots(monkeypatch):
     farther from the branch guess the second nearest root lies than the nearest (inf for one
     root; roots within 1e-7 count as one)."""
     margins, guesses = [], []
-    roots, step = inverse_stream._roots, inverse_stream.StaticInverse.step
+    roots, step = reference_inverse._roots, reference_inverse.StaticInverse.step
 
     def spy_step(self, x, yk):
         guesses.append(float(x[2]))
@@ -116,8 +116,8 @@ def single_roots(monkeypatch):
         margins.append(float(far[0] - dist[0]) if far.size else np.inf)
         return out
 
-    monkeypatch.setattr(inverse_stream, "_roots", spy)
-    monkeypatch.setattr(inverse_stream.StaticInverse, "step", spy_step)
+    monkeypatch.setattr(reference_inverse, "_roots", spy)
+    monkeypatch.setattr(reference_inverse.StaticInverse, "step", spy_step)
     return margins
 
 

@@ -24,7 +24,7 @@ from fmpy.validation import validate_fmu
 
 from pimodel.blocks.framework import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
-from pimodel.diagnosis.stream import (
+from pimodel.diagnosis.native_model import (
     MAX_ELEMENTS,
     NativeModel,
     element_sections,

@@ -1,5 +1,9 @@
-"""The feedforward of a :class:`~pimodel.diagnosis.model.DiagnosedInverse` as a causal
-python-control block (``DiagnosedInverse.block``).
+"""The NumPy reference of a :class:`~pimodel.diagnosis.model.DiagnosedInverse`'s causal
+feedforward: the per-sample solver of the static part (:class:`StaticInverse`, which
+:meth:`DiagnosedInverse.simulate` steps over the record, :func:`solve_static`) and the causal
+python-control block around it (:func:`inverse_block`). :meth:`DiagnosedInverse.block` returns
+the same block stepped on the C core (:func:`pimodel.diagnosis.native_inverse.inverse_block`);
+``tests/test_inverse_native.py`` holds the two equal to 1e-9, output and whole state.
 
 ``DiagnosedInverse.simulate`` is not causal when the model has dynamics or a delay: its
 prefilter reads the reference ahead, by one sample for the zero-order hold of the dynamics'
@@ -458,7 +462,8 @@ class _InverseStream:
 def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
                   input: str = "y_d", output: str = "v", input_range: float | None = None,
                   reference_range: float | None = None) -> control.NonlinearIOSystem:
-    """The causal feedforward as a discrete python-control block (module docstring).
+    """The causal feedforward as a discrete python-control block, stepped in NumPy (the
+    reference of :func:`pimodel.diagnosis.native_inverse.inverse_block`; module docstring).
 
     Parameters
     ----------
