@@ -23,8 +23,8 @@ from fmpy.validation import validate_fmu
 
 from pimodel.blocks.framework import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
-from pimodel.diagnosis.rate import STEP_SHARE
 from pimodel.diagnosis.native_model import NativeModel, state_labels, stream_simulate
+from pimodel.diagnosis.rate import STEP_SHARE
 from pimodel.fmu.block import fmu_block
 from pimodel.fmu.build import source_dir
 from pimodel.fmu.model_fmu import cosimulate_chain

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from pimodel.blocks.framework import initial_state
-from pimodel.diagnosis.reference_inverse import StaticInverse, inverse_latency, solve_static
 from pimodel.diagnosis.model import DiagnosedModel
+from pimodel.diagnosis.reference_inverse import StaticInverse, inverse_latency, solve_static
 
 DT = 1e-3
 RADII = [0.0, 0.15, 0.4, 0.7, 1.0]

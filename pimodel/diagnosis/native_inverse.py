@@ -32,11 +32,11 @@ import control
 import numpy as np
 
 from .. import _native
-from ..blocks.framework import BlockSettings, signal_labels, stepped_block
+from ..blocks.framework import signal_labels
 from .limits import MAX_LATENCY, MAX_SECTIONS, NMAX
 from .native_model import _band_gains
 from .rate import RATE_FAMILIES
-from .reference_inverse import StaticInverse, _delay, _filter, inverse_latency
+from .reference_inverse import StaticInverse, _delay, _filter, feedforward_block, inverse_latency
 from .signals import checked_signal
 from .wiener import inverse_sections
 
@@ -299,24 +299,9 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
     >>> res.outputs.round(9).tolist(), blk.latency
     ([0.0, 1.0, 0.0], 0)
     """
-    model = inverse.model
-    dt = model.dt if dt is None else float(dt)
-    if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
-        raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its filter "
-                         "and delay are per sample of that dt)")
-    native = NativeInverse(inverse, input_range, reference_range)
-    defaults = {"input_range": native.input_range, "reference_range": native.reference_range}
-    settings = BlockSettings(name, defaults, lambda s: NativeInverse(inverse, s["input_range"],
-                                                                   s["reference_range"]))
-
-    def step(ni, x, yd, t):
-        return ni.step(x, yd), x
-
-    blk = stepped_block(settings, step, own_state=lambda params: np.zeros(native.nstates),
-                        states=native.labels(), dt=model.dt, name=name, input=input,
-                        output=output, memo=True)
-    blk.latency = native.latency
-    return blk
+    return feedforward_block(inverse, dt, lambda ir, rr: NativeInverse(inverse, ir, rr),
+                             name=name, input=input, output=output, input_range=input_range,
+                             reference_range=reference_range)
 
 
 def inverse_fmu_parameters(inverse, *, input_range: float | None = None,

@@ -55,7 +55,7 @@ from .filters import mode_coefficients
 from .limits import MAX_DELAY, MAX_ELEMENTS, MAX_ORDER, NMAX, SECTION
 from .lti import ELEMENT_K, element_coefficients
 from .rate import RATE_FAMILIES, play_bands, rate_params
-from .signals import checked_signal
+from .signals import block_dt, checked_signal
 from .wiener import ELEMENT_K as WIENER_K
 
 __all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",
@@ -531,10 +531,7 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
     >>> res.outputs.round(3).tolist()
     [0.1, 1.35, 0.35]
     """
-    dt = model.dt if dt is None else float(dt)
-    if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
-        raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its lags, "
-                         "LTI part and delay are per sample of that dt)")
+    block_dt(model, dt, "its lags, LTI part and delay")
     native = NativeModel(model, input_range)
     labels = state_labels(model)
 
