@@ -14,9 +14,9 @@ import time
 
 import numpy as np
 
-from pimodel.diagnosis.inverse_native import NativeInverse
-from pimodel.diagnosis.inverse_stream import _InverseStream
 from pimodel.diagnosis.model import DiagnosedModel
+from pimodel.diagnosis.native_inverse import NativeInverse
+from pimodel.diagnosis.reference_inverse import _InverseStream
 
 EFFECTS = {
     "creep+delay": ("dynamics", "creep", "delay"),

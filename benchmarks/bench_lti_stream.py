@@ -18,7 +18,7 @@ import numpy as np
 
 from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
-from pimodel.diagnosis.stream import stream_simulate
+from pimodel.diagnosis.native_model import stream_simulate
 
 
 def stage(n_plays: int = 80) -> DiagnosedModel:

@@ -59,6 +59,9 @@ MOVED: dict[str, str] = {
     "pimodel.truth_sweep": "pimodel.experiments.stage_sweeps",
     "pimodel.compensation": "pimodel.experiments.compensation",
     "pimodel.demo": "pimodel.experiments.demo",
+    "pimodel.diagnosis.stream": "pimodel.diagnosis.native_model",
+    "pimodel.diagnosis.inverse_native": "pimodel.diagnosis.native_inverse",
+    "pimodel.diagnosis.inverse_stream": "pimodel.diagnosis.reference_inverse",
 }
 
 

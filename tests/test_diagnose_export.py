@@ -58,7 +58,7 @@ def test_export_writes_fmus_equal_to_the_models(records, tmp_path):
 
     from fmpy.validation import validate_fmu
 
-    from pimodel.diagnosis.inverse_native import NativeInverse
+    from pimodel.diagnosis.native_inverse import NativeInverse
     from pimodel.fmu.model_fmu import cosimulate_chain
 
     train, validate, vv = records

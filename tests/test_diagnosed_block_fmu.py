@@ -23,8 +23,8 @@ from fmpy.validation import validate_fmu
 
 from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
+from pimodel.diagnosis.native_model import NativeModel, state_labels, stream_simulate
 from pimodel.diagnosis.rate import STEP_SHARE
-from pimodel.diagnosis.stream import NativeModel, state_labels, stream_simulate
 from pimodel.fmu.block import fmu_block
 from pimodel.fmu.build import source_dir
 from pimodel.fmu.model_fmu import cosimulate_chain
@@ -397,7 +397,7 @@ def test_stream_follows_a_drift_with_a_level_per_record(clock):
     """A drift with a level per record (``drift_variant == "levels"``) without the measured
     output: the level the clock predicts, the trend since the train record's start
     (``drift_term``); the stream and the FMU parameters carry it in the offset."""
-    from pimodel.diagnosis.stream import fmu_parameters
+    from pimodel.diagnosis.native_model import fmu_parameters
 
     p = {"drift_per_s": 0.2, "drift_clock": clock, "drift_variant": "levels",
          "drift_t0_train": 1.0}

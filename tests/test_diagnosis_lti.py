@@ -152,7 +152,7 @@ def test_two_mode_model_exports_to_a_block_and_an_fmu_equal_to_simulate(alt_dyna
 
     from pimodel.blocks import initial_state
     from pimodel.cli.diagnose import export_models
-    from pimodel.diagnosis.stream import stream_simulate
+    from pimodel.diagnosis.native_model import stream_simulate
     from pimodel.fmu.model_fmu import cosimulate_chain
 
     rep, rec = alt_dynamics

@@ -96,7 +96,7 @@ def test_stream_and_inverse_block_run_the_filter():
     """The forward model streams on the C core (tests/test_wiener_stream.py: block and FMU);
     the inverse's block runs the filter's inverse after its solver, one sample later than the
     batch (tests/test_inverse_block.py)."""
-    from pimodel.diagnosis.stream import stream_simulate
+    from pimodel.diagnosis.native_model import stream_simulate
 
     m = _wiener_model([["mode", 800.0, 0.7]])
     v = np.sin(2 * np.pi * 15 * np.arange(500) * 1e-4)

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from pimodel.blocks import initial_state
-from pimodel.diagnosis.inverse_stream import StaticInverse, inverse_latency, solve_static
 from pimodel.diagnosis.model import DiagnosedModel
+from pimodel.diagnosis.reference_inverse import StaticInverse, inverse_latency, solve_static
 
 DT = 1e-3
 RADII = [0.0, 0.15, 0.4, 0.7, 1.0]
@@ -204,7 +204,7 @@ def test_strong_filtered_rate_inverse_stays_bounded(tau):
     solved input's rate fed back to the rate filter made the feedforward diverge (v up to 180
     for inputs within 1.2). With that feedback capped at RATE_FEEDBACK_CAP times the fresh
     rate it stays within the span of the input that made the reference."""
-    from pimodel.diagnosis.inverse_stream import RATE_FEEDBACK_CAP
+    from pimodel.diagnosis.reference_inverse import RATE_FEEDBACK_CAP
 
     assert RATE_FEEDBACK_CAP == 2.0
     m = DiagnosedModel([0.0, 0.1, 0.3, 0.6, 0.9, 1.2], [0.9, 0.35, 0.3, 0.2, 0.15, 0.1], 0.05,

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
-from pimodel.diagnosis.inverse_native import NativeInverse
-from pimodel.diagnosis.stream import stream_simulate
+from pimodel.diagnosis.native_inverse import NativeInverse
+from pimodel.diagnosis.native_model import stream_simulate
 from pimodel.fmu.model_fmu import cosimulate_chain
 from pimodel.fmu.operators import unit_parameters
 from pimodel.fmu.unit import FMUUnit

@@ -1,6 +1,8 @@
 """The C feedforward (fmu/src/pim_diag_inverse.c, ``NativeInverse``) equals the Python stream of
-``DiagnosedInverse.block()`` (``inverse_stream._InverseStream``, output and whole state) and the
-batch ``DiagnosedInverse.simulate`` delayed by the latency, to 1e-9: each static effect alone and
+the NumPy reference stream (``reference_inverse._InverseStream``, output and whole state), the
+block ``DiagnosedInverse.block()`` (stepped on C) equals the reference block, and the batch
+``DiagnosedInverse.simulate`` (its solver on C) equals the reference batch (NumPy solver) and
+the stream delayed by the latency, to 1e-9: each static effect alone and
 together, dynamics with a further element, whole and fractional delays, a folding model (the
 monotone projection), a start from the unknown memory, and models diagnosed on records of
 ``pimodel.stages.pi_stage`` and ``pimodel.stages.preisach_stage``.
@@ -13,15 +15,18 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import control
 import numpy as np
 import pytest
 
-import pimodel.diagnosis.inverse_stream as inverse_stream
+import pimodel.diagnosis.model as model_module
+import pimodel.diagnosis.reference_inverse as reference_inverse
+from pimodel.blocks import initial_state
 from pimodel.diagnosis import diagnose
-from pimodel.diagnosis.inverse_native import NativeInverse, inverse_fmu_parameters
-from pimodel.diagnosis.inverse_stream import _InverseStream, inverse_latency
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.monotone import is_monotone
+from pimodel.diagnosis.native_inverse import NativeInverse, inverse_fmu_parameters
+from pimodel.diagnosis.reference_inverse import _InverseStream, inverse_latency
 from pimodel.records import Record
 from pimodel.stages.pi_stage import excitation, random_truth
 from pimodel.stages.preisach_stage import excitations, random_alt_truth
@@ -100,7 +105,7 @@ def single_roots(monkeypatch):
     farther from the branch guess the second nearest root lies than the nearest (inf for one
     root; roots within 1e-7 count as one)."""
     margins, guesses = [], []
-    roots, step = inverse_stream._roots, inverse_stream.StaticInverse.step
+    roots, step = reference_inverse._roots, reference_inverse.StaticInverse.step
 
     def spy_step(self, x, yk):
         guesses.append(float(x[2]))
@@ -116,8 +121,8 @@ def single_roots(monkeypatch):
         margins.append(float(far[0] - dist[0]) if far.size else np.inf)
         return out
 
-    monkeypatch.setattr(inverse_stream, "_roots", spy)
-    monkeypatch.setattr(inverse_stream.StaticInverse, "step", spy_step)
+    monkeypatch.setattr(reference_inverse, "_roots", spy)
+    monkeypatch.setattr(reference_inverse.StaticInverse, "step", spy_step)
     return margins
 
 
@@ -126,6 +131,14 @@ def python_stream(m, y_d, reference_range):
     x = np.zeros(stream.size)
     v = np.array([stream.step(x, float(y)) for y in y_d])
     return v, x
+
+
+def reference_simulate(inv, y_d, **kwargs):
+    """``DiagnosedInverse.simulate`` with the NumPy solver (``reference_inverse.solve_static``)
+    in place of the C core."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(model_module, "_solve_static", reference_inverse.solve_static)
+        return inv.simulate(y_d, **kwargs)
 
 
 def assert_equal_to_python(inv, y_d, spreads, reference_range=None):
@@ -139,6 +152,7 @@ def assert_equal_to_python(inv, y_d, spreads, reference_range=None):
     assert np.max(np.abs(x - x_want)) < 1e-9  # the same state layout and values
     assert np.array_equal(native.run(y_d), got)
     batch = inv.simulate(y_d)
+    assert np.max(np.abs(batch - reference_simulate(inv, y_d))) < 1e-9
     a = native.latency
     assert a == inverse_latency(m)
     assert np.max(np.abs(got[a:] - batch[:y_d.size - a])) < 1e-9
@@ -182,6 +196,7 @@ def test_unknown_start_memory_equals_simulate_unknown(case):
     native = NativeInverse(inv)
     got = native.run(y_d, z0=z0)
     want = inv.simulate(y_d, initial_state="unknown")
+    assert np.max(np.abs(want - reference_simulate(inv, y_d, initial_state="unknown"))) < 1e-9
     a = native.latency
     assert np.max(np.abs(got[a:] - want[:y_d.size - a])) < 1e-9
     assert np.max(np.abs(got - native.run(y_d))) > 0.01  # the start memory matters
@@ -223,8 +238,34 @@ def test_c_step_equals_python_on_diagnosed_models(generator, effect, seed, singl
     assert np.max(np.abs(got - want)) < 1e-9
     if m.initial_state == "rest":
         batch = inv.simulate(y_d)
+        assert np.max(np.abs(batch - reference_simulate(inv, y_d))) < 1e-9
         a = native.latency
         assert np.max(np.abs(got[a:] - batch[:y_d.size - a])) < 1e-9
+
+
+@pytest.mark.parametrize("case", ["nominal", "static_all", "all", "wiener_two_delay_creep"])
+def test_block_on_c_equals_the_reference_block(case, single_roots):
+    """``DiagnosedInverse.block()`` steps ``NativeInverse``; the NumPy reference block
+    (``reference_inverse.inverse_block``) gives the same outputs, states and labels."""
+    effects, extra = CASES[case]
+    m = model(effects, **extra)
+    y_d = reference(m, n=300)
+    inv = m.inverse()
+    rr = float(np.ptp(inv.prefilter(y_d)))
+    blk = inv.block(reference_range=rr)
+    ref = reference_inverse.inverse_block(inv, reference_range=rr)
+    assert blk.state_labels == ref.state_labels == NativeInverse(inv).labels()
+    assert blk.latency == ref.latency == inverse_latency(m)
+    assert blk.params == ref.params
+    t = np.arange(y_d.size) * DT
+    got = control.input_output_response(blk, t, y_d, initial_state=initial_state(blk),
+                                        return_x=True)
+    want = control.input_output_response(ref, t, y_d, initial_state=initial_state(ref),
+                                         return_x=True)
+    assert min(single_roots) > 1e-6
+    assert np.max(np.abs(got.outputs - want.outputs)) < 1e-9
+    assert np.max(np.abs(got.states - want.states)) < 1e-9
+    assert np.ptp(want.outputs) > 0.5
 
 
 def test_errors():

@@ -24,7 +24,7 @@ from fmpy.validation import validate_fmu
 
 from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
-from pimodel.diagnosis.stream import (
+from pimodel.diagnosis.native_model import (
     MAX_ELEMENTS,
     NativeModel,
     element_sections,
@@ -223,3 +223,35 @@ def test_block_of_a_model_with_report_parameters():
     blk = m.block()
     res = control.input_output_response(blk, t, v, initial_state=initial_state(blk))
     assert np.max(np.abs(res.outputs - m.simulate(v, t))) < 1e-12
+
+
+def test_diagnosis_limits_are_the_c_cores():
+    """The C limits the diagnosis checks first (one place, pimodel.diagnosis.limits) are those
+    of the C headers and of the FMU builder."""
+    from pimodel.diagnosis import limits
+    from pimodel.fmu.build import MAX_LTI_ELEMENTS, NMAX
+
+    def define(header, name):
+        text = (source_dir() / header).read_text()
+        return int(re.search(rf"#define {name} (\d+)", text).group(1))
+
+    assert limits.NMAX == NMAX and limits.MAX_ELEMENTS == MAX_LTI_ELEMENTS
+    assert limits.MAX_ELEMENTS == define("pim_diagnosed.h", "PIM_DIAG_MAX_ELEMENTS")
+    assert limits.MAX_DELAY == define("pim_diagnosed.h", "PIM_DIAG_MAX_DELAY") - 2
+    assert limits.MAX_ORDER == define("pim_diagnosed.h", "PIM_DIAG_MAX_ORDER")
+    assert limits.SECTION == define("pim_diagnosed.h", "PIM_DIAG_SECTION")
+    assert limits.MAX_SECTIONS == define("pim_diag_inverse.h", "PIM_DINV_MAX_SECTIONS")
+    assert limits.MAX_LATENCY == define("pim_diag_inverse.h", "PIM_DINV_MAX_LATENCY")
+
+
+@pytest.mark.parametrize(("old", "new"), [
+    ("pimodel.diagnosis.stream", "pimodel.diagnosis.native_model"),
+    ("pimodel.diagnosis.inverse_native", "pimodel.diagnosis.native_inverse"),
+    ("pimodel.diagnosis.inverse_stream", "pimodel.diagnosis.reference_inverse")])
+def test_old_diagnosis_module_paths_warn_and_are_the_new_modules(old, new):
+    import importlib
+
+    sys.modules.pop(old, None)
+    with pytest.warns(DeprecationWarning, match=f"import {new} instead"):
+        module = importlib.import_module(old)
+    assert module is importlib.import_module(new)

@@ -23,7 +23,7 @@ from fmpy.validation import validate_fmu
 
 from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
-from pimodel.diagnosis.stream import (
+from pimodel.diagnosis.native_model import (
     NativeModel,
     fmu_parameters,
     prefilter_sections,

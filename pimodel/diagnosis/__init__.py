@@ -4,30 +4,33 @@
 where the validate residual lies, and adds candidate effects (creep, dynamics, delay,
 asymmetry, drift, rate) while each lowers the Bayesian information criterion (BIC) on the
 validate records by a clear margin;
-it returns a :class:`DiagnosisReport`. The submodules:
+it returns a :class:`DiagnosisReport`. The model it chose (:meth:`DiagnosisReport.model`) has its
+blocks and FMU units on the C core; the NumPy forms stay as references that tests hold equal.
 
-- :mod:`pimodel.diagnosis.diagnose`: :func:`diagnose` and :class:`DiagnosisReport`;
-- :mod:`pimodel.diagnosis.effects`: the records as segments, the nominal model and the
-  candidate effects, each fitted jointly with the hysteresis weights;
-- :mod:`pimodel.diagnosis.rate`: the ``rate`` candidate's columns (play radii and weights
-  growing with a low-passed input rate, to first order);
-- :mod:`pimodel.diagnosis.lti`: the linear part of the ``dynamics`` candidate (modes, a
-  low-pass, a direct term), its order chosen by the train BIC, and its approximate inverse;
-- :mod:`pimodel.diagnosis.wiener`: the ``dynamics`` candidate with a filter before the
-  hysteresis (a Wiener model: a driver's low-pass or a mode on the input);
-- :mod:`pimodel.diagnosis.delaylike`: whether a fitted ``dynamics`` acts as a pure delay (the
-  tie-break between the names ``dynamics`` and ``delay``);
-- :mod:`pimodel.diagnosis.noise`: the measurement-noise floor of the records;
-- :mod:`pimodel.diagnosis.where`: the regions, bands and correlations of the residual;
-- :mod:`pimodel.diagnosis.plots`: the figures of a report;
-- :mod:`pimodel.diagnosis.model`: :class:`~pimodel.diagnosis.model.DiagnosedModel`, the model a
-  report chose (:meth:`DiagnosisReport.model`), with its causal feedforward inverse;
-- :mod:`pimodel.diagnosis.stream`: that model streamed sample by sample on the C core, as a
-  python-control block and as the DiagnosedModel FMU unit's values;
-- :mod:`pimodel.diagnosis.inverse_stream`: the model's feedforward inverse as a causal
-  python-control block;
-- :mod:`pimodel.diagnosis.feedforward`: open-loop feedforward with such a model, tried on a
-  simulated true stage.
+Modules
+-------
+
+::
+
+    diagnose            diagnose() and the DiagnosisReport
+    effects             records as segments, the nominal model, the candidate effects' fits
+    filters             the discrete filters effects are built of: lag, mode, delay shift
+    rate                the rate candidate's columns (radii or weights growing with the rate)
+    drift               the drift candidate: clocks, levels per record, its term
+    lti                 the dynamics' linear part: elements, order by BIC, approximate inverse
+    wiener              the dynamics as a filter before the hysteresis (a Wiener model)
+    delaylike           whether a fitted dynamics acts as a pure delay
+    noise               the measurement-noise floor of the records
+    where               regions, bands and correlations of the residual
+    plots               the figures of a report
+    model               DiagnosedModel and DiagnosedInverse: the chosen model, batch forms
+    monotone            the nearest monotone PI weights (what the inverse solves)
+    native_model        the model streamed on the C core: its block, runner and FMU values
+    native_inverse      the causal feedforward on the C core: its block, runner and FMU values
+    reference_inverse   the feedforward's NumPy reference: per-sample solver and block
+    limits              the C core's limits the native forms respect
+    signals             the check of the signals the model and its runners take
+    feedforward         open-loop feedforward with a model, tried on a simulated stage
 
 Examples
 --------

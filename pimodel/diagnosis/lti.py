@@ -46,6 +46,7 @@ from scipy.signal import (
 )
 
 from .._native import biquad_rows
+from .filters import mode_coefficients
 
 __all__ = [
     "MAX_MODES",
@@ -151,11 +152,6 @@ def element_coefficients(element: Sequence, dt: float) -> tuple[np.ndarray, np.n
     if kind == "lowpass":
         a1 = np.exp(-dt / float(element[1]))
         return np.array([0.0, 1.0 - a1]), np.array([1.0, -a1])
-    from .effects import (
-        mode_coefficients,  # the base mode's ZOH (closed form); lazy: effects
-    )
-    # imports this module
-
     return mode_coefficients(float(element[1]), float(element[2]), dt)
 
 

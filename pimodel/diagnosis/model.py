@@ -21,7 +21,7 @@ delay alone. ``E_j`` are the further modes, low-pass and direct term of the line
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
 ``a = exp(-dt / tau)``. This class evaluates exactly that form, so :meth:`simulate` equals the
 diagnosis' own prediction. The same form, streamed sample by sample on the C core
-(:mod:`.stream`), is the python-control block (:meth:`DiagnosedModel.block`) and the
+(:mod:`.native_model`), is the python-control block (:meth:`DiagnosedModel.block`) and the
 DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
 :meth:`simulate` to 1e-12.
 
@@ -92,11 +92,14 @@ from scipy.optimize import brentq
 
 from ..operators.pi import PIOperator
 from .drift import drift_term
-from .effects import lag, mode, shift
-from .inverse_stream import inverse_block, solve_static
+from .filters import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
 from .monotone import monotone_model
+from .native_inverse import NativeInverse, inverse_block
+from .native_model import diagnosed_block
 from .rate import rate_columns, rate_params
+from .reference_inverse import solve_static
+from .signals import checked_signal
 from .wiener import inverse_prefilter, prefilter
 
 if TYPE_CHECKING:
@@ -252,7 +255,7 @@ class DiagnosedModel:
         >>> m.simulate([0.0, 1.0, 0.0]).round(3).tolist()
         [0.1, 1.35, 0.35]
         """
-        v = _signal(v, "v")
+        v = checked_signal(v, "v")
         tk = self._clock(v, t)
         p, e = self.params, self.effects
         Z = PIOperator(np.ones(self.radii.size), self.radii).play_outputs(v)
@@ -284,7 +287,7 @@ class DiagnosedModel:
                              tau, family, gains.size, input_range=input_range)
             y = y + R @ gains
         if "drift" in e:
-            y_meas = None if measured is None else _signal(measured, "measured")
+            y_meas = None if measured is None else checked_signal(measured, "measured")
             if y_meas is not None and y_meas.shape != v.shape:
                 raise ValueError(f"measured: expected {v.size} samples like v, got "
                                  f"{y_meas.shape}")
@@ -310,7 +313,7 @@ class DiagnosedModel:
     def block(self, dt: float | None = None, *, name: str = "diagnosed", input: str = "v",
               output: str = "y", input_range: float | None = None
               ) -> control.NonlinearIOSystem:
-        """The model as a discrete python-control block (C core step, :mod:`.stream`).
+        """The model as a discrete python-control block (C core step, :mod:`.native_model`).
 
         Every forward form streams, a Wiener model (``dynamics_position == "before"``) too:
         its filter runs as sections in series on ``v`` before a second set of plays, as
@@ -330,8 +333,8 @@ class DiagnosedModel:
         -------
         control.NonlinearIOSystem
             ``y[k]`` from ``v[k]`` (direct feedthrough), states
-            :func:`~pimodel.diagnosis.stream.state_labels`, all zero at the start; a drift term
-            reads python-control's time ``t``.
+            :func:`~pimodel.diagnosis.native_model.state_labels`, all zero at the start; a drift
+            term reads python-control's time ``t``.
 
         Raises
         ------
@@ -350,8 +353,6 @@ class DiagnosedModel:
         >>> bool(np.allclose(res.outputs, m.simulate([0.0, 1.0, 0.0]), rtol=0, atol=1e-12))
         True
         """
-        from .stream import diagnosed_block
-
         return diagnosed_block(self, dt, name=name, input=input, output=output,
                                input_range=input_range)
 
@@ -444,7 +445,7 @@ class DiagnosedModel:
         partial sums) and the offset as an affine output envelope, equal to :meth:`simulate`. The
         diagnosis fits the effects in parallel to the hysteresis (module docstring), which no chain
         of the operator FMUs reproduces; the DiagnosedModel FMU unit runs any model
-        (:func:`pimodel.diagnosis.stream.fmu_parameters`).
+        (:func:`pimodel.diagnosis.native_model.fmu_parameters`).
 
         Returns
         -------
@@ -525,13 +526,6 @@ def load_diagnosed_model(path) -> DiagnosedModel:
         return DiagnosedModel.from_dict(json.loads(p.read_text()))
     except (ValueError, json.JSONDecodeError) as err:
         raise ValueError(f"{p}: {err}") from None
-
-
-def _signal(x, name: str) -> np.ndarray:
-    a = np.asarray(x, float)
-    if a.ndim != 1 or a.size < 2 or not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}: expected a finite 1-D signal of at least 2 samples")
-    return a
 
 
 class DiagnosedInverse:
@@ -703,7 +697,7 @@ class DiagnosedInverse:
         >>> m.inverse().simulate([0.0, 0.6], initial_state="unknown").round(6).tolist()
         [0.0, 0.5]
         """
-        yd = _signal(y_d, "y_d")
+        yd = checked_signal(y_d, "y_d")
         self.model._clock(yd, t)
         state = self.model.initial_state if initial_state is None else initial_state
         if state not in INITIAL_STATES:
@@ -711,7 +705,7 @@ class DiagnosedInverse:
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
         x = self.prefilter(yd)
         z0 = self.initial_memory(x[0]) if state == "unknown" else None
-        x = solve_static(self.model.static_part(), x, rng, z0)
+        x = _solve_static(self.model.static_part(), x, rng, z0)
         if self.model.dynamics_before:  # the filter's output -> its input (approximate)
             return inverse_prefilter(x, self.model.params["wiener_elements"], self.model.dt)
         return x
@@ -724,7 +718,7 @@ class DiagnosedInverse:
         :meth:`simulate` reads the reference ahead (one sample for the dynamics' approximate
         inverse, after the hysteresis or before it, ``d`` for a delay); the block cannot, so it
         delays ``v`` instead by ``A = block.latency`` samples
-        (:func:`~pimodel.diagnosis.inverse_stream.inverse_latency`, 0 without dynamics and
+        (:func:`~pimodel.diagnosis.reference_inverse.inverse_latency`, 0 without dynamics and
         delay): fed ``y_d[0..k]`` it outputs ``v[k] = simulate(y_d)[k -
         A]`` for ``k >= A`` and the inverse of ``y_d[0]`` at rest before. A model driven by it
         follows ``y_d[k - A]`` (for a reference at rest over its first ``A + 1`` samples,
@@ -772,6 +766,17 @@ class DiagnosedInverse:
         """
         return inverse_block(self, dt, name=name, input=input, output=output,
                              input_range=input_range, reference_range=reference_range)
+
+
+def _solve_static(static: DiagnosedModel, x: np.ndarray, input_range: float, z0) -> np.ndarray:
+    """:func:`.reference_inverse.solve_static` on the C core (equal to 1e-9,
+    ``tests/test_inverse_native.py``); the NumPy reference for a model the C core does not
+    take (more than 128 plays or 64 creep lags)."""
+    try:
+        native = NativeInverse(DiagnosedInverse(static), input_range, float(np.ptp(x)))
+    except ValueError:  # the reference raises its own errors, or runs what C does not take
+        return solve_static(static, x, input_range, z0)
+    return native.run(x, z0)
 
 
 def _advance(x, d):

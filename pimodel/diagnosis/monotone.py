@@ -7,7 +7,7 @@ last reversal the plays with ``2 r_i < l`` move and the branch's slope is ``S_m`
 ``m = #{i: 2 r_i < l}``; within one sample the slope of ``y[k]``
 in ``v[k]`` is such a partial sum too (the moving plays are always the smallest radii). A
 partial sum ``S_m <= 0`` makes the branch turn back (fold): the per-sample root of
-:func:`pimodel.diagnosis.inverse_stream.solve_static` then vanishes where the branch folds, and
+:func:`pimodel.diagnosis.reference_inverse.solve_static` then vanishes where the branch folds, and
 the inverse jumps to a far root (on the shared real record: 14.8 V in one sample, where the
 reference input moves 0.19 V).
 
@@ -37,12 +37,8 @@ A model whose partial sums are all positive is returned unchanged, so the invers
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from .model import DiagnosedModel
 
 __all__ = [
     "FLOOR_SHARE",
@@ -173,7 +169,7 @@ def monotone_error(weights, projected, radii) -> float:
     return float(np.max(np.abs(d))) if d.size else 0.0
 
 
-def monotone_model(model: DiagnosedModel) -> DiagnosedModel:
+def monotone_model(model):
     """The model with its hysteresis weights made monotone, where that makes it invertible.
 
     Parameters

@@ -377,7 +377,8 @@ def inverse_sections(elements: Sequence, dt: float) -> np.ndarray | None:
     numpy.ndarray or None
         ``sos`` of shape ``(s, 6)`` (:func:`scipy.signal.sosfilt` form), static gain 1: what
         :func:`inverse_prefilter` runs and the inverse block
-        (:mod:`~pimodel.diagnosis.inverse_stream`) steps through.
+        (:mod:`~pimodel.diagnosis.native_inverse`, its reference
+        :mod:`~pimodel.diagnosis.reference_inverse`) steps through.
 
     Raises
     ------

@@ -86,13 +86,13 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
     from ..diagnosis.model import DiagnosedInverse, DiagnosedModel
 
     if isinstance(op, DiagnosedModel):
-        from ..diagnosis.stream import fmu_parameters
+        from ..diagnosis.native_model import fmu_parameters
 
         if Ts is not None and Ts != op.dt:
             raise ValueError(f"Ts: {Ts!r} differs from the model's dt = {op.dt!r}")
         return fmu_parameters(op)
     if isinstance(op, DiagnosedInverse):
-        from ..diagnosis.inverse_native import inverse_fmu_parameters
+        from ..diagnosis.native_inverse import inverse_fmu_parameters
 
         if Ts is not None and Ts != op.model.dt:
             raise ValueError(f"Ts: {Ts!r} differs from the model's dt = {op.model.dt!r}")

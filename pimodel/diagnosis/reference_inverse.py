@@ -1,5 +1,9 @@
-"""The feedforward of a :class:`~pimodel.diagnosis.model.DiagnosedInverse` as a causal
-python-control block (``DiagnosedInverse.block``).
+"""The NumPy reference of a :class:`~pimodel.diagnosis.model.DiagnosedInverse`'s causal
+feedforward: the per-sample solver of the static part (:class:`StaticInverse`, which
+:meth:`DiagnosedInverse.simulate` steps over the record, :func:`solve_static`) and the causal
+python-control block around it (:func:`inverse_block`). :meth:`DiagnosedInverse.block` returns
+the same block stepped on the C core (:func:`pimodel.diagnosis.native_inverse.inverse_block`);
+``tests/test_inverse_native.py`` holds the two equal to 1e-9, output and whole state.
 
 ``DiagnosedInverse.simulate`` is not causal when the model has dynamics or a delay: its
 prefilter reads the reference ahead, by one sample for the zero-order hold of the dynamics'
@@ -44,9 +48,11 @@ from ..blocks.framework import BlockSettings, signal_labels, stepped_block
 from .lti import inverse_sos
 from .monotone import monotone_model
 from .rate import STEP_SHARE, play_bands, rate_params
+from .signals import block_dt
 from .wiener import inverse_sections
 
-__all__ = ["StaticInverse", "inverse_block", "inverse_latency", "solve_static"]
+__all__ = ["StaticInverse", "feedforward_block", "inverse_block", "inverse_latency",
+           "solve_static"]
 
 RATE_FEEDBACK_CAP = 2.0  # the solved input's rate fed back: at most this times the fresh rate
 
@@ -409,6 +415,8 @@ class _InverseStream:
 
     def __init__(self, model, input_range, reference_range):
         self.solver = StaticInverse(model, input_range, reference_range)
+        self.input_range = self.solver.input_range
+        self.reference_range = 0.0 if reference_range is None else float(reference_range)
         self.sos, _ = _filter(model)
         self.zi = None if self.sos is None else sosfilt_zi(self.sos)
         self.ns = 0 if self.sos is None else self.sos.shape[0]
@@ -458,7 +466,8 @@ class _InverseStream:
 def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
                   input: str = "y_d", output: str = "v", input_range: float | None = None,
                   reference_range: float | None = None) -> control.NonlinearIOSystem:
-    """The causal feedforward as a discrete python-control block (module docstring).
+    """The causal feedforward as a discrete python-control block, stepped in NumPy (the
+    reference of :func:`pimodel.diagnosis.native_inverse.inverse_block`; module docstring).
 
     Parameters
     ----------
@@ -498,22 +507,64 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
     >>> res.outputs.round(9).tolist(), blk.latency
     ([0.0, 1.0, 0.0], 0)
     """
-    model = inverse.model
-    dt = model.dt if dt is None else float(dt)
-    if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
-        raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its filter "
-                         "and delay are per sample of that dt)")
-    stream = _InverseStream(model, input_range, reference_range)
-    defaults = {"input_range": stream.solver.input_range,
-                "reference_range": 0.0 if reference_range is None else float(reference_range)}
-    settings = BlockSettings(name, defaults, lambda s: _InverseStream(model, s["input_range"],
-                                                                  s["reference_range"]))
+    return feedforward_block(inverse, dt, lambda ir, rr: _InverseStream(inverse.model, ir, rr),
+                             name=name, input=input, output=output, input_range=input_range,
+                             reference_range=reference_range)
 
-    def step(inv, x, yd, t):
-        return inv.step(x, yd), x
 
-    blk = stepped_block(settings, step, own_state=lambda params: np.zeros(stream.size),
-                         states=stream.labels(), dt=model.dt, name=name, input=input,
-                         output=output, memo=True)
-    blk.latency = stream.latency
+def feedforward_block(inverse, dt: float | None, make, *, name: str, input: str, output: str,
+                      input_range: float | None, reference_range: float | None
+                      ) -> control.NonlinearIOSystem:
+    """The python-control block around a feedforward runner, NumPy or C.
+
+    Parameters
+    ----------
+    inverse : DiagnosedInverse
+        The inverse.
+    dt : float or None
+        Sample time [s]; must be the model's ``dt`` (None: the model's).
+    make : callable
+        ``make(input_range, reference_range)`` builds the runner (this module's per-sample
+        stream, or :class:`~pimodel.diagnosis.native_inverse.NativeInverse`): ``step(x,
+        y_d)`` (``x`` advances in place), ``labels()``, ``latency``, ``input_range``,
+        ``reference_range``.
+    name, input, output : str
+        Block name (params prefix) and signal names.
+    input_range, reference_range : float or None
+        The runner's defaults (the block's params ``"<name>.input_range"``,
+        ``"<name>.reference_range"``).
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        States ``labels()``, initial state all zeros, attribute ``latency``.
+
+    Raises
+    ------
+    ValueError
+        ``dt`` other than the model's, or what ``make`` raises.
+
+    Examples
+    --------
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> inv = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3).inverse()
+    >>> blk = feedforward_block(inv, None, lambda ir, rr: _InverseStream(inv.model, ir, rr),
+    ...                         name="ff", input="y_d", output="v", input_range=None,
+    ...                         reference_range=None)
+    >>> blk.latency, blk.nstates
+    (0, 9)
+    """
+    dt = block_dt(inverse.model, dt, "its filter and delay")
+    runner = make(input_range, reference_range)
+    defaults = {"input_range": runner.input_range, "reference_range": runner.reference_range}
+    settings = BlockSettings(name, defaults, lambda s: make(s["input_range"],
+                                                            s["reference_range"]))
+    labels = runner.labels()
+
+    def step(ff, x, yd, t):
+        return ff.step(x, yd), x
+
+    blk = stepped_block(settings, step, own_state=lambda params: np.zeros(len(labels)),
+                        states=labels, dt=dt, name=name, input=input, output=output, memo=True)
+    blk.latency = runner.latency
     return blk

@@ -25,7 +25,7 @@ Two things ``simulate`` takes from the whole record are parameters here:
 
 The dynamics is an LTI part ``b(z^-1) / a(z^-1)`` (``a[0] = 1``): the model's
 ``params["lti_b"]``, ``params["lti_a"]`` when given, else the unit-gain mode
-(:func:`~pimodel.diagnosis.effects.mode_coefficients` of ``mode_hz``, ``mode_damping``). Its
+(:func:`~pimodel.diagnosis.filters.mode_coefficients` of ``mode_hz``, ``mode_damping``). Its
 further elements (``params["lti_elements"]``, ``params["lti_gains"]``, :mod:`.lti`: a higher
 order chosen by the diagnosis, zeros from the parallel gains) run as second-order sections on
 ``h0``: ``sum_j g_j (E_j - M_1)[h0]``, each started at rest around ``h0[0]``, added to the
@@ -51,19 +51,16 @@ import numpy as np
 
 from .. import _native
 from ..blocks.framework import BlockSettings, signal_labels, stepped_block
-from ..fmu.build import MAX_LTI_ELEMENTS as MAX_ELEMENTS
-from ..fmu.build import NMAX
-from .effects import mode_coefficients
+from .filters import mode_coefficients
+from .limits import MAX_DELAY, MAX_ELEMENTS, MAX_ORDER, NMAX, SECTION
 from .lti import ELEMENT_K, element_coefficients
 from .rate import RATE_FAMILIES, play_bands, rate_params
+from .signals import block_dt, checked_signal
 from .wiener import ELEMENT_K as WIENER_K
 
 __all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",
            "prefilter_sections", "state_labels", "stream_simulate"]
 
-MAX_DELAY = 4094  # samples: PIM_DIAG_MAX_DELAY - 2 (fmu/src/pim_diagnosed.h)
-MAX_ORDER = 63  # LTI order: PIM_DIAG_MAX_ORDER
-SECTION = 3  # coefficients per section of a further element: PIM_DIAG_SECTION
 CLOCKS = {"record": 1, "absolute": 2}
 
 
@@ -426,9 +423,7 @@ def stream_simulate(model, v, t=None, *, input_range: float | None = None) -> np
     >>> stream_simulate(m, [0.0, 1.0, 0.0]).round(3).tolist()
     [0.1, 1.35, 0.35]
     """
-    from .model import _signal
-
-    v = _signal(v, "v")
+    v = checked_signal(v, "v")
     tk = model._clock(v, t)
     return NativeModel(model, input_range).run(v, tk)
 
@@ -536,10 +531,7 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
     >>> res.outputs.round(3).tolist()
     [0.1, 1.35, 0.35]
     """
-    dt = model.dt if dt is None else float(dt)
-    if not math.isclose(dt, model.dt, rel_tol=1e-12, abs_tol=0.0):
-        raise ValueError(f"dt: {dt!r} differs from the model's dt = {model.dt!r} (its lags, "
-                         "LTI part and delay are per sample of that dt)")
+    block_dt(model, dt, "its lags, LTI part and delay")
     native = NativeModel(model, input_range)
     labels = state_labels(model)
 

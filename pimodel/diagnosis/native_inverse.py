@@ -1,17 +1,20 @@
 """A :class:`~pimodel.diagnosis.model.DiagnosedInverse`'s causal feedforward on the C core
-(``fmu/src/pim_diag_inverse.c``): the runner :class:`NativeInverse` and the values of the
-DiagnosedInverse FMU unit (:func:`inverse_fmu_parameters`).
+(``fmu/src/pim_diag_inverse.c``): the python-control block (:func:`inverse_block`, what
+:meth:`DiagnosedInverse.block` returns), the runner :class:`NativeInverse` and the values of the
+DiagnosedInverse FMU unit (:func:`inverse_fmu_parameters`), so that the block, the runner and
+the FMU are one implementation.
 
-It runs what :func:`~pimodel.diagnosis.inverse_stream.inverse_block` runs in Python (the
-``_InverseStream`` sample), so ``tests/test_inverse_native.py`` holds the two equal to 1e-9:
-fed ``y_d[0..k]``, it outputs ``v[k] = DiagnosedInverse.simulate(y_d)[k - A]`` for ``k >= A``
-(``A`` = :func:`~pimodel.diagnosis.inverse_stream.inverse_latency`: the dynamics' one-sample
-advance and the delay's whole samples, one more for a fractional delay) and ``v_rest``, the
-inverse of ``y_d[0]`` from the initial state, before. Per sample: the prefilter's second-order
-sections (:func:`~pimodel.diagnosis.lti.inverse_sos`, at rest around ``y_d[0]``), the delay's
-fractional interpolation, and the exact root of the static part (creep, asymmetry, rate with
-the fresh rate of a nested rate-free solve), on the model's nearest monotone weights
-(:mod:`.monotone`); the semantics in ``fmu/src/pim_diag_inverse.h``.
+It runs what the NumPy reference :func:`~pimodel.diagnosis.reference_inverse.inverse_block`
+runs (the ``_InverseStream`` sample), so ``tests/test_inverse_native.py`` holds the two equal
+to 1e-9, output and whole state: fed ``y_d[0..k]``, it outputs ``v[k] =
+DiagnosedInverse.simulate(y_d)[k - A]`` for ``k >= A`` (``A`` =
+:func:`~pimodel.diagnosis.reference_inverse.inverse_latency`: the dynamics' one-sample advance
+and the delay's whole samples, one more for a fractional delay) and ``v_rest``, the inverse of
+``y_d[0]`` from the initial state, before. Per sample: the prefilter's second-order sections
+(:func:`~pimodel.diagnosis.lti.inverse_sos`, at rest around ``y_d[0]``), the delay's fractional
+interpolation, and the exact root of the static part (creep, asymmetry, rate with the fresh
+rate of a nested rate-free solve), on the model's nearest monotone weights (:mod:`.monotone`);
+the semantics in ``fmu/src/pim_diag_inverse.h``.
 
 Parameters computed here and passed to C: the projected weights, the sections, the latency,
 the delay's fraction and the root rule's scale ``reference_range``. A model with the filter
@@ -25,19 +28,19 @@ from __future__ import annotations
 
 import math
 
+import control
 import numpy as np
 
 from .. import _native
-from ..fmu.build import NMAX
-from .inverse_stream import StaticInverse, _delay, _filter, inverse_latency
+from ..blocks.framework import signal_labels
+from .limits import MAX_LATENCY, MAX_SECTIONS, NMAX
+from .native_model import _band_gains
 from .rate import RATE_FAMILIES
-from .stream import _band_gains
+from .reference_inverse import StaticInverse, _delay, _filter, feedforward_block, inverse_latency
+from .signals import checked_signal
 from .wiener import inverse_sections
 
-__all__ = ["NativeInverse", "inverse_fmu_parameters"]
-
-MAX_SECTIONS = 32  # PIM_DINV_MAX_SECTIONS (fmu/src/pim_diag_inverse.h)
-MAX_LATENCY = 1_000_000  # PIM_DINV_MAX_LATENCY
+__all__ = ["NativeInverse", "inverse_block", "inverse_fmu_parameters"]
 
 
 class NativeInverse:
@@ -50,7 +53,7 @@ class NativeInverse:
     input_range : float, optional
         Range of the rate effect's step rule; default ``2 r_n`` (as ``simulate``).
     reference_range : float, optional
-        The root rule's scale (:class:`~pimodel.diagnosis.inverse_stream.StaticInverse`);
+        The root rule's scale (:class:`~pimodel.diagnosis.reference_inverse.StaticInverse`);
         ``simulate`` uses ``ptp(inverse.prefilter(y_d))``; default 0.
 
     Raises
@@ -124,6 +127,29 @@ class NativeInverse:
             raise ValueError(f"model: {msg}")
         self.params, self.n = d, n
         self.nstates = _native.inverse_state_size(d)
+        self._solver_labels = solver.labels()
+
+    def labels(self) -> list[str]:
+        """Names of the state values (the layout of the reference stream's state).
+
+        Returns
+        -------
+        list of str
+            ``started``, ``seen`` (samples seen while the latency fills), ``v_rest``,
+            ``F_prev`` (the last prefiltered sample), ``f[1..2 ns]`` (prefilter sections),
+            ``g[1..2 np]`` (a Wiener model's post sections) and ``solver.*``
+            (:meth:`~pimodel.diagnosis.reference_inverse.StaticInverse.labels`).
+
+        Examples
+        --------
+        >>> from pimodel.diagnosis.model import DiagnosedModel
+        >>> ni = NativeInverse(DiagnosedModel([0.0], [1.0], 0.0, dt=1e-3).inverse())
+        >>> ni.labels()[4:], len(ni.labels()) == ni.nstates
+        (['solver.started', 'solver.v_prev', 'solver.guess', 'solver.z[1]'], True)
+        """
+        d = self.params
+        return (["started", "seen", "v_rest", "F_prev"] + signal_labels("f", 2 * d.ns)
+                + signal_labels("g", 2 * d.npost) + [f"solver.{s}" for s in self._solver_labels])
 
     def initial_state(self, z0=None) -> np.ndarray:
         """The state before the first sample: not started, the plays at rest at 0 or at ``z0``.
@@ -219,10 +245,63 @@ class NativeInverse:
         >>> NativeInverse(m.inverse()).run([2.0, 4.0, 6.0]).tolist()  # latency 1
         [1.0, 2.0, 3.0]
         """
-        from .model import _signal
-
-        yd = np.ascontiguousarray(_signal(y_d, "y_d"), dtype=float)
+        yd = np.ascontiguousarray(checked_signal(y_d, "y_d"), dtype=float)
         return _native.inverse_run(self.params, self.initial_state(z0), yd)
+
+
+def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
+                  input: str = "y_d", output: str = "v", input_range: float | None = None,
+                  reference_range: float | None = None) -> control.NonlinearIOSystem:
+    """The causal feedforward as a discrete python-control block, stepped on the C core.
+
+    Equal to the NumPy reference :func:`~pimodel.diagnosis.reference_inverse.inverse_block`
+    (to 1e-9, ``tests/test_inverse_native.py``): fed ``y_d[0..k]``, it outputs ``v[k] =
+    v_batch[k - A]`` (module docstring).
+
+    Parameters
+    ----------
+    inverse : DiagnosedInverse
+        The inverse.
+    dt : float, optional
+        Sample time [s]; must be the model's ``dt`` (default).
+    name, input, output : str
+        Block name (params prefix) and signal names.
+    input_range : float, optional
+        Range of the rate effect's step rule; default ``2 r_n`` (as ``simulate``).
+    reference_range : float, optional
+        :class:`~pimodel.diagnosis.reference_inverse.StaticInverse`'s scale of the root rule;
+        ``simulate`` uses ``ptp(inverse.prefilter(y_d))``.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        ``v[k] = v_batch[k - A]`` (``A`` =
+        :func:`~pimodel.diagnosis.reference_inverse.inverse_latency`; ``v_rest`` before),
+        direct feedthrough when ``A = 0``; states :meth:`NativeInverse.labels`, initial state
+        all zeros; params ``"<name>.input_range"``, ``"<name>.reference_range"``. The latency
+        is also the block's attribute ``latency``.
+
+    Raises
+    ------
+    ValueError
+        ``dt`` other than the model's, a bad model parameter, a model the C core does not
+        take (:class:`NativeInverse`).
+
+    Examples
+    --------
+    >>> import control
+    >>> from pimodel.blocks import initial_state
+    >>> from pimodel.diagnosis.model import DiagnosedModel
+    >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3)
+    >>> blk = inverse_block(m.inverse())
+    >>> res = control.input_output_response(blk, np.arange(3) * 1e-3, [0.1, 1.35, 0.35],
+    ...                                     initial_state=initial_state(blk))
+    >>> res.outputs.round(9).tolist(), blk.latency
+    ([0.0, 1.0, 0.0], 0)
+    """
+    return feedforward_block(inverse, dt, lambda ir, rr: NativeInverse(inverse, ir, rr),
+                             name=name, input=input, output=output, input_range=input_range,
+                             reference_range=reference_range)
 
 
 def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
@@ -230,7 +309,7 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
     """The DiagnosedInverse FMU unit and its variable values for ``inverse`` (``Ts = dt``).
 
     The static part's variables are those of the DiagnosedModel unit
-    (:func:`~pimodel.diagnosis.stream.fmu_parameters`) with the projected (monotone) weights;
+    (:func:`~pimodel.diagnosis.native_model.fmu_parameters`) with the projected (monotone) weights;
     the feedforward adds ``n_sections``, ``section[1..6 ns]`` (the prefilter),
     ``n_post_sections``, ``post_section[1..6 np]`` (a Wiener model's filter inverse),
     ``latency``, ``delay_fraction`` and ``reference_range``.
