@@ -106,7 +106,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.native_inverse",
     "pimodel.diagnosis.filters",
     "pimodel.diagnosis.limits",
-    "pimodel.diagnosis.signals",
+    "pimodel.diagnosis.checks",
     "pimodel.diagnosis.feedforward",
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",

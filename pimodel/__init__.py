@@ -40,24 +40,24 @@ play_reference      plain NumPy play (backlash) operator
 
 **The map** (each subpackage's docstring maps its modules)
 
-===========================  ==========================================================
-pimodel.operators            the operators: PI, generalized, asymmetric, rate-dependent, creep
-pimodel.identification       identify(), slopes, conventional, identifiability, fits
+===============================  =================================================================
+pimodel.operators                the operators: PI, generalized, asymmetric, rate-dependent, creep
+pimodel.identification           identify(), slopes, conventional, identifiability, fits
 pimodel.identification.adaptive  the radius estimator, its settings and health, joint
-pimodel.blocks               python-control blocks and the block framework
-pimodel.loops                compiled loops, simulation, actuator dynamics, describing
-pimodel.stages               simulated piezo stages for tests and studies
-pimodel.reference            plain NumPy references of the compiled algorithms
-pimodel.diagnosis            sim-to-real gap diagnosis: where, which effect, how far
-pimodel.fmu                  build FMUs; drive them; wrap them as blocks; co-simulate
-pimodel.experiments          studies, sweeps (serial or Dask), compensation, demo
-pimodel.cli                  the ``pimodel`` command line
-pimodel.records              measured records: load, save, validate
-pimodel.model_files          the JSON form of a model (load_model, save_model)
-pimodel.signals              test inputs: sinusoid, triangle, minor loops, staircase
-pimodel.checks               argument validation (errors name the argument)
-pimodel.plotting             matplotlib helpers (headless, consistent saving)
-===========================  ==========================================================
+pimodel.blocks                   python-control blocks and the block framework
+pimodel.loops                    compiled loops, simulation, actuator dynamics, describing
+pimodel.stages                   simulated piezo stages for tests and studies
+pimodel.reference                plain NumPy references of the compiled algorithms
+pimodel.diagnosis                sim-to-real gap diagnosis: where, which effect, how far
+pimodel.fmu                      build FMUs; drive them; wrap them as blocks; co-simulate
+pimodel.experiments              studies, sweeps (serial or Dask), compensation, demo
+pimodel.cli                      the ``pimodel`` command line
+pimodel.records                  measured records: load, save, validate
+pimodel.model_files              the JSON form of a model (load_model, save_model)
+pimodel.signals                  test inputs: sinusoid, triangle, minor loops, staircase
+pimodel.checks                   argument validation (errors name the argument)
+pimodel.plotting                 matplotlib helpers (headless, consistent saving)
+===============================  =================================================================
 
 Layers, bottom to top (a module imports only from its own layer or below):
 ``checks, signals, plotting, records, _native`` < ``operators`` < ``reference`` <

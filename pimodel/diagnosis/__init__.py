@@ -29,7 +29,7 @@ Modules
     native_inverse      the causal feedforward on the C core: its block, runner and FMU values
     reference_inverse   the feedforward's NumPy reference: per-sample solver and block
     limits              the C core's limits the native forms respect
-    signals             the check of the signals the model and its runners take
+    checks              the check of the signals the model and its runners take
     feedforward         open-loop feedforward with a model, tried on a simulated stage
 
 Examples

@@ -91,6 +91,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..operators.pi import PIOperator
+from .checks import checked_signal
 from .drift import drift_term
 from .filters import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
@@ -99,7 +100,6 @@ from .native_inverse import NativeInverse, inverse_block
 from .native_model import diagnosed_block
 from .rate import rate_columns, rate_params
 from .reference_inverse import solve_static
-from .signals import checked_signal
 from .wiener import inverse_prefilter, prefilter
 
 if TYPE_CHECKING:

@@ -33,11 +33,11 @@ import numpy as np
 
 from .. import _native
 from ..blocks.framework import signal_labels
+from .checks import checked_signal
 from .limits import MAX_LATENCY, MAX_SECTIONS, NMAX
 from .native_model import _band_gains
 from .rate import RATE_FAMILIES
 from .reference_inverse import StaticInverse, _delay, _filter, feedforward_block, inverse_latency
-from .signals import checked_signal
 from .wiener import inverse_sections
 
 __all__ = ["NativeInverse", "inverse_block", "inverse_fmu_parameters"]

@@ -51,11 +51,11 @@ import numpy as np
 
 from .. import _native
 from ..blocks.framework import BlockSettings, signal_labels, stepped_block
+from .checks import block_dt, checked_signal
 from .filters import mode_coefficients
 from .limits import MAX_DELAY, MAX_ELEMENTS, MAX_ORDER, NMAX, SECTION
 from .lti import ELEMENT_K, element_coefficients
 from .rate import RATE_FAMILIES, play_bands, rate_params
-from .signals import block_dt, checked_signal
 from .wiener import ELEMENT_K as WIENER_K
 
 __all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",

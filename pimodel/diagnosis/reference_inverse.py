@@ -45,10 +45,10 @@ import numpy as np
 from scipy.signal import sosfilt_zi
 
 from ..blocks.framework import BlockSettings, signal_labels, stepped_block
+from .checks import block_dt
 from .lti import inverse_sos
 from .monotone import monotone_model
 from .rate import STEP_SHARE, play_bands, rate_params
-from .signals import block_dt
 from .wiener import inverse_sections
 
 __all__ = ["StaticInverse", "feedforward_block", "inverse_block", "inverse_latency",
