@@ -66,6 +66,9 @@ Layers, bottom to top (a module imports only from its own layer or below):
 ``pimodel.estimator``, ...) still import, with a DeprecationWarning (:mod:`pimodel._deprecated`).
 """
 
+import sys as _sys
+import types as _types
+
 from ._deprecated import install as _install_deprecated_paths
 from .identification.adaptive.joint import (
     JointEstimate,
@@ -147,4 +150,18 @@ def __dir__() -> list[str]:
     return sorted(set(globals()) | set(_LAZY))
 
 
+
+
+class _Package(_types.ModuleType):
+    """pimodel's module type: the function ``pimodel.identify`` keeps its name when the 0.1
+    module path ``pimodel.identify`` is imported (the import system would set the attribute to
+    the module, as 0.1 never did: there the function shadowed its module)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if name == "identify" and isinstance(value, _types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package
 _install_deprecated_paths()

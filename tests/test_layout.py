@@ -175,3 +175,16 @@ def test_new_paths_import_without_deprecation_warnings():
 
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-2000:]
+
+
+def test_old_paths_leave_the_package_names_alone():
+    """``import pimodel.identify`` (the 0.1 module) must not replace the function
+    ``pimodel.identify``, as 0.1's import never did."""
+    before = {name: getattr(pimodel, name) for name in pimodel.__all__}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        for old in sorted(MOVED):
+            sys.modules.pop(old, None)
+            importlib.import_module(old)
+    assert {name: getattr(pimodel, name) for name in pimodel.__all__} == before
+    assert pimodel.identify.__module__ == "pimodel.identification.chain"
