@@ -384,3 +384,26 @@ def biquad_rows(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
     rows = xc.reshape(-1, xc.shape[-1]) if xc.ndim else xc
     lib.pim_biquad_rows(rows.shape[0], rows.shape[1], bb, aa, rows, out.reshape(rows.shape))
     return out
+
+
+# -- LIMITS: the C core's limits (fmu/src/core/pim_limits.h), read once -------------------------
+# The only copy in Python: use LIMITS["PIM_MAX_PLAYS"] etc., never a retyped number.
+
+lib.pim_limit_count.restype = ctypes.c_int
+lib.pim_limit_count.argtypes = []
+lib.pim_limit_name.restype = ctypes.c_char_p
+lib.pim_limit_name.argtypes = [ctypes.c_int]
+lib.pim_limit_value.restype = ctypes.c_double
+lib.pim_limit_value.argtypes = [ctypes.c_int]
+lib.pim_limit_is_integer.restype = ctypes.c_int
+lib.pim_limit_is_integer.argtypes = [ctypes.c_int]
+
+LIMITS: dict[str, int | float] = {
+    lib.pim_limit_name(i).decode(): (int(lib.pim_limit_value(i)) if lib.pim_limit_is_integer(i)
+                                     else lib.pim_limit_value(i))
+    for i in range(lib.pim_limit_count())
+}
+"""Every limit of the C core and the FMU units (``fmu/src/core/pim_limits.h``) by its C name,
+e.g. ``LIMITS["PIM_MAX_PLAYS"]`` (the FMU arrays' size); integers as ``int``, tolerances as
+``float``."""
+# -- end LIMITS --------------------------------------------------------------------------------

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
+from pimodel._native import LIMITS
 from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.stream import (
@@ -31,7 +32,6 @@ from pimodel.diagnosis.stream import (
     state_labels,
     stream_simulate,
 )
-from pimodel.fmu.build import source_dir
 from pimodel.fmu.model_fmu import cosimulate_chain
 from pimodel.fmu.unit import FMUUnit
 
@@ -119,9 +119,7 @@ def test_sections_are_the_elements_zoh_and_the_bound_matches_the_c_core():
     assert g.tolist() == [0.3, 0.2, 0.05]
     assert element_sections(without_elements(m)) is None
     assert element_sections(replace(m, effects=())) is None  # no dynamics: not used
-    header = (source_dir() / "pim_diagnosed.h").read_text()
-    assert MAX_ELEMENTS == int(re.search(r"#define PIM_DIAG_MAX_ELEMENTS (\d+)",
-                                         header).group(1))
+    assert MAX_ELEMENTS == LIMITS["PIM_DIAG_MAX_ELEMENTS"]
 
 
 @pytest.mark.parametrize(("change", "message"), [

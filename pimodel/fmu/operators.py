@@ -21,7 +21,7 @@ from ..creep import CreepOperator
 from ..generalized import GeneralizedPI
 from ..operator import PIOperator
 from ..rate_dependent import RateDependentPI, RateDependentPIInverse
-from .build import ENVELOPE_KINDS, NMAX
+from .spec import ENVELOPE_KINDS, NMAX
 
 __all__ = ["unit_parameters"]
 

@@ -68,13 +68,14 @@
 #include "pim_loops.h"
 #include "pim_rate_dependent.h"
 
+#include "config.h" /* generated: MODEL_IDENTIFIER, PIM_MODEL, ValueReference, PIM_UNIT_VARIABLES */
+
 #if !defined(PIM_MODEL) || PIM_MODEL < 1 || PIM_MODEL > 9
 #error "define PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator, 3 InversePI, 4 GeneralizedPI, \
 5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator, 8 DiagnosedModel, 9 DiagnosedInverse)"
 #endif
 #define PIM_HAS_INVERSE_FLAG (PIM_MODEL >= 4 && PIM_MODEL <= 7)
 #define PIM_DIAG_UNIT (PIM_MODEL == 8 || PIM_MODEL == 9) /* the diagnosed model's units */
-#define PIM_DINV_FMU_SECTIONS 10 /* DiagnosedInverse: sections in section[1..60] */
 
 #define PIM_NMAX PIM_MAX_PLAYS            /* declared array size: p[1..64], r[..], r_hat[..] */
 #define NMAX PIM_NMAX
@@ -83,89 +84,7 @@
 #else
 #define PIM_UNIT_NMAX PIM_NMAX            /* largest n */
 #endif
-#define PIM_MAX_SUBSTEPS 10000000LL       /* samples per doStep */
-#define PIM_MAX_SAMPLE_INDEX 4503599627370496.0 /* 2^52 */
-#define PIM_TS_MIN 1e-12                  /* smallest sample time [s] */
-#define PIM_SAMPLE_TOL 1e-9               /* tolerance of the sampling rule, in samples */
 
-typedef enum {
-    vr_Ts = 0,
-    vr_n = 1,
-    vr_z0 = 2,
-    vr_adaptive = 3,
-    vr_gain = 4,
-    vr_linear_play = 5,
-    vr_guard = 6,
-    vr_slope_window = 7,
-    vr_inverse = 8, /* units 4-7 */
-    vr_time = 9, /* FMI 3 independent variable */
-    vr_in1 = 10,  /* v (PIHysteresis, RadiusEstimator), y_d (InversePI), u (units 4-7) */
-    vr_out1 = 11, /* y (PIHysteresis, units 4-7), y_hat (RadiusEstimator), v (InversePI) */
-    vr_in2 = 12,  /* y (RadiusEstimator) */
-    vr_out2 = 13, /* e (RadiusEstimator) */
-    vr_law = 14,    /* RadiusEstimator: principal case from the data (0) or the estimate (1) */
-    vr_health = 15, /* RadiusEstimator: health bit mask (pim_est_health.h) */
-    vr_in_kind = 20, /* GeneralizedPI input envelope; AsymmetricPI shape (kind, c0..c3) */
-    vr_in_c0 = 21,
-    vr_in_c1 = 22,
-    vr_in_c2 = 23,
-    vr_in_c3 = 24,
-    vr_out_kind = 25, /* GeneralizedPI output envelope */
-    vr_out_c0 = 26,
-    vr_out_c1 = 27,
-    vr_out_c2 = 28,
-    vr_out_c3 = 29,
-    vr_p0 = 30, /* AsymmetricPI */
-    vr_a_l = 31,
-    vr_d_l = 32,
-    vr_a_r = 33,
-    vr_d_r = 34,
-    vr_rate_gain = 40, /* RateDependentPI */
-    vr_rate_time_constant = 41,
-    vr_v0 = 42,
-    vr_offset = 50, /* DiagnosedModel */
-    vr_reference_offset = 51,
-    vr_n_lags = 52,
-    vr_asymmetry_quadratic = 53,
-    vr_asymmetry_cubic = 54,
-    vr_center = 55,
-    vr_half_range = 56,
-    vr_rate_scale = 57,
-    vr_input_range = 58,
-    vr_drift_per_s = 59,
-    vr_drift_clock = 60,
-    vr_lti_order = 61,
-    vr_delay_samples = 62,
-    vr_rate_family = 63,
-    vr_rate_tau = 64,
-    vr_n_lti_elements = 65,
-    vr_n_wiener_elements = 66,
-    vr_reference_range = 67, /* DiagnosedInverse */
-    vr_latency = 68,
-    vr_delay_fraction = 69,
-    vr_n_sections = 70,
-    vr_n_post_sections = 71,
-    vr_p = 100,
-    vr_r = 200,
-    vr_r_hat = 300,
-    vr_w0 = 400, /* DiagnosedModel arrays */
-    vr_creep_gain = 500,
-    vr_creep_tau = 600,
-    vr_rate_band_gain = 700,
-    vr_lti_b = 800,
-    vr_lti_a = 900,
-    vr_p_hi = 1000, /* DiagnosedModel plays 65..128 */
-    vr_r_hi = 1100,
-    vr_w0_hi = 1200,
-    vr_rate_band_gain_hi = 1300,
-    vr_lti_gain = 1400, /* DiagnosedModel: the linear part's further elements */
-    vr_lti_element_b = 1500,
-    vr_lti_element_a = 1600,
-    vr_wiener_element_b = 1700, /* DiagnosedModel: the filter before the plays (Wiener) */
-    vr_wiener_element_a = 1800,
-    vr_section = 1900, /* DiagnosedInverse: the prefilter's sections */
-    vr_post_section = 2000 /* DiagnosedInverse: the post sections (a Wiener filter's inverse) */
-} ValueReference;
 
 typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
 
@@ -249,157 +168,22 @@ typedef struct {
 
 #define PIM_AT(field) offsetof(pim_unit, field)
 
-/* The variables of the unit (the model description is generated to the same list); inputs and
- * outputs first, as the accessors scan it on every call. */
-static const pim_var unit_vars[] = {
-#if PIM_MODEL == 1
-    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-#elif PIM_MODEL == 2
-    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"y", vr_in2, 'R', PIM_INPUT, 1, PIM_AT(in2)},
-    {"y_hat", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"e", vr_out2, 'R', PIM_OUTPUT, 1, PIM_AT(out2)},
-    {"r_hat", vr_r_hat, 'R', PIM_OUTPUT, PIM_NMAX, PIM_AT(rhat_out)},
-    {"health", vr_health, 'I', PIM_OUTPUT, 1, PIM_AT(health)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"law", vr_law, 'I', PIM_PARAMETER, 1, PIM_AT(law)},
-    {"gain", vr_gain, 'R', PIM_PARAMETER, 1, PIM_AT(gain)},
-    {"linear_play", vr_linear_play, 'B', PIM_PARAMETER, 1, PIM_AT(linear_play)},
-    {"guard", vr_guard, 'R', PIM_PARAMETER, 1, PIM_AT(guard)},
-    {"slope_window", vr_slope_window, 'I', PIM_PARAMETER, 1, PIM_AT(slope_window)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-#elif PIM_MODEL == 3
-    {"y_d", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"v", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"r_hat", vr_r_hat, 'R', PIM_INPUT, PIM_NMAX, PIM_AT(rhat_in)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"adaptive", vr_adaptive, 'B', PIM_PARAMETER, 1, PIM_AT(adaptive)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-#elif PIM_MODEL == 4
-    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
-    {"in_kind", vr_in_kind, 'I', PIM_PARAMETER, 1, PIM_AT(kind_in)},
-    {"in_c0", vr_in_c0, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[0])},
-    {"in_c1", vr_in_c1, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[1])},
-    {"in_c2", vr_in_c2, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[2])},
-    {"in_c3", vr_in_c3, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[3])},
-    {"out_kind", vr_out_kind, 'I', PIM_PARAMETER, 1, PIM_AT(kind_out)},
-    {"out_c0", vr_out_c0, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[0])},
-    {"out_c1", vr_out_c1, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[1])},
-    {"out_c2", vr_out_c2, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[2])},
-    {"out_c3", vr_out_c3, 'R', PIM_PARAMETER, 1, PIM_AT(c_out[3])},
-#elif PIM_MODEL == 5
-    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
-    {"p0", vr_p0, 'R', PIM_PARAMETER, 1, PIM_AT(p0)},
-    {"a_l", vr_a_l, 'R', PIM_PARAMETER, 1, PIM_AT(a_l)},
-    {"d_l", vr_d_l, 'R', PIM_PARAMETER, 1, PIM_AT(d_l)},
-    {"a_r", vr_a_r, 'R', PIM_PARAMETER, 1, PIM_AT(a_r)},
-    {"d_r", vr_d_r, 'R', PIM_PARAMETER, 1, PIM_AT(d_r)},
-    {"shape_kind", vr_in_kind, 'I', PIM_PARAMETER, 1, PIM_AT(kind_in)},
-    {"shape_c0", vr_in_c0, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[0])},
-    {"shape_c1", vr_in_c1, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[1])},
-    {"shape_c2", vr_in_c2, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[2])},
-    {"shape_c3", vr_in_c3, 'R', PIM_PARAMETER, 1, PIM_AT(c_in[3])},
-#elif PIM_MODEL == 6
-    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
-    {"rate_gain", vr_rate_gain, 'R', PIM_PARAMETER, 1, PIM_AT(rate_gain)},
-    {"rate_time_constant", vr_rate_time_constant, 'R', PIM_PARAMETER, 1, PIM_AT(rate_tc)},
-    {"v0", vr_v0, 'R', PIM_PARAMETER, 1, PIM_AT(v0)},
-#elif PIM_MODEL == 7
-    {"u", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"tau", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"c", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-    {"inverse", vr_inverse, 'B', PIM_PARAMETER, 1, PIM_AT(inverse)},
-#elif PIM_MODEL == 8
-    {"v", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"y", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-    {"w0", vr_w0, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0)},
-    {"offset", vr_offset, 'R', PIM_PARAMETER, 1, PIM_AT(offset)},
-    {"reference_offset", vr_reference_offset, 'R', PIM_PARAMETER, 1, PIM_AT(reference_offset)},
-    {"n_lags", vr_n_lags, 'I', PIM_PARAMETER, 1, PIM_AT(n_lags)},
-    {"creep_gain", vr_creep_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_gain)},
-    {"creep_tau", vr_creep_tau, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_tau)},
-    {"asymmetry_quadratic", vr_asymmetry_quadratic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_q)},
-    {"asymmetry_cubic", vr_asymmetry_cubic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_c3)},
-    {"center", vr_center, 'R', PIM_PARAMETER, 1, PIM_AT(center)},
-    {"half_range", vr_half_range, 'R', PIM_PARAMETER, 1, PIM_AT(half_range)},
-    {"rate_band_gain", vr_rate_band_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain)},
-    {"rate_scale", vr_rate_scale, 'R', PIM_PARAMETER, 1, PIM_AT(rate_scale)},
-    {"rate_family", vr_rate_family, 'I', PIM_PARAMETER, 1, PIM_AT(rate_family)},
-    {"rate_tau", vr_rate_tau, 'R', PIM_PARAMETER, 1, PIM_AT(rate_tau)},
-    {"input_range", vr_input_range, 'R', PIM_PARAMETER, 1, PIM_AT(input_range)},
-    {"drift_per_s", vr_drift_per_s, 'R', PIM_PARAMETER, 1, PIM_AT(drift_per_s)},
-    {"drift_clock", vr_drift_clock, 'I', PIM_PARAMETER, 1, PIM_AT(drift_clock)},
-    {"lti_order", vr_lti_order, 'I', PIM_PARAMETER, 1, PIM_AT(lti_order)},
-    {"lti_b", vr_lti_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_b)},
-    {"lti_a", vr_lti_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_a)},
-    {"delay_samples", vr_delay_samples, 'R', PIM_PARAMETER, 1, PIM_AT(delay_samples)},
-    {"n_lti_elements", vr_n_lti_elements, 'I', PIM_PARAMETER, 1, PIM_AT(n_lti_elements)},
-    {"lti_gain", vr_lti_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_gain)},
-    {"lti_element_b", vr_lti_element_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_element_b)},
-    {"lti_element_a", vr_lti_element_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(lti_element_a)},
-    {"n_wiener_elements", vr_n_wiener_elements, 'I', PIM_PARAMETER, 1, PIM_AT(n_wiener_elements)},
-    {"wiener_element_b", vr_wiener_element_b, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(wiener_element_b)},
-    {"wiener_element_a", vr_wiener_element_a, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(wiener_element_a)},
-    {"p_hi", vr_p_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p_hi)},
-    {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
-    {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
-    {"rate_band_gain_hi", vr_rate_band_gain_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain_hi)},
-#elif PIM_MODEL == 9
-    {"y_d", vr_in1, 'R', PIM_INPUT, 1, PIM_AT(in1)},
-    {"v", vr_out1, 'R', PIM_OUTPUT, 1, PIM_AT(out1)},
-    {"r", vr_r, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r)},
-    {"p", vr_p, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p)},
-    {"w0", vr_w0, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0)},
-    {"offset", vr_offset, 'R', PIM_PARAMETER, 1, PIM_AT(offset)},
-    {"reference_offset", vr_reference_offset, 'R', PIM_PARAMETER, 1, PIM_AT(reference_offset)},
-    {"n_lags", vr_n_lags, 'I', PIM_PARAMETER, 1, PIM_AT(n_lags)},
-    {"creep_gain", vr_creep_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_gain)},
-    {"creep_tau", vr_creep_tau, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(creep_tau)},
-    {"asymmetry_quadratic", vr_asymmetry_quadratic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_q)},
-    {"asymmetry_cubic", vr_asymmetry_cubic, 'R', PIM_PARAMETER, 1, PIM_AT(asym_c3)},
-    {"center", vr_center, 'R', PIM_PARAMETER, 1, PIM_AT(center)},
-    {"half_range", vr_half_range, 'R', PIM_PARAMETER, 1, PIM_AT(half_range)},
-    {"rate_band_gain", vr_rate_band_gain, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain)},
-    {"rate_scale", vr_rate_scale, 'R', PIM_PARAMETER, 1, PIM_AT(rate_scale)},
-    {"rate_family", vr_rate_family, 'I', PIM_PARAMETER, 1, PIM_AT(rate_family)},
-    {"rate_tau", vr_rate_tau, 'R', PIM_PARAMETER, 1, PIM_AT(rate_tau)},
-    {"input_range", vr_input_range, 'R', PIM_PARAMETER, 1, PIM_AT(input_range)},
-    {"reference_range", vr_reference_range, 'R', PIM_PARAMETER, 1, PIM_AT(reference_range)},
-    {"latency", vr_latency, 'I', PIM_PARAMETER, 1, PIM_AT(latency)},
-    {"delay_fraction", vr_delay_fraction, 'R', PIM_PARAMETER, 1, PIM_AT(delay_fraction)},
-    {"n_sections", vr_n_sections, 'I', PIM_PARAMETER, 1, PIM_AT(n_sections)},
-    {"section", vr_section, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(section)},
-    {"n_post_sections", vr_n_post_sections, 'I', PIM_PARAMETER, 1, PIM_AT(n_post_sections)},
-    {"post_section", vr_post_section, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(post_section)},
-    {"p_hi", vr_p_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(p_hi)},
-    {"r_hi", vr_r_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(r_hi)},
-    {"w0_hi", vr_w0_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(w0_hi)},
-    {"rate_band_gain_hi", vr_rate_band_gain_hi, 'R', PIM_PARAMETER, PIM_NMAX, PIM_AT(rate_band_gain_hi)},
-#endif
-    {"Ts", vr_Ts, 'R', PIM_PARAMETER, 1, PIM_AT(Ts)},
-    {"n", vr_n, 'I', PIM_PARAMETER, 1, PIM_AT(n)},
-    {"z0", vr_z0, 'R', PIM_PARAMETER, 1, PIM_AT(z0)},
-    {"time", vr_time, 'R', PIM_INDEPENDENT, 1, PIM_AT(time)},
-};
+/* The variables of the unit: the table PIM_UNIT_VARIABLES of config.h, generated from the
+ * Python spec (pimodel.fmu.spec) like the model description; inputs and outputs first, as the
+ * accessors scan it on every call. */
+#define PIM_VAR_ROW(name, vr, type, causality, size, member) \
+    {name, vr, type, causality, size, PIM_AT(member)},
+static const pim_var unit_vars[] = {PIM_UNIT_VARIABLES(PIM_VAR_ROW)};
+#undef PIM_VAR_ROW
 #define PIM_NVARS (sizeof unit_vars / sizeof unit_vars[0])
+
+/* The name of the variable stored at offset (e.g. the main input's, "v", "y_d" or "u"). */
+static const char *unit_name_of(size_t offset)
+{
+    for (size_t i = 0; i < PIM_NVARS; ++i)
+        if (unit_vars[i].offset == offset) return unit_vars[i].name;
+    return "?";
+}
 
 static int unit_error(pim_unit *u, const char *fmt, ...)
 {
@@ -1093,10 +877,7 @@ static int unit_check_inputs(pim_unit *u)
 {
     if (!isfinite(u->in1))
         return unit_error(u, "input %s = %g is not finite (NaN or Inf)",
-                          PIM_MODEL == 3 || PIM_MODEL == 9 ? "y_d"
-                          : PIM_HAS_INVERSE_FLAG          ? "u"
-                                                          : "v",
-                          u->in1);
+                          unit_name_of(PIM_AT(in1)), u->in1);
 #if PIM_MODEL == 2
     if (!isfinite(u->in2)) return unit_error(u, "input y = %g is not finite (NaN or Inf)", u->in2);
 #elif PIM_MODEL == 3
@@ -1283,17 +1064,15 @@ static int unit_do_step(pim_unit *u, double t, double h)
  * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
 static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
-    /* FMI 2 array elements: base 100, 200, ..., 2000 plus an index below PIM_NMAX */
-    const unsigned base = elements && vr >= 100 && vr < 2100 ? vr - vr % 100 : vr;
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
-        if (v->vr != base) continue;
-        if (v->size > 1 && elements) {
-            if (vr - base >= (unsigned)v->size) return NULL;
-            *elem = (int)(vr - base);
+        if (v->size > 1 && elements) { /* FMI 2 array elements: v->vr + 0 .. v->vr + size - 1 */
+            if (vr < v->vr || vr - v->vr >= (unsigned)v->size) continue;
+            *elem = (int)(vr - v->vr);
         } else {
-            if (vr != base || (elements && v->causality == PIM_INDEPENDENT)) return NULL;
-            *elem = -1; /* FMI 2 has no time variable */
+            if (vr != v->vr) continue;
+            if (elements && v->causality == PIM_INDEPENDENT) return NULL; /* FMI 2: no time */
+            *elem = -1;
         }
         return v;
     }

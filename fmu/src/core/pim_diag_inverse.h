@@ -59,10 +59,6 @@
 extern "C" {
 #endif
 
-#define PIM_DINV_MAX_PLAYS PIM_DIAG_MAX_PLAYS   /* 128 */
-#define PIM_DINV_MAX_LAGS PIM_DIAG_MAX_LAGS     /* 64 */
-#define PIM_DINV_MAX_SECTIONS 32                /* prefilter sections */
-#define PIM_DINV_MAX_LATENCY 1000000            /* samples */
 #define PIM_DINV_HEAD 4
 #define PIM_DINV_RATE_FEEDBACK_CAP 2.0          /* inverse_stream.RATE_FEEDBACK_CAP */
 #define PIM_DINV_SOLVER_MAX (3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS + 2 + PIM_DINV_MAX_PLAYS + \
