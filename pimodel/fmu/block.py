@@ -24,6 +24,8 @@ from ..blocks import _Block
 from ..checks import positive_scalar
 from .unit import FMUUnit
 
+__all__ = ["fmu_block"]
+
 
 def _signals(unit: FMUUnit, causality: str) -> list[str]:
     """Scalar signal names of that causality; FMI 3 arrays as ``name[1]`` ... ``name[N]``."""

@@ -23,6 +23,8 @@ from ..plotting import new_figure, save_figure
 from ..signals import triangle
 from .cosim import cosimulate_adaptive_loop
 
+__all__ = ["CosimComparison", "compare_with_native", "plot_comparison"]
+
 DT = 1e-4  # s
 
 

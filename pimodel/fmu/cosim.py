@@ -22,6 +22,8 @@ from ..operator import PIOperator
 from .build import fmu_filename
 from .unit import FMUUnit
 
+__all__ = ["cosimulate_adaptive_loop"]
+
 LOOP_UNITS = ("PIHysteresis", "RadiusEstimator", "InversePI")  # the FMUs this master runs
 
 

@@ -7,8 +7,9 @@ Layout of ``fmu/src`` (as the Modelica Reference-FMUs: shared code, then one fol
 - ``fmi/``: the FMI 2 / FMI 3 glue (``fmi2_pimodel.c``, ``fmi3_pimodel.c``) and the
   version-independent unit framework ``pim_unit.h`` (modes, sampling rule, state format,
   logging, the variable lookup);
-- ``units/<Unit>/unit.h``: one unit's fields, parameter check, derived quantities, per-sample
-  step and state checks, the hooks the framework calls.
+- ``units/<Unit>/unit.h``: one unit's own code (its parameter rules and helpers), included by
+  the framework; ``units/shared/``: code shared by some units (``diag_static.h``: the static
+  part of the DiagnosedModel and DiagnosedInverse units).
 
 An FMU's ``sources/`` holds these files flat, with the generated ``config.h``
 (:func:`pimodel.fmu.spec.config_h`) and a ``model.c`` including its unit and glue.
@@ -18,8 +19,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["CORE_SOURCES", "FRAMEWORK", "GLUE", "HEADERS", "source_dir", "source_files",
-           "unit_dir"]
+__all__ = ["CORE_SOURCES", "FRAMEWORK", "GLUE", "HEADERS", "SHARED_UNIT_FILES", "UNIT_FILES",
+           "source_dir", "source_files", "unit_dir"]
 
 CORE_SOURCES = ("pim_pi.c", "pim_estimator.c", "pim_est_health.c", "pim_loops.c",
                 "pim_generalized.c", "pim_asymmetric.c", "pim_rate_dependent.c", "pim_creep.c",
@@ -30,6 +31,7 @@ HEADERS = ("pim_limits.h", "pim_core.h", "pim_estimator.h", "pim_est_health.h", 
 FRAMEWORK = ("pim_unit.h",)  # fmi/
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}  # fmi/, #included by model.c
 UNIT_FILES = ("unit.h",)  # units/<Unit>/
+SHARED_UNIT_FILES = ("diag_static.h",)  # units/shared/: code shared by some units
 
 
 def source_dir() -> Path:
@@ -103,4 +105,5 @@ def source_files(unit: str, fmi_version: str) -> list[Path]:
     src = source_dir()
     return [src / "fmi" / GLUE[fmi_version], *[src / "fmi" / f for f in FRAMEWORK],
             *[unit_dir(unit) / f for f in UNIT_FILES],
+            *[src / "units" / "shared" / f for f in SHARED_UNIT_FILES],
             *[src / "core" / f for f in (*CORE_SOURCES, *HEADERS)]]
