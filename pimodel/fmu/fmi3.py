@@ -1,6 +1,13 @@
 """Deprecated alias: the FMI 3.0 model descriptions are written by
 :mod:`pimodel.fmu.description` (one writer for FMI 2.0 and 3.0), the instantiation token comes
-from :mod:`pimodel.fmu.spec`. Kept one release for ``from pimodel.fmu.fmi3 import ...``."""
+from :mod:`pimodel.fmu.spec`. Kept one release for ``from pimodel.fmu.fmi3 import ...``.
+
+Examples
+--------
+>>> from pimodel.fmu.description import model_description
+>>> model_description3("PIHysteresis") == model_description("PIHysteresis", "3.0")
+True
+"""
 
 from __future__ import annotations
 
