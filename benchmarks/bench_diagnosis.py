@@ -14,10 +14,10 @@ import time
 
 import numpy as np
 
-from pimodel.data import Record
 from pimodel.diagnosis import diagnose
-from pimodel.operator import PIOperator
-from pimodel.truth import excitation, random_truth
+from pimodel.operators.pi import PIOperator
+from pimodel.records import Record
+from pimodel.stages.pi_stage import excitation, random_truth
 
 
 def long_record(kind: str, n: int, truth, seed: int) -> Record:

@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from pimodel import PIOperator, RadiusEstimator
-from pimodel.estimator_reference import estimate_radii_reference
+from pimodel.reference.radius_estimator import estimate_radii_reference
 from pimodel.signals import add_noise_snr, sinusoid
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])

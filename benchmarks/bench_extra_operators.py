@@ -16,11 +16,11 @@ import numpy as np
 from bench_operator import best_time  # the benchmarks folder is on sys.path when run
 
 from pimodel import PIOperator
-from pimodel.asymmetric import AsymmetricPI
-from pimodel.creep import CreepOperator
-from pimodel.envelopes import Envelope
-from pimodel.generalized import GeneralizedPI
-from pimodel.rate_dependent import RateDependentPI
+from pimodel.operators.asymmetric import AsymmetricPI
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.envelopes import Envelope
+from pimodel.operators.generalized import GeneralizedPI
+from pimodel.operators.rate_dependent import RateDependentPI
 
 
 def random_operators(rng, n: int = 8):

@@ -10,11 +10,11 @@ import time
 
 import numpy as np
 
-from pimodel.actuators import stage_dynamics
-from pimodel.compensation import STAGE
-from pimodel.loops import PID, loop_system, run_loop
+from pimodel.experiments.compensation import STAGE
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import PID, loop_system, run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid
-from pimodel.simulation import simulate
 
 
 def main() -> None:

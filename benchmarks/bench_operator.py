@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 from pimodel import PIOperator
-from pimodel.reference import pi_reference
+from pimodel.reference.operators import pi_reference
 
 
 def best_time(fn, repeat: int = 5) -> float:

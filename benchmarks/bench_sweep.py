@@ -19,7 +19,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from pimodel.study_runner import run_study
+from pimodel.experiments.studies import run_study
 
 
 def timed_run(study: str, quick: bool, workers: int, out: Path) -> tuple[float, dict]:

@@ -5,28 +5,21 @@ slopes, adaptive radius estimator, joint estimator), python-control blocks, C FM
 sim-to-real gap diagnosis. Signals are sampled: ``y[k]`` is the response to ``v[0..k]``.
 Units follow the data (e.g. V in, um out); time is in seconds.
 
-**Operators**
+**The names a user types first** (re-exported here)
 
 ==================  ===============================================================
 PIOperator          PI operator: weighted plays, exact inverse, streaming state
 TimeDependentPI     PI operator with radii per sample (the estimator's model)
-pi_reference        plain NumPy PI operator (the C core's specification)
-play_reference      plain NumPy play (backlash) operator
-==================  ===============================================================
-
-**Identification**
-
-==================  ===============================================================
+GeneralizedPI       plays between input/output envelopes, exact inverse
+AsymmetricPI        distinct loading and unloading envelopes
+RateDependentPI     radii growing with the input rate
+CreepOperator       a sum of first-order lags, exact inverse
+Cascade             operators in series and the chain's inverse
 identify            fit y = PI[v] + offset to a record (adaptive, conventional, joint)
 Identification      identify's result: operator, offset, errors, JSON
 identify_slopes     number of plays and weights from the loop slopes (BIC)
 check_excitation    does the input excite every play? (reversals, range, loop width)
 fit_conventional    conventional baseline: preset radii, least-squares weights
-==================  ===============================================================
-
-**Estimators**
-
-==================  ===============================================================
 RadiusEstimator     the adaptive radius law (regime from the data), streaming (C core)
 estimate_radii      the radius law over a whole record
 RadiusEstimate      estimate_radii's result: final radii and history
@@ -34,77 +27,124 @@ JointEstimator      online estimation of weights and radii together, streaming
 estimate_jointly    the joint estimator over a whole record
 stream_jointly      the joint estimator over (v, y) chunks of any size
 JointEstimate       the joint estimators' result
-==================  ===============================================================
-
-**Records**
-
-==================  ===============================================================
 Record              a sampled record t, v, y (validated)
 load_record         read a record from CSV (header) or NPZ
 save_record         write a record to CSV or NPZ
+load_model          read a model file (operator, cascade or diagnosed model)
+save_model          write a model file
+diagnose            where the sim-to-real gap lies and which effect causes it
+DiagnosisReport     diagnose's result
+pi_reference        plain NumPy PI operator (the C core's specification)
+play_reference      plain NumPy play (backlash) operator
 ==================  ===============================================================
 
-**Submodules**
+**The map** (each subpackage's docstring maps its modules)
 
-============================  ==========================================================
-pimodel.signals               test inputs: sinusoid, triangle, minor loops, staircase
-pimodel.blocks                python-control blocks: PI, inverse, estimator, PID
-pimodel.simulation            simulate a python-control system from its initial states
-pimodel.actuators             stage dynamics: mode, creep, delay (discretised)
-pimodel.describing            describing function, sector, circle criterion, limit cycles
-pimodel.loops                 compiled loops: feedforward, adaptive inverse, PID
-pimodel.long_records          long noisy records made in chunks
-pimodel.estimator_settings    radius estimator settings chosen from the record
-pimodel.estimator_health      health report of a radius estimate: can it be trusted?
-pimodel.play_reduction        joint fit: merge or drop the plays the data do not resolve
-pimodel.envelopes             input/output envelopes (poly2, tanh) with exact inverses
-pimodel.generalized           GeneralizedPI: plays between envelopes, exact inverse
-pimodel.asymmetric            AsymmetricPI: distinct loading/unloading envelopes
-pimodel.rate_dependent        RateDependentPI: radii growing with the input rate
-pimodel.creep                 CreepOperator: sum of first-order lags, exact inverse
-pimodel.cascade               Cascade: operators in series and the chain's inverse
-pimodel.fit_operators         identify the generalized, rate-dependent and creep operators
-pimodel.blocks_extra          python-control blocks of those operators
-pimodel.models                the JSON form of a model (load_model, save_model)
-pimodel.sweep                 sweeps over cases, serially or on Dask (run_cases, grid)
-pimodel.truth_sweep           sweeps of identify/diagnose over simulated stages
-pimodel.diagnosis             sim-to-real gap diagnosis: where, which effect, how far
-pimodel.truth                 simulated stages with creep, dynamics, delay, ...
-pimodel.fmu                   build FMUs; drive them; wrap them as blocks; co-simulate
-pimodel.fmu.operators         FMU unit and parameter values for an operator or inverse
-pimodel.fmu.model_fmu         FMUs of a model, one per stage; co-simulate the chain
-============================  ==========================================================
+===========================  ==========================================================
+pimodel.operators            the operators: PI, generalized, asymmetric, rate-dependent, creep
+pimodel.identification       identify(), slopes, conventional, identifiability, fits
+pimodel.identification.adaptive  the radius estimator, its settings and health, joint
+pimodel.blocks               python-control blocks and the block framework
+pimodel.loops                compiled loops, simulation, actuator dynamics, describing
+pimodel.stages               simulated piezo stages for tests and studies
+pimodel.reference            plain NumPy references of the compiled algorithms
+pimodel.diagnosis            sim-to-real gap diagnosis: where, which effect, how far
+pimodel.fmu                  build FMUs; drive them; wrap them as blocks; co-simulate
+pimodel.experiments          studies, sweeps (serial or Dask), compensation, demo
+pimodel.cli                  the ``pimodel`` command line
+pimodel.records              measured records: load, save, validate
+pimodel.model_files          the JSON form of a model (load_model, save_model)
+pimodel.signals              test inputs: sinusoid, triangle, minor loops, staircase
+pimodel.checks               argument validation (errors name the argument)
+pimodel.plotting             matplotlib helpers (headless, consistent saving)
+===========================  ==========================================================
+
+Layers, bottom to top (a module imports only from its own layer or below):
+``checks, signals, plotting, records, _native`` < ``operators`` < ``reference`` <
+``identification`` < ``blocks`` < ``loops`` < ``stages`` < ``diagnosis`` < ``model_files`` <
+``fmu`` < ``experiments`` < ``cli``. The 0.1 module paths (``pimodel.truth``,
+``pimodel.estimator``, ...) still import, with a DeprecationWarning (:mod:`pimodel._deprecated`).
 """
 
-from .conventional import fit_conventional
-from .data import Record, load_record, save_record
-from .estimator import RadiusEstimate, RadiusEstimator, estimate_radii
-from .excitation import check_excitation
-from .identify import Identification, identify
-from .joint import JointEstimate, JointEstimator, estimate_jointly, stream_jointly
-from .operator import PIOperator, TimeDependentPI
-from .reference import pi_reference, play_reference
-from .slopes import identify_slopes
+from ._deprecated import install as _install_deprecated_paths
+from .identification.adaptive.joint import (
+    JointEstimate,
+    JointEstimator,
+    estimate_jointly,
+    stream_jointly,
+)
+from .identification.adaptive.radius_estimator import (
+    RadiusEstimate,
+    RadiusEstimator,
+    estimate_radii,
+)
+from .identification.chain import Identification, identify
+from .identification.conventional import fit_conventional
+from .identification.identifiability import check_excitation
+from .identification.slopes import identify_slopes
+from .operators.asymmetric import AsymmetricPI
+from .operators.cascade import Cascade
+from .operators.creep import CreepOperator
+from .operators.generalized import GeneralizedPI
+from .operators.pi import PIOperator, TimeDependentPI
+from .operators.rate_dependent import RateDependentPI
+from .records import Record, load_record, save_record
+from .reference.operators import pi_reference, play_reference
 
 __all__ = [
+    "AsymmetricPI",
+    "Cascade",
+    "CreepOperator",
+    "DiagnosisReport",
+    "GeneralizedPI",
     "Identification",
+    "JointEstimate",
+    "JointEstimator",
+    "PIOperator",
+    "RadiusEstimate",
+    "RadiusEstimator",
+    "RateDependentPI",
+    "Record",
+    "TimeDependentPI",
     "check_excitation",
+    "diagnose",
+    "estimate_jointly",
+    "estimate_radii",
     "fit_conventional",
     "identify",
     "identify_slopes",
-    "JointEstimate",
-    "JointEstimator",
-    "estimate_jointly",
-    "stream_jointly",
-    "RadiusEstimate",
-    "RadiusEstimator",
-    "estimate_radii",
-    "PIOperator",
-    "TimeDependentPI",
-    "Record",
+    "load_model",
     "load_record",
-    "save_record",
     "pi_reference",
     "play_reference",
+    "save_model",
+    "save_record",
+    "stream_jointly",
 ]
 __version__ = "0.1.0"
+
+# Heavy or higher-layer names, imported on first use (``import pimodel`` stays light, so that
+# ``pimodel --help`` is quick): name -> module.
+_LAZY = {
+    "diagnose": "pimodel.diagnosis.diagnose",
+    "DiagnosisReport": "pimodel.diagnosis.diagnose",
+    "load_model": "pimodel.model_files",
+    "save_model": "pimodel.model_files",
+}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'pimodel' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
+
+_install_deprecated_paths()

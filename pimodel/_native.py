@@ -27,6 +27,32 @@ def _find_library() -> Path:
 
 lib = ctypes.CDLL(str(_find_library()))
 
+# -- LIMITS: the C core's limits (fmu/src/core/pim_limits.h), read once -------------------------
+# The only copy in Python: use LIMITS["PIM_MAX_PLAYS"] etc., never a retyped number.
+
+lib.pim_limit_count.restype = ctypes.c_int
+lib.pim_limit_count.argtypes = []
+lib.pim_limit_name.restype = ctypes.c_char_p
+lib.pim_limit_name.argtypes = [ctypes.c_int]
+lib.pim_limit_value.restype = ctypes.c_double
+lib.pim_limit_value.argtypes = [ctypes.c_int]
+lib.pim_limit_is_integer.restype = ctypes.c_int
+lib.pim_limit_is_integer.argtypes = [ctypes.c_int]
+
+LIMITS: dict[str, int | float] = {
+    lib.pim_limit_name(i).decode(): (int(lib.pim_limit_value(i)) if lib.pim_limit_is_integer(i)
+                                     else lib.pim_limit_value(i))
+    for i in range(lib.pim_limit_count())
+}
+"""Every limit and enumeration code of the C core and the FMU units (``fmu/src/core/pim_limits.h``)
+by its C name,
+e.g. ``LIMITS["PIM_MAX_PLAYS"]`` (the FMU arrays' size); integers as ``int``, tolerances as
+``float``."""
+#: envelope kinds of pim_generalized.h by name (the PIM_ENV_* codes)
+ENVELOPE_KINDS: dict[str, int] = {k: LIMITS[f"PIM_ENV_{k.upper()}"]
+                                  for k in ("poly2", "tanh", "poly2_inv", "tanh_inv")}
+# -- end LIMITS --------------------------------------------------------------------------------
+
 c_size = ctypes.c_size_t
 c_double_p = ctypes.POINTER(ctypes.c_double)
 
@@ -93,6 +119,120 @@ def pi_inverse(
     if lib.pim_pi_inverse(n, p, r, z, pinv, rinv, zinv) != 0:
         return None
     return pinv, rinv, zinv
+
+
+# -- raw PI step for python-control blocks (pointers cached by the caller) -----------------------
+
+raw_pi_step = lib["pim_pi_step"]  # a second handle: raw pointers, no ndpointer argument checks
+raw_pi_step.restype = ctypes.c_double
+raw_pi_step.argtypes = [c_size, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double]
+
+lib.pim_adaptive_inverse_step.restype = ctypes.c_double
+lib.pim_adaptive_inverse_step.argtypes = [c_size, F64, F64, F64, ctypes.c_double]
+
+
+def address(a: np.ndarray) -> int:
+    """The data address of a C-contiguous float64 array, for :data:`raw_pi_step`."""
+    return a.ctypes.data
+
+
+# -- radius estimator (fmu/src/pim_estimator.h) -------------------------------------------------
+
+_D = ctypes.POINTER(ctypes.c_double)
+lib.pim_est_sizeof.restype = c_size
+lib.pim_est_init.restype = ctypes.c_char_p
+lib.pim_est_init.argtypes = [ctypes.c_void_p, c_size, F64, F64, F64, ctypes.c_double,
+                             ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                             ctypes.c_double, ctypes.c_int]
+lib.pim_est_step.restype = ctypes.c_int
+lib.pim_est_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, F64_OR_NULL, _D,
+                             _D, _D]
+lib.pim_est_run.restype = ctypes.c_long
+lib.pim_est_run.argtypes = [ctypes.c_void_p, c_size, F64, F64, F64_OR_NULL, F64, F64, F64,
+                            F64_OR_NULL]
+lib.pim_est_get_state.restype = None
+lib.pim_est_get_state.argtypes = [ctypes.c_void_p, F64]
+lib.pim_est_set_state.restype = ctypes.c_char_p
+lib.pim_est_set_state.argtypes = [ctypes.c_void_p, F64]
+lib.pim_est_set_slope_check.restype = ctypes.c_char_p
+lib.pim_est_set_slope_check.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_double]
+lib.pim_est_set_law.restype = ctypes.c_char_p
+lib.pim_est_set_law.argtypes = [ctypes.c_void_p, ctypes.c_int]
+lib.pim_project_ordered.restype = None
+lib.pim_project_ordered.argtypes = [c_size, F64, F64, ctypes.c_int]
+
+
+def estimator_buffer() -> ctypes.Array:
+    """Zeroed storage for one ``pim_estimator`` (``pim_est_sizeof()`` bytes)."""
+    return ctypes.create_string_buffer(lib.pim_est_sizeof())
+
+
+def estimator_step(buf: ctypes.Array, v: float, y: float) -> tuple[int, float, float, float]:
+    """One estimator sample: ``(rc, y_hat, e, e_dot)`` (``pim_est_step``)."""
+    yh, e, ed = ctypes.c_double(), ctypes.c_double(), ctypes.c_double()
+    rc = lib.pim_est_step(buf, v, y, None, ctypes.byref(yh), ctypes.byref(e), ctypes.byref(ed))
+    return rc, yh.value, e.value, ed.value
+
+
+# -- compiled closed loops (fmu/src/pim_loops.h) ------------------------------------------------
+
+LOOP_MAX_PLAYS, LOOP_MAX_DYN = LIMITS["PIM_MAX_PLAYS"], LIMITS["PIM_MAX_DYN"]
+_EST_WORDS = lib.pim_est_sizeof() // 8
+_D64 = ctypes.c_double * LOOP_MAX_PLAYS
+
+
+class Loop(ctypes.Structure):
+    """``pim_loop``: plant, feedforward, estimator copy and PID of a compiled loop."""
+
+    _fields_ = [
+        ("n", c_size), ("p", _D64), ("r", _D64), ("z", _D64),
+        ("nx", c_size), ("A", ctypes.c_double * (LOOP_MAX_DYN * LOOP_MAX_DYN)),
+        ("B", ctypes.c_double * LOOP_MAX_DYN), ("C", ctypes.c_double * LOOP_MAX_DYN),
+        ("D", ctypes.c_double), ("xd", ctypes.c_double * LOOP_MAX_DYN),
+        ("ff_mode", ctypes.c_int), ("ff_gain", ctypes.c_double),
+        ("ni", c_size), ("pinv", _D64), ("rinv", _D64), ("zinv", _D64),
+        ("nm", c_size), ("pm", _D64), ("zm", _D64),
+        ("est", ctypes.c_double * _EST_WORDS),
+        ("pid_on", ctypes.c_int), ("kp", ctypes.c_double), ("ki", ctypes.c_double),
+        ("kd", ctypes.c_double), ("tf", ctypes.c_double), ("dt", ctypes.c_double),
+        ("integ", ctypes.c_double), ("dfilt", ctypes.c_double), ("e_prev", ctypes.c_double),
+    ]
+
+
+lib.pim_loop_sizeof.restype = c_size
+if ctypes.sizeof(Loop) != lib.pim_loop_sizeof():  # pragma: no cover - build mismatch guard
+    raise ImportError("pimodel: the ctypes layout of pim_loop does not match the C core")
+lib.pim_loop_run.restype = ctypes.c_int
+lib.pim_loop_run.argtypes = [ctypes.POINTER(Loop), c_size, F64, F64, F64_OR_NULL, F64_OR_NULL,
+                             F64_OR_NULL]
+
+
+def loop_take_estimator(L: Loop, buf: ctypes.Array) -> None:
+    """Copy an estimator's state (:func:`estimator_buffer`) into the loop's ``est`` field."""
+    ctypes.memmove(ctypes.addressof(L) + Loop.est.offset, ctypes.addressof(buf),
+                   ctypes.sizeof(L.est))
+
+
+def loop_run(L: Loop, r: np.ndarray, y: np.ndarray, v, e, R) -> int:
+    """Run the loop over ``r`` (``pim_loop_run``); 0 on success."""
+    return lib.pim_loop_run(ctypes.byref(L), r.size, r, y, v, e, R)
+
+
+# -- reversal scanner (fmu/src/pim_reversals.h) -------------------------------------------------
+
+_I64 = np.ctypeslib.ndpointer(dtype=np.int64, flags="C_CONTIGUOUS")
+lib.pim_rev_scan_sizeof.restype = c_size
+lib.pim_rev_scan_init.restype = None
+lib.pim_rev_scan_init.argtypes = [ctypes.c_void_p]
+lib.pim_rev_scan_run.restype = c_size
+lib.pim_rev_scan_run.argtypes = [ctypes.c_void_p, c_size, F64, ctypes.c_double, _I64, _I64]
+
+
+def reversal_scanner() -> ctypes.Array:
+    """A fresh ``pim_rev_scan`` state (initialised)."""
+    buf = ctypes.create_string_buffer(lib.pim_rev_scan_sizeof())
+    lib.pim_rev_scan_init(buf)
+    return buf
 
 
 # -- generalized, rate-dependent and creep operators (fmu/src/pim_generalized.h,
@@ -315,7 +455,7 @@ def inverse_run(d: InverseParams, x: np.ndarray, y_d: np.ndarray) -> np.ndarray:
 # -- health of a radius estimate (fmu/src/pim_est_health.h) ------------------------------------
 
 HEALTH_EXCITATION, HEALTH_MERGED, HEALTH_PINNED, HEALTH_MOVING, HEALTH_FIT = 1, 2, 4, 8, 16
-HEALTH_MAX_PLAYS = 64  # PIM_MAX_PLAYS
+HEALTH_MAX_PLAYS = LIMITS["PIM_MAX_PLAYS"]
 
 lib.pim_health_sizeof.restype = c_size
 lib.pim_health_init.restype = ctypes.c_char_p
@@ -384,26 +524,3 @@ def biquad_rows(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
     rows = xc.reshape(-1, xc.shape[-1]) if xc.ndim else xc
     lib.pim_biquad_rows(rows.shape[0], rows.shape[1], bb, aa, rows, out.reshape(rows.shape))
     return out
-
-
-# -- LIMITS: the C core's limits (fmu/src/core/pim_limits.h), read once -------------------------
-# The only copy in Python: use LIMITS["PIM_MAX_PLAYS"] etc., never a retyped number.
-
-lib.pim_limit_count.restype = ctypes.c_int
-lib.pim_limit_count.argtypes = []
-lib.pim_limit_name.restype = ctypes.c_char_p
-lib.pim_limit_name.argtypes = [ctypes.c_int]
-lib.pim_limit_value.restype = ctypes.c_double
-lib.pim_limit_value.argtypes = [ctypes.c_int]
-lib.pim_limit_is_integer.restype = ctypes.c_int
-lib.pim_limit_is_integer.argtypes = [ctypes.c_int]
-
-LIMITS: dict[str, int | float] = {
-    lib.pim_limit_name(i).decode(): (int(lib.pim_limit_value(i)) if lib.pim_limit_is_integer(i)
-                                     else lib.pim_limit_value(i))
-    for i in range(lib.pim_limit_count())
-}
-"""Every limit of the C core and the FMU units (``fmu/src/core/pim_limits.h``) by its C name,
-e.g. ``LIMITS["PIM_MAX_PLAYS"]`` (the FMU arrays' size); integers as ``int``, tolerances as
-``float``."""
-# -- end LIMITS --------------------------------------------------------------------------------

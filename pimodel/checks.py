@@ -4,6 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = [
+    "as_signal",
+    "as_vector",
+    "integer_in",
+    "positive_scalar",
+    "scalar_or_vector",
+]
+
 
 def as_signal(value, name: str, *, min_length: int = 1) -> np.ndarray:
     """Return ``value`` as a finite 1-D float64 array, or raise ValueError naming ``name``.

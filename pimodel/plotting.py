@@ -10,6 +10,12 @@ matplotlib.use("Agg")  # headless: figures are written to files, never shown
 
 import matplotlib.pyplot as plt  # noqa: E402
 
+__all__ = [
+    "new_figure",
+    "readability_problems",
+    "save_figure",
+]
+
 
 def new_figure(ncols: int = 1, nrows: int = 1, size=(6.4, 4.2)):
     """A figure with ``nrows x ncols`` axes, sized per axis.

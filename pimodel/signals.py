@@ -10,6 +10,14 @@ import numpy as np
 
 from .checks import positive_scalar
 
+__all__ = [
+    "add_noise_snr",
+    "biased_staircase",
+    "major_minor_loops",
+    "sinusoid",
+    "triangle",
+]
+
 
 def _time(fs: float, duration: float) -> np.ndarray:
     fs = positive_scalar(fs, "fs")
@@ -229,7 +237,8 @@ def add_noise_snr(y: np.ndarray, snr_db: float, rng: np.random.Generator) -> np.
 
     See Also
     --------
-    pimodel.long_records.noisy_output_chunks : the same noise level for records made in chunks.
+    pimodel.stages.long_records.noisy_output_chunks : the same noise level for records made in
+    chunks.
 
     Examples
     --------

@@ -3,14 +3,14 @@ model (the effects the verdict named), on the true stage, open loop and inside t
 study's integral loop; and on the shared real record through its augmented model as a digital
 twin (a simulation through a fitted model, not a measurement).
 
-Cases: generator (``pimodel.truth``, ``pimodel.truth_alt``) x withheld effect (creep, dynamics,
-delay, asymmetry, drift, rate) x seed (3 seeds; ``--quick``: 1 seed of a few effects), and one
-case for the real record (open loop only). Per case: the records are diagnosed (as ``tests/
-test_augmented_feedforward.py`` does), the reference ``y_d`` is the noise-free true stage's
-response to the validate input, and each model's ``inverse().simulate(y_d)`` drives the
-noise-free true stage, open loop and with integral feedback (:func:`pimodel.diagnosis.
-feedforward.integral_loop`, gain scaled so the crossover equals the compensation study's).
-The tracking error is the RMS of ``y - y_d`` after the start-up region [um].
+Cases: generator (``pimodel.stages.pi_stage``, ``pimodel.stages.preisach_stage``) x withheld effect
+(creep, dynamics, delay, asymmetry, drift, rate) x seed (3 seeds; ``--quick``: 1 seed of a few
+effects), and one case for the real record (open loop only). Per case: the records are diagnosed (as
+``tests/ test_augmented_feedforward.py`` does), the reference ``y_d`` is the noise-free true stage's
+response to the validate input, and each model's ``inverse().simulate(y_d)`` drives the noise-free
+true stage, open loop and with integral feedback (:func:`pimodel.diagnosis.
+feedforward.integral_loop`, gain scaled so the crossover equals the compensation study's). The
+tracking error is the RMS of ``y - y_d`` after the start-up region [um].
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / \
     "smarthysteresis-piezo-1hz" / "piezo_1hz.csv"
@@ -50,8 +50,8 @@ def cases(quick: bool) -> list[dict]:
 def integral_gain(v: np.ndarray, y: np.ndarray) -> float:
     """``ki`` [input units / (output unit s)] that gives a stage of chord gain
     ``ptp(v) / ptp(y)`` the crossover of the compensation study's loop (``ki = 20 V/(um s)`` at
-    its stage's chord gain, :func:`pimodel.compensation.chord_gain`)."""
-    from pimodel.compensation import chord_gain
+    its stage's chord gain, :func:`pimodel.experiments.compensation.chord_gain`)."""
+    from pimodel.experiments.compensation import chord_gain
 
     return KI_COMPENSATION * float(np.ptp(v) / np.ptp(y)) / chord_gain()
 
@@ -59,19 +59,19 @@ def integral_gain(v: np.ndarray, y: np.ndarray) -> float:
 def _diagnosed(params: dict):
     """The stage, the validate input and the diagnosis, as ``tests/
     test_augmented_feedforward.py`` makes them."""
-    from pimodel.data import Record
     from pimodel.diagnosis import diagnose
+    from pimodel.records import Record
 
     effect, seed = params["effect"], params["seed"]
     if params["generator"] == "truth":
-        from pimodel.truth import excitation, random_truth
+        from pimodel.stages.pi_stage import excitation, random_truth
 
         truth = random_truth([effect], seed)
         tt, vt = excitation("train", seed=1)
         tv, vv = excitation("validate", seed=2)
         rep = diagnose([truth.record(tt, vt, 1)], [truth.record(tv, vv, 2)])
         return truth, tv, vv, rep
-    from pimodel.truth_alt import excitations, random_alt_truth
+    from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
     truth = random_alt_truth([effect], seed)
     (tt, vt), (tv, vv) = excitations(seed)
@@ -88,7 +88,7 @@ def _rms(e: np.ndarray, start: int) -> float:
 def _stage_case(params: dict) -> dict:
     from pimodel.diagnosis.feedforward import integral_loop
     from pimodel.diagnosis.where import startup_length
-    from pimodel.truth_steps import noise_free, stage_stepper
+    from pimodel.stages.stepper import noise_free, stage_stepper
 
     truth, t, v_ref, rep = _diagnosed(params)
     stage = noise_free(truth)
@@ -103,7 +103,7 @@ def _stage_case(params: dict) -> dict:
         model = rep.model(augmented=name == "augmented")
         ff = model.inverse().simulate(y_d)
         row["open"][name] = _rms(stage.simulate(t, ff, rng) - y_d, start)
-        # pimodel.truth's rate effect takes the step rule's range from the whole record
+        # pimodel.stages.pi_stage's rate effect takes the step rule's range from the whole record
         # (ptp(v)); the loop's input is known only at its end, so the loop is rerun with the
         # range it produced until the two agree (once or twice)
         span = float(np.ptp(ff))

@@ -10,17 +10,17 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from pimodel.actuators import stage_dynamics  # noqa: E402
-from pimodel.compensation import (  # noqa: E402
+from pimodel.experiments.compensation import (
     STAGE,
     chord_gain,
     compensation_table,
     identified_models,
     reference,
 )
-from pimodel.loops import run_loop  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
+from pimodel.loops.actuators import stage_dynamics  # noqa: E402
+from pimodel.loops.compiled import run_loop  # noqa: E402
 from pimodel.plotting import new_figure, save_figure  # noqa: E402
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
 
 
 def run(out: Path, quick: bool = False) -> StudyResult:

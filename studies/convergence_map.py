@@ -25,10 +25,10 @@ from pathlib import Path
 import numpy as np
 
 from pimodel import PIOperator, RadiusEstimator, estimate_radii
-from pimodel.estimator import stream_tail_average
-from pimodel.long_records import noisy_output_chunks, record_length
+from pimodel.experiments.studies import StudyResult, Table, study_main
+from pimodel.identification.adaptive.radius_estimator import stream_tail_average
 from pimodel.plotting import new_figure, save_figure
-from pimodel.study_runner import StudyResult, Table, study_main
+from pimodel.stages.long_records import noisy_output_chunks, record_length
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
 R = np.array([0.4, 1.0, 1.5, 2.0, 3.6])

@@ -13,11 +13,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from pimodel.compensation import STAGE  # noqa: E402
+from pimodel.experiments.compensation import STAGE  # noqa: E402
+from pimodel.experiments.fmu_comparison import compare_with_native, plot_comparison  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
 from pimodel.fmu import build_fmus  # noqa: E402
-from pimodel.fmu.compare import compare_with_native, plot_comparison  # noqa: E402
 from pimodel.fmu.cosim import LOOP_UNITS  # noqa: E402
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
 
 R0 = [0.0, 0.3, 0.4, 0.8]
 

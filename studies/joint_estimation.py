@@ -19,10 +19,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from pimodel import JointEstimator, PIOperator, estimate_jointly, stream_jointly  # noqa: E402
-from pimodel.long_records import noisy_output_chunks  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
 from pimodel.plotting import new_figure, save_figure  # noqa: E402
 from pimodel.signals import biased_staircase, sinusoid  # noqa: E402
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
+from pimodel.stages.long_records import noisy_output_chunks  # noqa: E402
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
 R = np.array([0.4, 1.0, 1.5, 2.0, 3.6])

@@ -24,19 +24,19 @@ from pathlib import Path
 import control
 import numpy as np
 
-from pimodel.actuators import stage_dynamics
-from pimodel.compensation import STAGE
-from pimodel.describing import (
+from pimodel.experiments.compensation import STAGE
+from pimodel.experiments.studies import StudyResult, Table, study_main
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import PID, run_loop
+from pimodel.loops.describing import (
     circle_criterion,
     harmonic_balance,
     residual_hysteresis,
     sector,
     static_gain,
 )
-from pimodel.loops import PID, run_loop
-from pimodel.operator import PIOperator
+from pimodel.operators.pi import PIOperator
 from pimodel.plotting import new_figure, save_figure
-from pimodel.study_runner import StudyResult, Table, study_main
 
 FS = 50_000.0  # Hz: 50 samples per period of the 1 kHz mode
 DT = 1.0 / FS

@@ -15,10 +15,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from pimodel import identify  # noqa: E402
-from pimodel.compensation import STAGE  # noqa: E402
+from pimodel.experiments.compensation import STAGE  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
 from pimodel.plotting import new_figure, save_figure  # noqa: E402
 from pimodel.signals import add_noise_snr, major_minor_loops, triangle  # noqa: E402
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
 
 PAPER_SLOPES = (6.3460, 8.0195, 9.1747, 9.6224)
 

@@ -18,11 +18,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from pimodel import PIOperator, RadiusEstimator, estimate_radii  # noqa: E402
-from pimodel.estimator import run_tail_average, stream_tail_average  # noqa: E402
-from pimodel.long_records import noisy_output_chunks, record_length  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
+from pimodel.identification.adaptive.radius_estimator import run_tail_average, stream_tail_average  # noqa: E402
 from pimodel.plotting import new_figure, save_figure  # noqa: E402
 from pimodel.signals import add_noise_snr, biased_staircase, sinusoid  # noqa: E402
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
+from pimodel.stages.long_records import noisy_output_chunks, record_length  # noqa: E402
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
 R = np.array([0.4, 1.0, 1.5, 2.0, 3.6])

@@ -13,8 +13,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from pimodel import identify, load_record  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
 from pimodel.plotting import new_figure, save_figure  # noqa: E402
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / \
     "smarthysteresis-piezo-1hz" / "piezo_1hz.csv"

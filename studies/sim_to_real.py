@@ -1,9 +1,9 @@
 """Study: sim-to-real gap diagnosis with withheld effects on two generators (confusion tables)
 and on the shared real piezo record.
 
-Generators: ``pimodel.truth`` (PI hysteresis, the same model family as the candidates) and the
-independently written ``pimodel.truth_alt`` (Preisach hysteresis, log-law creep, two modes,
-exponential static map, coloured noise; also effects outside the vocabulary that must come
+Generators: ``pimodel.stages.pi_stage`` (PI hysteresis, the same model family as the candidates) and
+the independently written ``pimodel.stages.preisach_stage`` (Preisach hysteresis, log-law creep, two
+modes, exponential static map, coloured noise; also effects outside the vocabulary that must come
 back "unexplained"). The diagnosis never sees the effect's name. Full size: 10 seeds per case;
 ``--quick``: 1 seed, single effects only.
 
@@ -26,9 +26,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from pimodel.data import Record  # noqa: E402
 from pimodel.diagnosis import diagnose  # noqa: E402
-from pimodel.study_runner import StudyResult, Table, study_main  # noqa: E402
+from pimodel.experiments.studies import StudyResult, Table, study_main  # noqa: E402
+from pimodel.records import Record  # noqa: E402
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / \
     "smarthysteresis-piezo-1hz" / "piezo_1hz.csv"
@@ -68,7 +68,7 @@ def _records(case: dict):
 def _stage_records(case: dict):
     seed, effects, clock = case["seed"], case["effects"], case["drift_clock"]
     if case["generator"] == "truth":
-        from pimodel.truth import excitation, random_truth
+        from pimodel.stages.pi_stage import excitation, random_truth
 
         tt, vt = excitation("train", seed=2 * seed + 1)
         tv, vv = excitation("validate", seed=2 * seed + 2)
@@ -76,7 +76,7 @@ def _stage_records(case: dict):
         truth = random_truth(effects, seed, drift_clock=clock)
         return [truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed,
                                                                    "validate")], "rest"
-    from pimodel.truth_alt import excitations, random_alt_truth
+    from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
     (tt, vt), (tv, vv) = excitations(seed + 1)
     truth = random_alt_truth(effects, seed, "absolute" if clock == "absolute" else "record")
@@ -159,9 +159,9 @@ def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) ->
         d["min_shrink"] = min(d["min_shrink"], float(r["shrink"]))
     out.mkdir(parents=True, exist_ok=True)
     (out / "cases.json").write_text(json.dumps(rows, indent=1, default=float))
-    for gen, title in (("truth", "pimodel.truth (PI family)"),
-                       ("truth_alt", "pimodel.truth_alt (independent: Preisach, log creep, "
-                                     "two modes, coloured noise)")):
+    for gen, title in (("truth", "pimodel.stages.pi_stage (PI family)"),
+                       ("truth_alt", "pimodel.stages.preisach_stage (independent: Preisach, "
+                                     "log creep, two modes, coloured noise)")):
         res.tables.append(Table(f"Withheld effects, {title}: right verdicts / cases, "
                                 "validate-gap shrink, verdicts",
                                 ["truth", "right", "min shrink", "median shrink", "verdicts"],

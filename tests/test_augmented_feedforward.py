@@ -4,11 +4,11 @@ on the true (simulated, noise-free) stage, on records where the diagnosis named 
 import numpy as np
 import pytest
 
-from pimodel.data import Record
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.feedforward import open_loop_rms
-from pimodel.truth import excitation, random_truth
-from pimodel.truth_alt import excitations, random_alt_truth
+from pimodel.records import Record
+from pimodel.stages.pi_stage import excitation, random_truth
+from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
 MIN_CUT = 2.0  # the issue's target: the augmented inverse cuts the RMS error at least 2x
 
@@ -34,8 +34,8 @@ def _case(generator: str, effect: str, seed: int):
 # truth_alt records start from negative saturation: the inverses start from the memory that
 # the first reference sample implies (the diagnosis' initial_state "unknown"); from rest, the
 # log-law creep carried the start-up error through the record (creep cuts 1.95x, 1.38x, 2.50x;
-# now 5.2x, 3.9x, 11.2x); rate: cuts 8.9x to 9.3x on pimodel.truth, 28x to 47x on truth_alt
-# (the fresh rate from the rate-free inverse, docs/diagnosis.md)
+# now 5.2x, 3.9x, 11.2x); rate: cuts 8.9x to 9.3x on pimodel.stages.pi_stage, 28x to 47x on
+# truth_alt (the fresh rate from the rate-free inverse, docs/diagnosis.md)
 @pytest.mark.slow
 @pytest.mark.parametrize("generator,effect,seed", [
     ("truth", "creep", 0), ("truth", "creep", 1), ("truth", "asymmetry", 0),

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from pimodel import PIOperator
-from pimodel.actuators import creep_lags, creep_per_decade, second_order_mode, stage_dynamics
 from pimodel.blocks import (
     adaptive_compensator_block,
     estimator_block,
@@ -17,10 +16,16 @@ from pimodel.blocks import (
     pid_block,
     radius_estimator,
 )
-from pimodel.compensation import STAGE, compensation_table, identified_models, reference
-from pimodel.loops import PID, loop_system, run_loop
+from pimodel.experiments.compensation import STAGE, compensation_table, identified_models, reference
+from pimodel.loops.actuators import (
+    creep_lags,
+    creep_per_decade,
+    second_order_mode,
+    stage_dynamics,
+)
+from pimodel.loops.compiled import PID, loop_system, run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid, triangle
-from pimodel.simulation import simulate
 
 DT = 1e-4
 

@@ -8,8 +8,7 @@ import control
 import numpy as np
 import pytest
 
-from pimodel.asymmetric import AsymmetricPI
-from pimodel.blocks_extra import (
+from pimodel.blocks.operators import (
     asymmetric_pi_block,
     block_initial_state,
     creep_block,
@@ -17,10 +16,11 @@ from pimodel.blocks_extra import (
     rate_dependent_inverse_block,
     rate_dependent_pi_block,
 )
-from pimodel.creep import CreepOperator
-from pimodel.envelopes import Envelope
-from pimodel.generalized import GeneralizedPI
-from pimodel.rate_dependent import RateDependentPI
+from pimodel.operators.asymmetric import AsymmetricPI
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.envelopes import Envelope
+from pimodel.operators.generalized import GeneralizedPI
+from pimodel.operators.rate_dependent import RateDependentPI
 
 DT = 1e-3
 T = np.arange(400) * DT
@@ -107,5 +107,5 @@ def test_block_errors():
         creep_block(GPI)
     with pytest.raises(ValueError, match="smallest base radius"):
         rate_dependent_inverse_block(RateDependentPI([1.0], [0.1], rate_gain=0.0, dt=DT))
-    with pytest.raises(TypeError, match="sys: expected a block of pimodel.blocks_extra"):
+    with pytest.raises(TypeError, match="sys: expected a block of pimodel.blocks.operators"):
         block_initial_state(control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], DT))

@@ -20,7 +20,7 @@ from pimodel.blocks import (
 )
 from pimodel.fmu import build_fmus
 from pimodel.fmu.block import fmu_block
-from pimodel.loops import run_loop
+from pimodel.loops.compiled import run_loop
 from pimodel.signals import sinusoid
 
 STAGE = PIOperator([6.3460, 1.6735, 1.1552, 0.4477], [0.0, 0.1945, 0.4826, 0.5707])

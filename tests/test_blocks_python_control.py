@@ -1,6 +1,6 @@
 """Every block, and the interconnections of the README, driven by plain
 ``control.input_output_response`` with ``initial_state=pimodel.blocks.initial_state(sys,
-params)``: equal to ``pimodel.simulation.simulate`` and to the C core (1e-12), from non-zero
+params)``: equal to ``pimodel.loops.simulation.simulate`` and to the C core (1e-12), from non-zero
 initial states and with non-default params."""
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import control
 import numpy as np
 import pytest
 
-import pimodel.blocks
-import pimodel.simulation
+import pimodel.blocks.framework
+import pimodel.blocks.pi
+import pimodel.loops.simulation
 from pimodel import PIOperator
-from pimodel.actuators import stage_dynamics
 from pimodel.blocks import (
     InitialStateWarning,
     adaptive_compensator_block,
@@ -26,9 +26,10 @@ from pimodel.blocks import (
     pid_block,
     radius_estimator,
 )
-from pimodel.loops import PID, loop_system, run_loop
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import PID, loop_system, run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid, triangle
-from pimodel.simulation import simulate
 
 DT = 1e-4
 STAGE = PIOperator([6.3460, 1.6735, 1.1552, 0.4477], [0.0, 0.1945, 0.4826, 0.5707])
@@ -279,7 +280,8 @@ def test_deprecated_names_still_work():
         close(res["pi_z2"], res["z[2]"])
 
 
-@pytest.mark.parametrize("module", [pimodel.blocks, pimodel.simulation])
+@pytest.mark.parametrize("module", [pimodel.blocks.framework, pimodel.blocks.pi,
+                                    pimodel.loops.simulation])
 def test_docstring_examples_run(module):
     failures, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
     assert tried > 0 and failures == 0

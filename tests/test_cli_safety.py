@@ -13,7 +13,7 @@ import pytest
 
 from pimodel import PIOperator, Record, load_record, save_record
 from pimodel.cli import main
-from pimodel.data import DataError
+from pimodel.records import DataError
 
 SIM = ["--weights", "1,0.5", "--radii", "0,0.2"]
 

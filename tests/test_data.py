@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pimodel import Record, load_record, save_record
-from pimodel.data import DataError
+from pimodel.records import DataError
 
 
 def make_record(n=50):

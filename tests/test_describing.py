@@ -8,8 +8,8 @@ import control
 import numpy as np
 import pytest
 
-from pimodel.compensation import STAGE
-from pimodel.describing import (
+from pimodel.experiments.compensation import STAGE
+from pimodel.loops.describing import (
     PIDescribingFunction,
     circle_criterion,
     harmonic_balance,
@@ -18,7 +18,7 @@ from pimodel.describing import (
     sector,
     static_gain,
 )
-from pimodel.operator import PIOperator
+from pimodel.operators.pi import PIOperator
 
 SIGNED = STAGE.inverse()  # signed weights, radii in um
 NO_LINEAR_PLAY = PIOperator([0.7, 0.2, 0.1], [0.05, 0.3, 0.8])

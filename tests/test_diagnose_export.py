@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from pimodel.cli import main
-from pimodel.data import save_record
 from pimodel.diagnosis.model import load_diagnosed_model
-from pimodel.models import load_model
-from pimodel.truth import excitation, random_truth
+from pimodel.model_files import load_model
+from pimodel.records import save_record
+from pimodel.stages.pi_stage import excitation, random_truth
 
 
 @pytest.fixture(scope="module")

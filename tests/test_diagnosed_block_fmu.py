@@ -30,7 +30,7 @@ from pimodel.fmu.build import source_dir
 from pimodel.fmu.model_fmu import cosimulate_chain
 from pimodel.fmu.operators import unit_parameters
 from pimodel.fmu.unit import FMUUnit
-from pimodel.models import load_model
+from pimodel.model_files import load_model
 
 sys.path.insert(0, str(Path(__file__).parent))
 from diagnosed_unit import run_unit, unit_file  # noqa: E402
@@ -245,11 +245,11 @@ def test_unit_with_more_than_64_plays(fmus, fmi):
 
 
 def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
-    """A rate model diagnosed on a ``pimodel.truth`` record (radii growing with the rate, 80
-    signed plays): the C stream on the whole validate record and the FMU unit on its first
+    """A rate model diagnosed on a ``pimodel.stages.pi_stage`` record (radii growing with the rate,
+    80 signed plays): the C stream on the whole validate record and the FMU unit on its first
     1500 samples equal simulate to 1e-12 (relative to the output's size)."""
     from pimodel.diagnosis import diagnose
-    from pimodel.truth import excitation, random_truth
+    from pimodel.stages.pi_stage import excitation, random_truth
 
     truth = random_truth(["rate"], 0)
     rec = truth.record(*excitation("validate", seed=2), 2)

@@ -7,7 +7,7 @@ import pytest
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.model import DiagnosedModel, load_diagnosed_model
 from pimodel.diagnosis.monotone import is_monotone, monotone_model
-from pimodel.truth import excitation, random_truth
+from pimodel.stages.pi_stage import excitation, random_truth
 
 N_ROUND_TRIP = 3000  # samples of the validate input in the round trips (the solve is per sample)
 

@@ -1,6 +1,7 @@
-"""Sim-to-real gap diagnosis on records of ``pimodel.truth``: withheld effects (generation and
-diagnosis kept apart: the effect name never reaches diagnose), a clean record, bad input, the
-CLI, and the real record. The independent generator is tested in ``test_diagnosis_alt.py``.
+"""Sim-to-real gap diagnosis on records of ``pimodel.stages.pi_stage``: withheld effects
+(generation and diagnosis kept apart: the effect name never reaches diagnose), a clean record, bad
+input, the CLI, and the real record. The independent generator is tested in
+``test_diagnosis_alt.py``.
 
 The unit suite runs one seed per effect and per pair; the full sweep (10 seeds per case) is
 ``studies/sim_to_real.py``."""
@@ -16,7 +17,7 @@ from pimodel import Record, save_record
 from pimodel.cli import main
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.effects import EFFECTS as CANDIDATES
-from pimodel.truth import EFFECTS, excitation, random_truth
+from pimodel.stages.pi_stage import EFFECTS, excitation, random_truth
 
 
 def records(effects, seed, drift_clock="record"):

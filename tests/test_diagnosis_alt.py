@@ -1,6 +1,6 @@
-"""Diagnosis on records of the independent generator ``pimodel.truth_alt`` (Preisach hysteresis,
-log-law creep, two modes, fractional delay, exponential static map, drift on the shared clock,
-coloured noise): withheld effects, a clean record, and effects outside the vocabulary (a dead
+"""Diagnosis on records of the independent generator ``pimodel.stages.preisach_stage`` (Preisach
+hysteresis, log-law creep, two modes, fractional delay, exponential static map, drift on the shared
+clock, coloured noise): withheld effects, a clean record, and effects outside the vocabulary (a dead
 zone, a second input the model does not see, Bouc-Wen hysteresis) that must be "unexplained".
 
 The records start from negative saturation, a memory the nominal model cannot know, so the
@@ -14,7 +14,7 @@ import pytest
 
 from pimodel import Record
 from pimodel.diagnosis import diagnose
-from pimodel.truth_alt import excitations, random_alt_truth
+from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
 
 def alt_records(effects, seed, drift_clock="absolute"):

@@ -1,6 +1,7 @@
 """A fitted ``dynamics`` that acts as a pure delay (``pimodel.diagnosis.delaylike``) gives way
 to ``delay``: the gain check against an independent frequency response, and the
-``pimodel.truth`` delay + drift case whose delay of one sample was named ``dynamics`` (three
+``pimodel.stages.pi_stage`` delay + drift case whose delay of one sample was named ``dynamics``
+(three
 fast modes) before the tie-break."""
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import pytest
 
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.delaylike import is_delay_like, lti_gain
-from pimodel.truth import excitation, random_truth
+from pimodel.stages.pi_stage import excitation, random_truth
 
 
 def test_gain_equals_the_zoh_frequency_response_of_python_control():

@@ -1,7 +1,7 @@
 """The ``drift`` candidate's levels per record (:mod:`pimodel.diagnosis.drift`): the out-of-fold
 level of a validate record, and records whose output levels differ (a sensor zeroed anew) found
-as ``drift`` on ``pimodel.truth`` records, with one and with two train records. The drift pairs
-and the clock variants on both generators are in ``test_diagnosis.py`` and
+as ``drift`` on ``pimodel.stages.pi_stage`` records, with one and with two train records. The drift
+pairs and the clock variants on both generators are in ``test_diagnosis.py`` and
 ``test_diagnosis_alt.py``."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import pytest
 from pimodel import Record
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.drift import describe_levels, drift_term, out_of_fold_level
-from pimodel.truth import excitation, random_truth
+from pimodel.stages.pi_stage import excitation, random_truth
 
 
 def test_out_of_fold_level_never_uses_its_own_block():

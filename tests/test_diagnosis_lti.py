@@ -19,8 +19,8 @@ from pimodel.diagnosis.lti import (
     lti_columns,
 )
 from pimodel.diagnosis.model import load_diagnosed_model
-from pimodel.truth import excitation, random_truth
-from pimodel.truth_alt import excitations, random_alt_truth
+from pimodel.stages.pi_stage import excitation, random_truth
+from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
 ONE_MODE_SHRINK_TODAY = 0.75  # truth_alt dynamics, seed 0, with the one-mode candidate
 

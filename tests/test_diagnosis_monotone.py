@@ -19,7 +19,7 @@ from pimodel.diagnosis.monotone import (
     monotone_model,
     monotone_weights,
 )
-from pimodel.operator import PIOperator
+from pimodel.operators.pi import PIOperator
 
 
 def _floor(weights) -> float:

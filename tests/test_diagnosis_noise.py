@@ -7,7 +7,7 @@ import numpy as np
 from scipy.signal import lfilter
 
 from pimodel.diagnosis.noise import measure_noise_floor, robust_std
-from pimodel.operator import PIOperator
+from pimodel.operators.pi import PIOperator
 
 FS = 10_000.0
 

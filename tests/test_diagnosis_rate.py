@@ -9,7 +9,7 @@ import pytest
 
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.rate import RateBasis, input_rate, rate_columns
-from pimodel.operator import PIOperator
+from pimodel.operators.pi import PIOperator
 
 DT = 1e-4
 RADII = np.linspace(0.0, 0.5, 6)
@@ -119,9 +119,9 @@ def test_model_inverse_of_rate_is_causal_and_close(family, gains):
 
 
 def test_inverse_of_an_instantaneous_rate_beats_ignoring_it():
-    """Radius family without a filter, gains as ``pimodel.truth``'s rate (linearised, the model
-    ``A v[k] + B' (v[k] - v[k-1])`` has its zero at ``z = B' / (A + B') = 2``, outside the unit
-    circle, so no exact causal inverse is stable): the inverse takes the fresh rate from the
+    """Radius family without a filter, gains as ``pimodel.stages.pi_stage``'s rate (linearised, the
+    model ``A v[k] + B' (v[k] - v[k-1])`` has its zero at ``z = B' / (A + B') = 2``, outside the
+    unit circle, so no exact causal inverse is stable): the inverse takes the fresh rate from the
     rate-free inverse and recovers the input about 3x better than that inverse (measured 0.005
     against 0.016 RMS; a rate held from sample k - 1 oscillated here, 0.031), and leaves about
     a quarter of the rate term in the round trip (held: 1.1 times it)."""

@@ -2,8 +2,9 @@
 ``pimodel.diagnosis.wiener``): its filter and approximate inverse against python-control, the
 diagnosed model's forward form, inverse and its stream on the C core, and the verdict on stages
 whose amplifier low-passes the input (written here, independently of the candidate library:
-the filter by python-control's zero-order hold, then the PI stage of ``pimodel.truth`` or the
-Preisach stage of ``pimodel.truth_alt``)."""
+the filter by python-control's zero-order hold, then the PI stage of ``pimodel.stages.pi_stage`` or
+the
+Preisach stage of ``pimodel.stages.preisach_stage``)."""
 
 from __future__ import annotations
 
@@ -17,9 +18,9 @@ from pimodel.blocks import initial_state
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.model import DiagnosedModel, load_diagnosed_model
 from pimodel.diagnosis.wiener import inverse_prefilter, prefilter, search_filter
-from pimodel.operator import PIOperator
-from pimodel.truth import excitation, random_truth, zoh_coefficients
-from pimodel.truth_alt import excitations, random_alt_truth
+from pimodel.operators.pi import PIOperator
+from pimodel.stages.pi_stage import excitation, random_truth, zoh_coefficients
+from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
 TAU = 1 / (2 * np.pi * 300.0)  # a 300 Hz first-order low-pass [s]
 
@@ -104,7 +105,8 @@ def test_stream_and_inverse_block_run_the_filter():
 
 
 def truth_driver_records(seed: int):
-    """A ``pimodel.truth`` PI stage (no other effect) behind an amplifier with a first-order
+    """A ``pimodel.stages.pi_stage`` PI stage (no other effect) behind an amplifier with a
+    first-order
     bandwidth of 150-600 Hz (seeded)."""
     rng = np.random.default_rng(8000 + seed)
     fc = rng.uniform(150.0, 600.0)
@@ -120,7 +122,8 @@ def truth_driver_records(seed: int):
 
 
 def alt_driver_records(seed: int):
-    """A ``pimodel.truth_alt`` Preisach stage behind a second-order low-pass (a driver with
+    """A ``pimodel.stages.preisach_stage`` Preisach stage behind a second-order low-pass (a driver
+    with
     two poles, 200-500 Hz, damping 0.5-1.2, seeded)."""
     rng = np.random.default_rng(9000 + seed)
     w, zeta = 2 * np.pi * rng.uniform(200.0, 500.0), rng.uniform(0.5, 1.2)

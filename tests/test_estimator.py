@@ -12,17 +12,17 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from pimodel import PIOperator
-from pimodel.estimator import (
+from pimodel.identification.adaptive.radius_estimator import (
     RadiusEstimator,
     estimate_radii,
     project_ordered,
     run_tail_average,
     stream_tail_average,
 )
-from pimodel.estimator_reference import estimate_radii_reference, project_ordered_reference
-from pimodel.estimator_settings import default_settings
-from pimodel.long_records import noisy_output_chunks, record_length
+from pimodel.identification.adaptive.settings import default_settings
+from pimodel.reference.radius_estimator import estimate_radii_reference, project_ordered_reference
 from pimodel.signals import add_noise_snr, biased_staircase, sinusoid, triangle
+from pimodel.stages.long_records import noisy_output_chunks, record_length
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
 R = np.array([0.4, 1.0, 1.5, 2.0, 3.6])

@@ -15,8 +15,8 @@ import pytest
 from pimodel import PIOperator, estimate_radii
 from pimodel.blocks import estimator_block
 from pimodel.fmu.unit import FMUUnit
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid
-from pimodel.simulation import simulate
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
 R = np.array([0.4, 1.0, 1.5, 2.0, 3.6])

@@ -1,4 +1,4 @@
-"""The health checks of a radius estimate (pimodel.estimator_health) run in the C core
+"""The health checks of a radius estimate (pimodel.identification.adaptive.health) run in the C core
 (fmu/src/pim_est_health.c), the code the RadiusEstimator FMU runs: the still-moving check's
 quarters are exact up to 64 rows and on a grid within N / 32 rows beyond."""
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pimodel._native import HEALTH_FIT, HEALTH_MERGED, HEALTH_MOVING, HEALTH_PINNED, health_checks
-from pimodel.estimator_health import estimator_health
+from pimodel.identification.adaptive.health import estimator_health
 
 
 def exact_drift(hist: np.ndarray) -> float:
@@ -65,7 +65,7 @@ def test_fit_check_of_the_core_matches_the_python_report():
     estimate_radii's own run: the RMS over the last quarter is Python's exactly up to 64 rows,
     and its noise bound is within 5 % of Python's (median based) on a noisy record."""
     from pimodel import PIOperator, estimate_radii
-    from pimodel.estimator_settings import noise_level
+    from pimodel.identification.adaptive.settings import noise_level
     from pimodel.signals import add_noise_snr, sinusoid
 
     p, r = np.array([0.3, 0.5, 0.8]), np.array([0.4, 1.0, 1.5])

@@ -1,5 +1,5 @@
 """Identification of the generalized, rate-dependent and creep operators on records from
-generators written independently of the models: ``pimodel.truth`` (another module's PI +
+generators written independently of the models: ``pimodel.stages.pi_stage`` (another module's PI +
 quadratic asymmetry + creep lags discretised by python-control) and plain loops in this file."""
 
 from __future__ import annotations
@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 
 from pimodel import PIOperator
-from pimodel.actuators import creep_per_decade
-from pimodel.fit_operators import (
+from pimodel.identification.extended_operators import (
     fit_asymmetric,
     fit_creep,
     fit_generalized,
     fit_rate_dependent,
 )
-from pimodel.truth import STAGE_RADII, STAGE_WEIGHTS, Truth, excitation
+from pimodel.loops.actuators import creep_per_decade
+from pimodel.stages.pi_stage import STAGE_RADII, STAGE_WEIGHTS, Truth, excitation
 
 
 def _scored_rms(pred, y, v):
@@ -24,7 +24,8 @@ def _scored_rms(pred, y, v):
     return float(np.sqrt(np.mean((pred[k0:] - y[k0:]) ** 2)))
 
 
-# -- generalized: asymmetry from pimodel.truth (quadratic output term) ----------------------
+# -- generalized: asymmetry from pimodel.stages.pi_stage (quadratic output term)
+# ----------------------
 
 @pytest.mark.parametrize(("asymmetry", "seed"), [(0.06, 0), (-0.04, 1)])
 def test_generalized_fit_recovers_truth_asymmetry(asymmetry, seed):
@@ -168,7 +169,8 @@ def test_rate_dependent_fit_from_several_rates(rate_time_constant):
                                    atol=1e-9)
 
 
-# -- creep: pimodel.truth's creep lags on step/hold records -----------------------------------
+# -- creep: pimodel.stages.pi_stage's creep lags on step/hold records
+# -----------------------------------
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_creep_fit_from_holds(seed):
@@ -227,7 +229,7 @@ def _tracking_rms(truth, inverse, y_train):
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_feedforward_asymmetry_cuts_tracking_error(seed):
-    from pimodel.truth import random_truth
+    from pimodel.stages.pi_stage import random_truth
 
     truth = random_truth(["asymmetry"], seed)
     t, v = excitation("train", seed=seed)
@@ -242,10 +244,10 @@ def test_feedforward_asymmetry_cuts_tracking_error(seed):
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_feedforward_creep_cuts_tracking_error(seed):
-    from pimodel.cascade import Cascade
-    from pimodel.creep import CreepOperator
-    from pimodel.fit_operators import fit_hysteresis_with_creep
-    from pimodel.truth import random_truth
+    from pimodel.identification.extended_operators import fit_hysteresis_with_creep
+    from pimodel.operators.cascade import Cascade
+    from pimodel.operators.creep import CreepOperator
+    from pimodel.stages.pi_stage import random_truth
 
     truth = random_truth(["creep"], seed)
     t, v = excitation("train", seed=seed)

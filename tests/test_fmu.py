@@ -15,14 +15,14 @@ import pytest
 from fmpy.validation import validate_fmu
 
 from pimodel import PIOperator, RadiusEstimator, estimate_radii
-from pimodel.actuators import stage_dynamics
 from pimodel.fmu import MODELS
 from pimodel.fmu.block import fmu_block
 from pimodel.fmu.cosim import cosimulate_adaptive_loop
 from pimodel.fmu.unit import FMUUnit
-from pimodel.loops import loop_system, run_loop
+from pimodel.loops.actuators import stage_dynamics
+from pimodel.loops.compiled import loop_system, run_loop
+from pimodel.loops.simulation import simulate
 from pimodel.signals import sinusoid, triangle
-from pimodel.simulation import simulate
 
 P, R = [1.0, 0.5, 0.3], [0.0, 0.2, 0.6]
 STAGE = PIOperator([6.3460, 1.6735, 1.1552, 0.4477], [0.0, 0.1945, 0.4826, 0.5707])

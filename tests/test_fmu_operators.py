@@ -20,17 +20,17 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
-from pimodel.asymmetric import AsymmetricPI
-from pimodel.cascade import Cascade
-from pimodel.creep import CreepOperator
-from pimodel.envelopes import Envelope
 from pimodel.fmu.build import NMAX
 from pimodel.fmu.model_fmu import build_model_fmus, cosimulate_chain
 from pimodel.fmu.operators import unit_parameters
 from pimodel.fmu.unit import FMUUnit
-from pimodel.generalized import GeneralizedPI
-from pimodel.models import load_model, model_from_dict, model_to_dict, save_model
-from pimodel.rate_dependent import RateDependentPI
+from pimodel.model_files import load_model, model_from_dict, model_to_dict, save_model
+from pimodel.operators.asymmetric import AsymmetricPI
+from pimodel.operators.cascade import Cascade
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.envelopes import Envelope
+from pimodel.operators.generalized import GeneralizedPI
+from pimodel.operators.rate_dependent import RateDependentPI
 
 sys.path.insert(0, str(Path(__file__).parent))
 from fmu_driver import StateHeader, UnitPrefix, fnv1a  # noqa: E402

@@ -97,23 +97,29 @@ def test_no_value_reference_typed_in_c():
 
 
 def _python_sources() -> list[Path]:
-    return sorted((ROOT / "pimodel" / "fmu").rglob("*.py"))
+    return sorted((ROOT / "pimodel").rglob("*.py"))
 
 
 def test_no_limit_typed_in_python():
-    """pimodel/fmu (and the LIMITS section of pimodel/_native.py) type no C limit: no name like
-    NMAX / MAX_* / *_WIN / *_TOL bound to a number, and no limit's value next to such a name."""
-    limit_name = r"\w*(?:NMAX|MAX|LIMIT|WIN|TOL|SUBSTEPS)\w*"
-    assign = re.compile(rf"^\s*({limit_name})\s*(?::[^=]+)?=\s*[-+\d.(]")
-    values = "|".join(sorted({str(v) for v in LIMITS.values() if isinstance(v, int)
-                              and v > 2}, key=len, reverse=True))
-    near = re.compile(rf"\b{limit_name}\b[^\n#]{{0,20}}\b({values})\b")
-    native = (ROOT / "pimodel" / "_native.py").read_text()
-    texts = {f: f.read_text() for f in _python_sources()}
-    texts[ROOT / "pimodel" / "_native.py"] = native[native.index("# -- LIMITS"):]
-    hits = [f"{f.relative_to(ROOT)}:{i}: {line.strip()}"
-            for f, text in texts.items() for i, line in enumerate(text.splitlines(), 1)
-            if assign.search(line) or near.search(line.replace("_", ""))]
+    """pimodel types no C limit or code: no constant bound to a number beside a C name
+    (``X = 64  # PIM_MAX_PLAYS``), and no limit-like name (NMAX, MAX_PLAYS, *_BINS, *_SECTIONS,
+    ...) bound to a C limit's value. The C core exports them: ``pimodel._native.LIMITS``."""
+    constant = re.compile(r"^\s*[A-Z_][A-Z0-9_]*(?:\s*,\s*[A-Z_][A-Z0-9_]*)*\s*(?::[^=]+)?="
+                          r"\s*[-+(]?\s*(\d[\d_.e+-]*)")
+    c_name = re.compile(r"PIM_[A-Z_]+|pim_\w+\.h|fmu/src")
+    limit_like = re.compile(r"NMAX|MAX_(?:PLAYS|LAGS|DYN|DELAY|ORDER|ELEMENTS|SECTIONS|LATENCY|"
+                            r"SUBSTEPS)|WINDOW|WIN\b|BINS|CHECKPOINTS")
+    values = {float(v) for v in LIMITS.values()}
+    hits = []
+    for f in _python_sources():
+        for i, line in enumerate(f.read_text().splitlines(), 1):
+            m = constant.match(line)
+            if not m:
+                continue
+            value = float(m.group(1).replace("_", "").rstrip("."))
+            if c_name.search(line) or (limit_like.search(line.split("=")[0])
+                                       and value in values):
+                hits.append(f"{f.relative_to(ROOT)}:{i}: {line.strip()}")
     assert not hits, hits
 
 
@@ -121,7 +127,10 @@ def test_limits_are_the_c_header():
     """LIMITS holds every limit of pim_limits.h, with the value the compiler sees."""
     header = (source_dir() / "core" / "pim_limits.h").read_text()
     defined = set(re.findall(r"^#define (PIM_\w+) ", header, flags=re.M)) - {"PIM_LIMITS_H"}
-    assert defined == set(LIMITS)
+    codes = set(re.findall(r"X\((PIM_(?:LAW|ENV)_\w+), 1\)", header))
+    assert codes == {"PIM_LAW_DATA", "PIM_LAW_PAPER", "PIM_ENV_POLY2", "PIM_ENV_TANH",
+                     "PIM_ENV_POLY2_INV", "PIM_ENV_TANH_INV"}
+    assert defined | codes == set(LIMITS)
     for name, literal in re.findall(r"^#define (PIM_\w+) ([\d.e+-]+)(?:LL)?\s", header, re.M):
         assert LIMITS[name] == float(literal), name
     assert LIMITS["PIM_DIAG_MAX_PLAYS"] == 2 * LIMITS["PIM_MAX_PLAYS"]

@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from pimodel import PIOperator, estimate_radii, identify, load_record
-from pimodel.data import DataError
+from pimodel.records import DataError
 
 RUNS: collections.Counter = collections.Counter()
 

@@ -10,7 +10,7 @@ import pytest
 
 from pimodel import PIOperator, Record, check_excitation, identify, identify_slopes, save_record
 from pimodel.cli import main
-from pimodel.conventional import fit_conventional
+from pimodel.identification.conventional import fit_conventional
 from pimodel.signals import add_noise_snr, major_minor_loops, triangle
 
 STAGE = PIOperator([6.3460, 1.6735, 1.1552, 0.4477], [0.0, 0.1945, 0.4826, 0.5707])

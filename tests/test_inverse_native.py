@@ -3,7 +3,7 @@
 batch ``DiagnosedInverse.simulate`` delayed by the latency, to 1e-9: each static effect alone and
 together, dynamics with a further element, whole and fractional delays, a folding model (the
 monotone projection), a start from the unknown memory, and models diagnosed on records of
-``pimodel.truth`` and ``pimodel.truth_alt``.
+``pimodel.stages.pi_stage`` and ``pimodel.stages.preisach_stage``.
 
 Every reference here is reachable, and where a solve has several roots the nearest the branch
 guess is nearer than the next by more than 1e-6 (asserted on the Python solver), so no tie of
@@ -17,14 +17,14 @@ import numpy as np
 import pytest
 
 import pimodel.diagnosis.inverse_stream as inverse_stream
-from pimodel.data import Record
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.inverse_native import NativeInverse, inverse_fmu_parameters
 from pimodel.diagnosis.inverse_stream import _InverseStream, inverse_latency
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.monotone import is_monotone
-from pimodel.truth import excitation, random_truth
-from pimodel.truth_alt import excitations, random_alt_truth
+from pimodel.records import Record
+from pimodel.stages.pi_stage import excitation, random_truth
+from pimodel.stages.preisach_stage import excitations, random_alt_truth
 
 DT = 1e-3
 RADII = [0.0, 0.1, 0.3, 0.6, 0.9, 1.2]

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from pimodel import JointEstimator, PIOperator, estimate_jointly, identify, stream_jointly
-from pimodel.branches import ReversalScanner, find_reversals
-from pimodel.long_records import noisy_output_chunks
-from pimodel.play_reduction import reduce_plays
+from pimodel.identification.branches import ReversalScanner, find_reversals
+from pimodel.identification.play_reduction import reduce_plays
 from pimodel.signals import biased_staircase, sinusoid
+from pimodel.stages.long_records import noisy_output_chunks
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
 R = np.array([0.4, 1.0, 1.5, 2.0, 3.6])

@@ -6,8 +6,12 @@ import numpy as np
 import pytest
 
 from pimodel import PIOperator
-from pimodel.estimator import RadiusEstimator, run_tail_average, stream_tail_average
-from pimodel.long_records import noisy_output_chunks, record_length
+from pimodel.identification.adaptive.radius_estimator import (
+    RadiusEstimator,
+    run_tail_average,
+    stream_tail_average,
+)
+from pimodel.stages.long_records import noisy_output_chunks, record_length
 
 P = np.array([0.3, 0.5, 0.8, 0.3, 0.2])
 R = np.array([0.4, 1.0, 1.5, 2.0, 3.6])

@@ -3,7 +3,8 @@ has more than one mode (or a low-pass, a direct term; ``lti_elements``, ``lti_ga
 :mod:`pimodel.diagnosis.lti`) streams sample by sample as the runner, the python-control block
 and the DiagnosedModel FMU (FMI 2 and 3), each equal to ``DiagnosedModel.simulate`` to 1e-12;
 malformed elements are refused with the element named (ValueError in Python, a logged
-fmi2Error/fmi3Error in the FMU). The end-to-end test on a diagnosed ``pimodel.truth_alt``
+fmi2Error/fmi3Error in the FMU). The end-to-end test on a diagnosed
+``pimodel.stages.preisach_stage``
 two-mode stage is in ``tests/test_diagnosis_lti.py``."""
 
 from __future__ import annotations

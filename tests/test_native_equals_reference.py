@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from pimodel import PIOperator, TimeDependentPI, estimate_radii
-from pimodel.estimator_reference import estimate_radii_reference
-from pimodel.reference import pi_inverse_reference, pi_reference, tdpi_reference
+from pimodel.reference.operators import pi_inverse_reference, pi_reference, tdpi_reference
+from pimodel.reference.radius_estimator import estimate_radii_reference
 
 
 @pytest.mark.parametrize("seed", range(5))

@@ -1,4 +1,4 @@
-"""The streaming-state contract the operator classes share (pimodel/_operator_base.py): stepping
+"""The streaming-state contract the operator classes share (pimodel/operators/base.py): stepping
 equals simulating, simulate leaves the streaming state alone, reset restores it, a failed step
 changes nothing, parameters are read-only copies, and each class documents its own members."""
 
@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from pimodel import PIOperator
-from pimodel.asymmetric import AsymmetricPI
-from pimodel.creep import CreepOperator
-from pimodel.envelopes import Envelope
-from pimodel.generalized import GeneralizedPI
-from pimodel.rate_dependent import RateDependentPI
+from pimodel.operators.asymmetric import AsymmetricPI
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.envelopes import Envelope
+from pimodel.operators.generalized import GeneralizedPI
+from pimodel.operators.rate_dependent import RateDependentPI
 
 FORWARD = {
     "PIOperator": lambda: PIOperator([1.0, 0.5, 0.3], [0.0, 0.2, 0.5], initial_state=0.1),

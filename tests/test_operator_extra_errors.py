@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pimodel.creep import CreepOperator
-from pimodel.envelopes import Envelope
-from pimodel.generalized import GeneralizedPI
-from pimodel.rate_dependent import RateDependentPI
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.envelopes import Envelope
+from pimodel.operators.generalized import GeneralizedPI
+from pimodel.operators.rate_dependent import RateDependentPI
 
 
 @pytest.mark.parametrize(
@@ -40,7 +40,8 @@ def test_generalized_errors():
         op.simulate([0.0, 20.0])
     with pytest.raises(ValueError, match="v: sample 0 is nan"):
         op.simulate([np.nan])
-    with pytest.raises(TypeError, match="input_envelope: expected a pimodel.envelopes.Envelope"):
+    with pytest.raises(TypeError, match="input_envelope: expected a "
+                       "pimodel.operators.envelopes.Envelope"):
         GeneralizedPI([1.0], [0.0], input_envelope=np.tanh)
     with pytest.raises(ValueError, match=r"radii: radius 2 \(counted from 1\) is -0.1"):
         GeneralizedPI([1.0, 1.0], [0.0, -0.1])
@@ -79,7 +80,11 @@ def test_creep_errors():
 
 
 def test_fit_errors():
-    from pimodel.fit_operators import fit_creep, fit_generalized, fit_rate_dependent
+    from pimodel.identification.extended_operators import (
+        fit_creep,
+        fit_generalized,
+        fit_rate_dependent,
+    )
 
     v = np.sin(np.linspace(0, 10, 200))
     with pytest.raises(ValueError, match="v and y: expected equal lengths, got 200 and 199"):
@@ -103,7 +108,7 @@ def test_fit_errors():
 
 
 def test_asymmetric_errors():
-    from pimodel.asymmetric import AsymmetricPI
+    from pimodel.operators.asymmetric import AsymmetricPI
 
     with pytest.raises(ValueError, match="direct_weight: expected a finite number > 0"):
         AsymmetricPI(0.0, [1.0], [0.1])
@@ -113,7 +118,7 @@ def test_asymmetric_errors():
         AsymmetricPI(1.0, [1.0], [0.1], descending=(1.0,))
     with pytest.raises(ValueError, match="weights: weight 2 is negative"):
         AsymmetricPI(1.0, [1.0, -1.0], [0.1, 0.2])
-    with pytest.raises(TypeError, match="shape: expected a pimodel.envelopes.Envelope"):
+    with pytest.raises(TypeError, match="shape: expected a pimodel.operators.envelopes.Envelope"):
         AsymmetricPI(1.0, [1.0], [0.1], shape=np.tanh)
     op = AsymmetricPI(1.0, [0.5], [0.1], shape=Envelope.tanh(1.0, 1.0))
     # the output saturates at p0 + 0.5 (1 + 0.1) = 1.55: a larger y_d has no input
@@ -124,7 +129,7 @@ def test_asymmetric_errors():
 def test_to_dict_is_json_and_rebuilds_the_operator():
     import json
 
-    from pimodel.asymmetric import AsymmetricPI
+    from pimodel.operators.asymmetric import AsymmetricPI
 
     v = np.sin(np.linspace(0, 9, 300)) * 2
     gpi = GeneralizedPI([1.0, 0.5], [0.0, 0.3], input_envelope=Envelope.tanh(3, 0.3))

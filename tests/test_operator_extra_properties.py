@@ -8,10 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pimodel import PIOperator
-from pimodel.creep import CreepOperator
-from pimodel.envelopes import Envelope
-from pimodel.generalized import GeneralizedPI
-from pimodel.rate_dependent import RateDependentPI
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.envelopes import Envelope
+from pimodel.operators.generalized import GeneralizedPI
+from pimodel.operators.rate_dependent import RateDependentPI
 
 V_MAX = 5.0
 finite = st.floats(-V_MAX, V_MAX, allow_nan=False, allow_infinity=False)
@@ -224,7 +224,7 @@ def test_creep_is_linear(cr, u, a):
 
 @st.composite
 def asymmetric(draw):
-    from pimodel.asymmetric import AsymmetricPI
+    from pimodel.operators.asymmetric import AsymmetricPI
 
     p, r = draw(pi_parts(linear_play=False))
     shape = draw(st.sampled_from([None, Envelope.tanh(3.0, 0.3, 0.2), Envelope.poly2(0, 1, 0.05)]))
@@ -255,7 +255,7 @@ def test_asymmetric_wiping_out(op, amp, frac_down):
 
 @given(pi_parts(linear_play=False), st.floats(0.05, 2), signals)
 def test_asymmetric_with_equal_envelopes_is_generalized_pi(parts, p0, v):
-    from pimodel.asymmetric import AsymmetricPI
+    from pimodel.operators.asymmetric import AsymmetricPI
 
     p, r = parts
     shape = Envelope.tanh(2.0, 0.3)

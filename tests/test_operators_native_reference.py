@@ -1,16 +1,17 @@
 """The C core of the generalized, rate-dependent and creep operators equals the NumPy/SciPy
-references of :mod:`pimodel.reference_operators` to 1e-12 (relative to the signal scale)."""
+references of :mod:`pimodel.reference.extended_operators` to 1e-12 (relative to the signal
+scale)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from pimodel.creep import CreepOperator
-from pimodel.envelopes import Envelope
-from pimodel.generalized import GeneralizedPI
-from pimodel.rate_dependent import RateDependentPI
-from pimodel.reference_operators import (
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.envelopes import Envelope
+from pimodel.operators.generalized import GeneralizedPI
+from pimodel.operators.rate_dependent import RateDependentPI
+from pimodel.reference.extended_operators import (
     creep_inverse_reference,
     creep_reference,
     gpi_reference,
@@ -112,8 +113,8 @@ def test_streaming_equals_batch():
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("shape", [Envelope.identity(), Envelope.tanh(3.0, 0.3, 0.2, 0.1)])
 def test_asymmetric_equals_reference(seed, shape):
-    from pimodel.asymmetric import AsymmetricPI
-    from pimodel.reference_operators import asym_inverse_reference, asym_reference
+    from pimodel.operators.asymmetric import AsymmetricPI
+    from pimodel.reference.extended_operators import asym_inverse_reference, asym_reference
 
     rng = np.random.default_rng(seed)
     n = 5

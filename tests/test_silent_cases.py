@@ -11,8 +11,8 @@ import pytest
 
 from pimodel import PIOperator, Record, identify
 from pimodel.cli import main
-from pimodel.data import save_record
-from pimodel.identify import MAX_REPEATED_SAMPLES
+from pimodel.identification.chain import MAX_REPEATED_SAMPLES
+from pimodel.records import save_record
 from pimodel.signals import sinusoid
 
 

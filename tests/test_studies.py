@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pimodel.cli import main
-from pimodel.study_runner import available_studies, run_study
+from pimodel.experiments.studies import available_studies, run_study
 
 
 def test_all_studies_are_listed():
@@ -82,9 +82,10 @@ def test_sim_to_real(tmp_path):
 @pytest.mark.slow
 def test_augmented_feedforward(tmp_path):
     """Quick size: every case gives a complete table row with finite errors, the figure is
-    written, and on ``pimodel.truth`` the augmented inverse tracks better than the nominal one
+    written, and on ``pimodel.stages.pi_stage`` the augmented inverse tracks better than the nominal
+    one
     (open loop) wherever the verdict names asymmetry or creep."""
-    from pimodel.study_runner import load_study
+    from pimodel.experiments.studies import load_study
 
     res = _run("augmented_feedforward", tmp_path)
     out = tmp_path / "augmented_feedforward"
@@ -111,11 +112,11 @@ def test_augmented_feedforward(tmp_path):
 
 def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
     """A rerun of a sweep study loads its finished cases instead of computing them."""
-    from pimodel.study_runner import load_study
+    from pimodel.experiments.studies import load_study
 
     first = run_study("paper_simulation", tmp_path, quick=True, workers=0)
     module = load_study("paper_simulation")
-    monkeypatch.setattr("pimodel.study_runner.load_study", lambda name: module)
+    monkeypatch.setattr("pimodel.experiments.studies.load_study", lambda name: module)
     monkeypatch.setattr(module, "run_case", lambda params: pytest.fail(f"recomputed {params}"))
     again = run_study("paper_simulation", tmp_path, quick=True, workers=0)
     assert again.to_json() == first.to_json()

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from pimodel.cli import main
-from pimodel.sweep import (
+from pimodel.experiments.sweeps import (
     WORKER_ENV,
     CaseFailed,
     case_key,
@@ -54,7 +54,7 @@ def test_serial_results_in_case_order_and_json_plain(tmp_path):
 def test_serial_run_does_not_import_dask():
     code = textwrap.dedent("""
         import sys
-        from pimodel.sweep import run_cases
+        from pimodel.experiments.sweeps import run_cases
         assert run_cases(lambda p: p["x"] + 1, [{"x": 1}], workers=0, progress=False) == [2]
         print(sorted(m for m in sys.modules if m.split(".")[0] in ("dask", "distributed")))
     """)
@@ -120,7 +120,7 @@ def test_killed_sweep_resumes_with_only_the_missing_cases(tmp_path):
     log, cache = tmp_path / "log", tmp_path / "cases"
     script = textwrap.dedent(f"""
         import os, signal
-        from pimodel.sweep import run_cases
+        from pimodel.experiments.sweeps import run_cases
 
         def case(p):
             with open({str(log)!r}, "a") as fh:
@@ -267,7 +267,7 @@ def scheduler():
 
 @pytest.mark.slow
 def test_cluster_gives_the_serial_numbers_in_case_order(tmp_path, scheduler):
-    from pimodel.truth_sweep import truth_sweep
+    from pimodel.experiments.stage_sweeps import truth_sweep
 
     cases = [{**c, "n_plays": 4} for c in grid(noise_um=[0.005, 0.02], seed=[0, 1, 2])]
     serial = truth_sweep(cases, target="identify", out=tmp_path / "s", workers=0,

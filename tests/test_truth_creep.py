@@ -5,8 +5,8 @@ single polynomial transfer function failed both, docs/design-notes.md)."""
 import numpy as np
 import pytest
 
-from pimodel.truth import CREEP_DECADES, CREEP_T_MIN, Truth, creep_lag_filters
-from pimodel.truth_steps import stage_stepper
+from pimodel.stages.pi_stage import CREEP_DECADES, CREEP_T_MIN, Truth, creep_lag_filters
+from pimodel.stages.stepper import stage_stepper
 
 FS = 10_000.0
 PERCENT = 1.5

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from pimodel.diagnosis.feedforward import integral_loop
-from pimodel.truth import EFFECTS, Truth, excitation, random_truth
-from pimodel.truth_alt import AltTruth, excitations, random_alt_truth
-from pimodel.truth_steps import noise_free, stage_stepper
+from pimodel.stages.pi_stage import EFFECTS, Truth, excitation, random_truth
+from pimodel.stages.preisach_stage import AltTruth, excitations, random_alt_truth
+from pimodel.stages.stepper import noise_free, stage_stepper
 
 
 def _stepped(truth, t, v):

@@ -105,7 +105,7 @@ def test_stream_without_delay_and_from_a_nonzero_start():
     # y[k] = sum_i w_i Gamma_{r_i}[F[v]][k] + offset + the terms of h0 (the plays of v)
     only = replace(m, effects=("dynamics",))
     x = prefilter(v, FILTERS["lowpass_then_mode"], DT)
-    from pimodel.operator import PIOperator
+    from pimodel.operators.pi import PIOperator
 
     ref = PIOperator(np.ones(5), RADII).play_outputs(x) @ m.weights + m.offset
     assert np.max(np.abs(stream_simulate(only, v, t) - ref)) < 1e-12
@@ -295,11 +295,11 @@ def _diagnosed(stage: str):
 
     from pimodel.diagnosis import diagnose
 
-    if stage == "truth_lowpass":  # pimodel.truth PI behind a first-order driver
+    if stage == "truth_lowpass":  # pimodel.stages.pi_stage PI behind a first-order driver
         train, validate, _ = truth_driver_records(0)
         return diagnose(train, validate).model(augmented=True), validate[0]
-    # pimodel.truth_alt Preisach behind a second-order low-pass (seed 1: the diagnosis fits a
-    # mode of damping above 1)
+    # pimodel.stages.preisach_stage Preisach behind a second-order low-pass (seed 1: the diagnosis
+    # fits a mode of damping above 1)
     train, validate = alt_driver_records(1)
     return diagnose(train, validate, initial_state="unknown").model(augmented=True), validate[0]
 
@@ -339,8 +339,8 @@ def test_diagnose_export_writes_a_wiener_fmu(tmp_path):
     from test_diagnosis_wiener import truth_driver_records
 
     from pimodel.cli import main
-    from pimodel.data import save_record
     from pimodel.diagnosis.model import load_diagnosed_model
+    from pimodel.records import save_record
 
     train, validate, _ = truth_driver_records(0)
     paths = [save_record(r, tmp_path / f"{name}.csv")

@@ -7,6 +7,8 @@ import argparse
 import importlib
 import sys
 
+__all__ = ["COMMANDS", "build_parser", "main"]
+
 COMMANDS = ["simulate", "identify", "fmu", "diagnose", "demo", "study", "sweep"]
 
 

@@ -7,6 +7,14 @@ import os
 import warnings
 from pathlib import Path
 
+__all__ = [
+    "add_columns_option",
+    "column_names",
+    "float_list",
+    "refuse_overwrite",
+    "unique_name",
+]
+
 
 def float_list(text: str) -> list[float]:
     """Parse ``"1,2.5,3"`` (commas or spaces) into floats, for argparse ``type=``."""

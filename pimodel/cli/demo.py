@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+__all__ = [
+    "register",
+    "run",
+]
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -17,7 +22,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..demo import run_demo
+    from ..experiments.demo import run_demo
 
     report = run_demo(args.out)
     print(f"report: {report}")

@@ -6,8 +6,14 @@ import argparse
 import json
 from pathlib import Path
 
-from ..data import load_record
+from ..records import load_record
 from .common import add_columns_option, refuse_overwrite
+
+__all__ = [
+    "export_models",
+    "register",
+    "run",
+]
 
 EXPORT_FILES = ("augmented.json", "nominal.json", "nominal.model.json",
                 "augmented_1_DiagnosedModel.fmu", "nominal_1_DiagnosedModel.fmu",
@@ -79,7 +85,7 @@ def export_models(rep, out_dir, *, fmu: bool = True) -> list:
     """Write ``augmented.json``, ``nominal.json``, ``nominal.model.json`` (operator JSON) and,
     with ``fmu``, both models' FMUs (unit DiagnosedModel) and their feedforwards' (unit
     DiagnosedInverse) into ``out_dir``; returns the paths written."""
-    from ..models import save_model
+    from ..model_files import save_model
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

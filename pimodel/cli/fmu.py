@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+__all__ = [
+    "register",
+    "run_build",
+]
+
 
 def register(sub) -> None:
     p = sub.add_parser("fmu", help="build the FMI 2.0 / 3.0 co-simulation FMUs",
@@ -30,7 +35,7 @@ def register(sub) -> None:
                    "GeneralizedPI AsymmetricPI RateDependentPI CreepOperator DiagnosedModel "
                    "DiagnosedInverse")
     b.add_argument("--model", default=None,
-                   help="a model JSON file (pimodel.models, or a DiagnosedModel): build its "
+                   help="a model JSON file (pimodel.model_files, or a DiagnosedModel): build its "
                    "operators' FMUs")
     b.add_argument("--dt", type=float, default=None,
                    help="with --model: sample time [s] of rate-independent stages (default: "
@@ -50,7 +55,7 @@ def run_build(args: argparse.Namespace) -> int:
             from pathlib import Path
 
             from ..fmu.model_fmu import build_inverse_fmu, build_model_fmus
-            from ..models import load_model
+            from ..model_files import load_model
 
             stem = "".join(ch if ch.isalnum() else "_" for ch in Path(args.model).stem)
             stem = stem if stem[:1].isalpha() else f"m_{stem}"

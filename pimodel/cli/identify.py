@@ -6,8 +6,13 @@ import argparse
 import json
 import sys
 
-from ..data import load_record
+from ..records import load_record
 from .common import add_columns_option, float_list, refuse_overwrite
+
+__all__ = [
+    "register",
+    "run",
+]
 
 
 def register(sub) -> None:
@@ -33,7 +38,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..identify import identify
+    from ..identification.chain import identify
 
     refuse_overwrite({"DATA": [args.data]}, {"--json": args.json}, {"--plots": args.plots})
     rec = load_record(args.data, columns=args.columns)
@@ -44,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
                    gains=gains, passes=args.passes)
     idn.save_json(args.json)
     if args.plots:
-        from ..plots_identify import plot_identification
+        from ..identification.plots import plot_identification
 
         for path in plot_identification(idn, rec.t, rec.v, rec.y, args.plots):
             print(f"figure: {path}")

@@ -4,9 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from ..data import Record, load_record, save_record
-from ..operator import PIOperator
+from ..operators.pi import PIOperator
+from ..records import Record, load_record, save_record
 from .common import add_columns_option, float_list, refuse_overwrite, unique_name
+
+__all__ = [
+    "register",
+    "run",
+]
 
 
 def register(sub) -> None:

@@ -7,9 +7,14 @@ import sys
 import time
 from pathlib import Path
 
+__all__ = [
+    "register",
+    "run",
+]
+
 
 def register(sub) -> None:
-    from ..study_runner import add_run_options, available_studies
+    from ..experiments.studies import add_run_options, available_studies
 
     names = ", ".join(available_studies()) or "none found"
     p = sub.add_parser(
@@ -30,8 +35,8 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..study_runner import available_studies, run_study
-    from ..sweep import CaseFailed
+    from ..experiments.studies import available_studies, run_study
+    from ..experiments.sweeps import CaseFailed
 
     if args.list or not args.name:
         for name in available_studies():

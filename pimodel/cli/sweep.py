@@ -9,6 +9,12 @@ import sys
 import time
 from pathlib import Path
 
+__all__ = [
+    "build_cases",
+    "register",
+    "run",
+]
+
 
 def _value(text: str):
     """A command-line value: JSON (numbers, true/false/null, lists) or else the text itself."""
@@ -42,8 +48,12 @@ def _range(text: str) -> tuple[str, tuple[float, float]]:
 
 
 def register(sub) -> None:
-    from ..study_runner import add_run_options
-    from ..truth_sweep import DIAGNOSE_SETTINGS, IDENTIFY_SETTINGS, TRUTH_PARAMS
+    from ..experiments.stage_sweeps import (
+        DIAGNOSE_SETTINGS,
+        IDENTIFY_SETTINGS,
+        TRUTH_PARAMS,
+    )
+    from ..experiments.studies import add_run_options
 
     p = sub.add_parser(
         "sweep",
@@ -78,7 +88,7 @@ def register(sub) -> None:
 
 def build_cases(args: argparse.Namespace) -> list[dict]:
     """The cases the options describe (grid x seeds, or a random sample), with --set values."""
-    from ..sweep import grid, random_cases
+    from ..experiments.sweeps import grid, random_cases
 
     fixed = {name: _value(v) for name, v in args.set}
     if args.random:
@@ -101,8 +111,8 @@ def build_cases(args: argparse.Namespace) -> list[dict]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..sweep import DEFAULT_MEMORY_LIMIT, CaseFailed
-    from ..truth_sweep import truth_sweep
+    from ..experiments.stage_sweeps import truth_sweep
+    from ..experiments.sweeps import DEFAULT_MEMORY_LIMIT, CaseFailed
 
     cases = build_cases(args)
     out = Path(args.out or Path("out") / "sweeps" / args.target)

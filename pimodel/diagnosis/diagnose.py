@@ -41,21 +41,19 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from ..data import Record
+from ..records import Record
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
-from .effects import (
-    EFFECTS,
-    Model,
-    Segment,
-    fit_effect,
-    fit_nominal,
-    make_segment,
-)
+from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
+
+__all__ = [
+    "diagnose",
+    "DiagnosisReport",
+]
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
@@ -135,7 +133,7 @@ class DiagnosisReport:
 
         Examples
         --------
-        >>> from pimodel.truth import excitation, random_truth
+        >>> from pimodel.stages.pi_stage import excitation, random_truth
         >>> truth = random_truth(["creep"], 0)
         >>> tt, vt = excitation("train", seed=1)
         >>> tv, vv = excitation("validate", seed=2)
@@ -227,7 +225,7 @@ def _check(records: list[Record], role: str) -> None:
             raise ValueError(f"{rec.source}: the input is constant (no reversal)")
         if np.ptp(rec.y) == 0:
             raise ValueError(f"{rec.source}: the output is constant")
-        from ..branches import find_reversals
+        from ..identification.branches import find_reversals
 
         if not find_reversals(rec.v, 0.01 * float(np.ptp(rec.v))):
             raise ValueError(f"{rec.source}: the input has no reversal (no hysteresis loop)")
@@ -270,7 +268,7 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
 
     Examples
     --------
-    >>> from pimodel.truth import excitation, random_truth
+    >>> from pimodel.stages.pi_stage import excitation, random_truth
     >>> truth = random_truth(["creep"], 0)
     >>> tt, vt = excitation("train", seed=1)
     >>> tv, vv = excitation("validate", seed=2)

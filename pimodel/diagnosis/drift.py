@@ -34,9 +34,19 @@ DRIFT_VARIANTS = ("record", "absolute", "levels")
 DRIFT_KEYS = ("clock", "levels")  # the grid parameters of a drift variant
 LEVEL_FOLDS = 4  # contiguous blocks of a validate record for its out-of-fold level
 
-__all__ = ["DRIFT_VARIANTS", "DRIFT_KEYS", "LEVEL_FOLDS", "drift_variants", "drift_columns",
-           "drift_k", "out_of_fold_level", "record_levels", "describe_levels", "level_report",
-           "drift_term"]
+__all__ = [
+    "DRIFT_KEYS",
+    "DRIFT_VARIANTS",
+    "LEVEL_FOLDS",
+    "describe_levels",
+    "drift_columns",
+    "drift_k",
+    "drift_term",
+    "drift_variants",
+    "level_report",
+    "out_of_fold_level",
+    "record_levels",
+]
 
 
 def drift_variants(effects, n_validate: int) -> list[dict]:

@@ -16,11 +16,26 @@ from scipy.optimize import minimize_scalar
 from scipy.signal import cont2discrete, lfilter
 
 from .._native import biquad_rows
-from ..operator import PIOperator
+from ..operators.pi import PIOperator
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import RATE_BANDS, RATE_FAMILIES, RATE_TAU_REFINE, RATE_TAU_START, RATE_TAUS
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
+
+__all__ = [
+    "base_features",
+    "delay_grid",
+    "fit_effect",
+    "fit_nominal",
+    "lag",
+    "make_segment",
+    "mode",
+    "mode_coefficients",
+    "mode_rows",
+    "Model",
+    "Segment",
+    "shift",
+]
 
 CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))

@@ -28,7 +28,7 @@ def open_loop_rms(truth, t: np.ndarray, v: np.ndarray, models: dict) -> dict:
 
     Parameters
     ----------
-    truth : pimodel.truth.Truth or pimodel.truth_alt.AltTruth
+    truth : pimodel.stages.pi_stage.Truth or pimodel.stages.preisach_stage.AltTruth
         The simulated stage (its noise is switched off here).
     t, v : numpy.ndarray
         Times [s] and input [V] that make the reference ``y_d`` (the stage's response).
@@ -43,7 +43,7 @@ def open_loop_rms(truth, t: np.ndarray, v: np.ndarray, models: dict) -> dict:
     Examples
     --------
     >>> from pimodel.diagnosis.model import DiagnosedModel
-    >>> from pimodel.truth import Truth
+    >>> from pimodel.stages.pi_stage import Truth
     >>> t = np.arange(2000) * 1e-4
     >>> v = np.sin(2 * np.pi * 5 * t)
     >>> truth = Truth(weights=(1.0, 0.5), radii=(0.0, 0.3))
@@ -82,8 +82,8 @@ def integral_loop(step, t, ff, y_d, ki: float) -> tuple[np.ndarray, np.ndarray]:
 
     Per sample k: ``v[k] = ff[k] + u[k]``, ``y[k] = step(t[k], v[k])``, and
     ``u[k + 1] = u[k] + ki dt (y_d[k] - y[k])`` from ``u[0] = 0``: the backward-Euler integral
-    of the compensation study's loop (:func:`pimodel.compensation.compensation_table`), with
-    one sample of computation delay, because the stage passes ``v[k]`` to ``y[k]`` directly.
+    of the compensation study's loop (:func:`pimodel.experiments.compensation.compensation_table`),
+    with one sample of computation delay, because the stage passes ``v[k]`` to ``y[k]`` directly.
 
     Parameters
     ----------

@@ -40,7 +40,7 @@ import control
 import numpy as np
 from scipy.signal import sosfilt_zi
 
-from ..blocks import _labels, _Settings, _stepped_block
+from ..blocks.framework import BlockSettings, signal_labels, stepped_block
 from .lti import inverse_sos
 from .monotone import monotone_model
 from .rate import STEP_SHARE, play_bands, rate_params
@@ -262,9 +262,10 @@ class StaticInverse:
         >>> StaticInverse(DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)).labels()
         ['started', 'v_prev', 'guess', 'z[1]', 'z[2]']
         """
-        rate = (["rho_f"] + _labels("m", self.n) + ["v0_prev"]
+        rate = (["rho_f"] + signal_labels("m", self.n) + ["v0_prev"]
                 + [f"source.{s}" for s in self.source.labels()]) if self.rate else []
-        return ["started", "v_prev", "guess"] + _labels("z", self.n) + _labels("L", self.m) + rate
+        return (["started", "v_prev", "guess"] + signal_labels("z", self.n)
+                + signal_labels("L", self.m) + rate)
 
     def initial_state(self, z0=None) -> np.ndarray:
         """The state before the first sample: not started, the plays at rest at 0 (as
@@ -423,8 +424,8 @@ class _InverseStream:
         self.size = self._post.stop + self.solver.size
 
     def labels(self) -> list[str]:
-        return (["started", "seen", "v_rest", "F_prev"] + _labels("f", 2 * self.ns)
-                + _labels("g", 2 * self.np) + [f"solver.{s}" for s in self.solver.labels()])
+        return (["started", "seen", "v_rest", "F_prev"] + signal_labels("f", 2 * self.ns)
+                + signal_labels("g", 2 * self.np) + [f"solver.{s}" for s in self.solver.labels()])
 
     def step(self, x: np.ndarray, yd: float) -> float:
         """``v`` output at this sample; ``x`` advances in place."""
@@ -505,13 +506,13 @@ def inverse_block(inverse, dt: float | None = None, *, name: str = "inverse",
     stream = _InverseStream(model, input_range, reference_range)
     defaults = {"input_range": stream.solver.input_range,
                 "reference_range": 0.0 if reference_range is None else float(reference_range)}
-    settings = _Settings(name, defaults, lambda s: _InverseStream(model, s["input_range"],
+    settings = BlockSettings(name, defaults, lambda s: _InverseStream(model, s["input_range"],
                                                                   s["reference_range"]))
 
     def step(inv, x, yd, t):
         return inv.step(x, yd), x
 
-    blk = _stepped_block(settings, step, own_state=lambda params: np.zeros(stream.size),
+    blk = stepped_block(settings, step, own_state=lambda params: np.zeros(stream.size),
                          states=stream.labels(), dt=model.dt, name=name, input=input,
                          output=output, memo=True)
     blk.latency = stream.latency

@@ -47,9 +47,19 @@ from scipy.signal import (
 
 from .._native import biquad_rows
 
-__all__ = ["MAX_MODES", "element_coefficients", "lti_columns", "lti_k", "describe_lti",
-           "continuous_zpk", "approximate_inverse", "inverse_sos", "select_order",
-           "polish_elements", "nelder_mead"]
+__all__ = [
+    "MAX_MODES",
+    "approximate_inverse",
+    "continuous_zpk",
+    "describe_lti",
+    "element_coefficients",
+    "inverse_sos",
+    "lti_columns",
+    "lti_k",
+    "nelder_mead",
+    "polish_elements",
+    "select_order",
+]
 
 MAX_MODES = 3  # modes of the linear part, the base mode included
 MAX_ELEMENTS = 2  # extra elements at most (each step costs a joint polish)
@@ -141,7 +151,9 @@ def element_coefficients(element: Sequence, dt: float) -> tuple[np.ndarray, np.n
     if kind == "lowpass":
         a1 = np.exp(-dt / float(element[1]))
         return np.array([0.0, 1.0 - a1]), np.array([1.0, -a1])
-    from .effects import mode_coefficients  # the base mode's ZOH (closed form); lazy: effects
+    from .effects import (
+        mode_coefficients,  # the base mode's ZOH (closed form); lazy: effects
+    )
     # imports this module
 
     return mode_coefficients(float(element[1]), float(element[2]), dt)

@@ -54,14 +54,14 @@ Approximations, by choice:
   model's term then differs from the assumed one by ``(1 - a) (rho[k] - rho_v0[k])``: the
   round trip is close, not exact. Why not exact: with the rate of ``v[k]`` itself the model is,
   linearised on a branch, ``y[k] = A v[k] + B' (v[k] - v[k-1])`` with ``B' = -sum g_b r_i /
-  (dt rate_scale)``, a zero at ``z = B' / (A + B')``; on ``pimodel.truth`` (``tau = 0``)
+  (dt rate_scale)``, a zero at ``z = B' / (A + B')``; on ``pimodel.stages.pi_stage`` (``tau = 0``)
   ``z`` is 1.8 to 2.1 (the fitted models and the truth alike), so the exact inverse is unstable
   (an error grows about 2x per sample). A rate held from sample k - 1 (the earlier choice,
   ``A z^2 + B' z - B' = 0``: complex roots of modulus 1.4) makes the feedforward oscillate
   from sample to sample (it tracked worse than the nominal inverse, 0.71x to 0.94x), and
   repeated passes, each on the previous pass' rate, diverge after the first. Measured
-  open-loop cuts against the nominal inverse: ``pimodel.truth`` rate 8.9x to 9.3x,
-  ``pimodel.truth_alt`` rate 28x to 47x (``docs/notes/ff-rate.md``).
+  open-loop cuts against the nominal inverse: ``pimodel.stages.pi_stage`` rate 8.9x to 9.3x,
+  ``pimodel.stages.preisach_stage`` rate 28x to 47x (``docs/notes/ff-rate.md``).
 * **delay**: not inverted; the feedforward is advanced by the delay (``y_d[k + d]``, linear
   interpolation): it needs the reference ``d`` samples ahead (a known trajectory).
 * **dynamics**: the linear part ``G`` is replaced by a stable approximate inverse
@@ -90,7 +90,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.optimize import brentq
 
-from ..operator import PIOperator
+from ..operators.pi import PIOperator
 from .drift import drift_term
 from .effects import lag, mode, shift
 from .inverse_stream import inverse_block, solve_static
@@ -102,7 +102,7 @@ from .wiener import inverse_prefilter, prefilter
 if TYPE_CHECKING:
     import control
 
-__all__ = ["DiagnosedModel", "DiagnosedInverse", "load_diagnosed_model"]
+__all__ = ["DiagnosedInverse", "DiagnosedModel", "load_diagnosed_model"]
 
 KIND = "DiagnosedModel"
 INITIAL_STATES = ("rest", "unknown")  # as diagnose(initial_state=...)
@@ -440,15 +440,15 @@ class DiagnosedModel:
         """The model as an operator that ``pimodel fmu build --model`` accepts.
 
         Only the nominal model (no effects) has one: a
-        :class:`~pimodel.generalized.GeneralizedPI` with the weights (signed, positive partial
-        sums) and the offset as an affine output envelope, equal to :meth:`simulate`. The
-        diagnosis fits the effects in parallel to the hysteresis (module docstring), which no
-        chain of the operator FMUs reproduces; the DiagnosedModel FMU unit runs any model
+        :class:`~pimodel.operators.generalized.GeneralizedPI` with the weights (signed, positive
+        partial sums) and the offset as an affine output envelope, equal to :meth:`simulate`. The
+        diagnosis fits the effects in parallel to the hysteresis (module docstring), which no chain
+        of the operator FMUs reproduces; the DiagnosedModel FMU unit runs any model
         (:func:`pimodel.diagnosis.stream.fmu_parameters`).
 
         Returns
         -------
-        pimodel.generalized.GeneralizedPI
+        pimodel.operators.generalized.GeneralizedPI
 
         Raises
         ------
@@ -463,8 +463,8 @@ class DiagnosedModel:
         >>> bool(np.allclose(op.simulate(v), m.simulate(v)))
         True
         """
-        from ..envelopes import Envelope
-        from ..generalized import GeneralizedPI
+        from ..operators.envelopes import Envelope
+        from ..operators.generalized import GeneralizedPI
 
         if self.effects:
             raise ValueError(f"model: the effects {list(self.effects)} are fitted in parallel "
@@ -603,8 +603,8 @@ class DiagnosedInverse:
         moves the fewest plays. Plays the record never moves keep their memory for good, and
         at rest their constant share is already in the fitted offset; the weights of the
         plays with large radii are also the least determined (the output along the family
-        can wiggle about ``y_0``). Measured on ``pimodel.truth_alt`` (records from negative
-        saturation), the deepest ``u`` that reaches ``y_0`` left, e.g., a rate model's
+        can wiggle about ``y_0``). Measured on ``pimodel.stages.preisach_stage`` (records from
+        negative saturation), the deepest ``u`` that reaches ``y_0`` left, e.g., a rate model's
         open-loop error 2.5 times that of the nearest (``docs/notes/ff-creep.md``).
 
         Parameters

@@ -44,8 +44,13 @@ import numpy as np
 if TYPE_CHECKING:
     from .model import DiagnosedModel
 
-__all__ = ["FLOOR_SHARE", "is_monotone", "monotone_weights", "monotone_error",
-           "monotone_model"]
+__all__ = [
+    "FLOOR_SHARE",
+    "is_monotone",
+    "monotone_error",
+    "monotone_model",
+    "monotone_weights",
+]
 
 FLOOR_SHARE = 0.25  # the projected slopes' floor, a share of the median partial sum
 

@@ -26,6 +26,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter, savgol_coeffs, savgol_filter
 
+__all__ = [
+    "measure_noise_floor",
+    "robust_std",
+]
+
 ARX_NA, ARX_NB, ARX_LEAD = 6, 24, 4  # linear model of the residual on the model output
 SG_WINDOW = 9  # Savitzky-Golay window [samples] and polynomial order
 SG_ORDER = 3

@@ -9,6 +9,10 @@ import numpy as np
 
 from ..plotting import new_figure, save_figure
 
+__all__ = [
+    "plot_diagnosis",
+]
+
 
 def plot_diagnosis(rep, out_dir, *, prefix: str = "", units=("V", "um")) -> list[Path]:
     """Save the two figures of a diagnosis as PNG files.

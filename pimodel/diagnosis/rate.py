@@ -1,11 +1,11 @@
 """The ``rate`` candidate: hysteresis whose play radii or weights depend on a low-passed input
 rate, to first order, as columns that are linear in their gains.
 
-A rate-dependent PI model (as :class:`pimodel.rate_dependent.RateDependentPI`, generalised) has
-radii ``r_i (1 + a_b rho_f[k])`` or weights ``w_i (1 + c_b rho_f[k])`` for the plays ``i`` of
-band ``b``, where ``rho_f`` is the input rate, normalised by ``rate_scale`` and passed through a
-first-order low-pass with time constant ``tau`` (``tau = 0``: the rate of the last sample
-interval). Two families, one loop that widens with the rate and one that grows as a whole; to
+A rate-dependent PI model (as :class:`pimodel.operators.rate_dependent.RateDependentPI`,
+generalised) has radii ``r_i (1 + a_b rho_f[k])`` or weights ``w_i (1 + c_b rho_f[k])`` for the
+plays ``i`` of band ``b``, where ``rho_f`` is the input rate, normalised by ``rate_scale`` and
+passed through a first-order low-pass with time constant ``tau`` (``tau = 0``: the rate of the last
+sample interval). Two families, one loop that widens with the rate and one that grows as a whole; to
 first order in the gains the output changes by
 
 * ``"radius"`` columns ``R_b[k] = sum_{i in b} (-s_i) r_i rho_f[j_i]``: play ``i`` lags further
@@ -20,8 +20,8 @@ first order in the gains the output changes by
 Fitted jointly, the two families share too much on a record of a few constant rates (while a
 play is in contact, ``R`` is ``rho_f (z_i - v)``, a weight column minus a linear one) and the fit
 then follows neither out of contact (measured: a validate RMS 2.2 times that of the radius
-family alone on ``pimodel.truth``). So the candidate fits one family's ``RATE_BANDS`` gains
-jointly with the hysteresis weights and chooses the family and ``tau`` by the train residual:
+family alone on ``pimodel.stages.pi_stage``). So the candidate fits one family's ``RATE_BANDS``
+gains jointly with the hysteresis weights and chooses the family and ``tau`` by the train residual:
 ``tau`` on the grid ``RATE_TAUS``, then by geometric steps (``RATE_TAU_REFINE``) around the best
 positive one. Without a filter (``tau = 0``) a sampled step, a one-sample jump above
 ``STEP_SHARE`` of the input range, is no rate a play follows (its rate counts as 0); a low-pass
@@ -40,8 +40,18 @@ RATE_BANDS = 8  # play bands: the candidate has RATE_BANDS gains
 RATE_FAMILIES = ("radius", "weight")  # radii or weights growing with the rate
 STEP_SHARE = 0.05  # without a filter, a one-sample jump above this share of the range is a step
 
-__all__ = ["RATE_BANDS", "RATE_FAMILIES", "RATE_TAU_REFINE", "RATE_TAUS", "RateBasis",
-           "filtered_rate", "input_rate", "play_bands", "rate_columns", "rate_params"]
+__all__ = [
+    "RATE_BANDS",
+    "RATE_FAMILIES",
+    "RATE_TAUS",
+    "RATE_TAU_REFINE",
+    "RateBasis",
+    "filtered_rate",
+    "input_rate",
+    "play_bands",
+    "rate_columns",
+    "rate_params",
+]
 
 
 def input_rate(v: np.ndarray, dt: float, rate_scale: float, tau: float,

@@ -50,7 +50,7 @@ import control
 import numpy as np
 
 from .. import _native
-from ..blocks import _labels, _Settings, _stepped_block
+from ..blocks.framework import BlockSettings, signal_labels, stepped_block
 from ..fmu.build import MAX_LTI_ELEMENTS as MAX_ELEMENTS
 from ..fmu.build import NMAX
 from .effects import mode_coefficients
@@ -464,12 +464,12 @@ def state_labels(model) -> list[str]:
     nbuf = int(math.floor(d.delay)) + 2 if d.delay > 0 else 0
     rate = []
     if d.rate_w:
-        rate = ["rho_f"] + (_labels("m", n) if d.rate_family == 0 else [])
-    return (["started", "v_prev", "t_start", "head"] + _labels("z", n)
-            + rate + _labels("L", d.m)
-            + _labels("s", d.order) + _labels("e", 2 * (d.ne + 1) if d.ne else 0)
-            + _labels("x_delay", nbuf)
-            + (_labels("zf", n) + _labels("f", 2 * d.nw) if d.nw else []))
+        rate = ["rho_f"] + (signal_labels("m", n) if d.rate_family == 0 else [])
+    return (["started", "v_prev", "t_start", "head"] + signal_labels("z", n)
+            + rate + signal_labels("L", d.m)
+            + signal_labels("s", d.order) + signal_labels("e", 2 * (d.ne + 1) if d.ne else 0)
+            + signal_labels("x_delay", nbuf)
+            + (signal_labels("zf", n) + signal_labels("f", 2 * d.nw) if d.nw else []))
 
 
 def _block_setting(value):
@@ -559,12 +559,12 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
                 "reference_weights": model.reference_weights.copy(),
                 "reference_offset": model.reference_offset,
                 "input_range": native.input_range, **params}
-    settings = _Settings(name, defaults, build)
+    settings = BlockSettings(name, defaults, build)
 
     def step(nm, x, v, t):
         return nm.step(x, v, t), x
 
-    return _stepped_block(settings, step, own_state=lambda params: settings.get(params)
+    return stepped_block(settings, step, own_state=lambda params: settings.get(params)
                           .initial_state(), states=labels, dt=model.dt, name=name, input=input,
                           output=output)
 

@@ -6,7 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..branches import find_reversals
+from ..identification.branches import find_reversals
+
+__all__ = [
+    "residual_breakdown",
+    "startup_length",
+]
 
 STARTUP_SPAN = 0.9  # the start-up region ends when the input first spans this share of its range
 STARTUP_REGION = "start-up (until the input first spans 90 % of its range)"

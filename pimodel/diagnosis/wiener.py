@@ -37,7 +37,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from scipy.signal import bilinear_zpk, lfilter, lfilter_zi, sosfilt, sosfilt_zi, zpk2sos
 
-from ..operator import PIOperator
+from ..operators.pi import PIOperator
 from .lti import INVERSE_FILTER, element_coefficients, nelder_mead
 
 __all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "inverse_sections",

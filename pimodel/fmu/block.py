@@ -20,7 +20,7 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from ..blocks import _Block
+from ..blocks.framework import Block
 from ..checks import positive_scalar
 from .unit import FMUUnit
 
@@ -122,7 +122,7 @@ def fmu_block(path, dt: float, *, start: dict | None = None, inputs=None, output
         unit.free_state(saved)
         return y
 
-    sys = _Block(upd, out, own_state=lambda params: np.zeros(1),
+    sys = Block(upd, out, own_state=lambda params: np.zeros(1),
                  aliases={f"{name or 'fmu'}_time": "time"}, inputs=list(ins),
                  outputs=list(outs), states=["time"], dt=dt, name=label)
     sys.fmu_unit = unit

@@ -17,8 +17,8 @@ import control
 import numpy as np
 from fmpy import read_model_description
 
-from ..loops import LoopResult
-from ..operator import PIOperator
+from ..loops.compiled import LoopResult
+from ..operators.pi import PIOperator
 from .build import fmu_filename
 from .unit import FMUUnit
 

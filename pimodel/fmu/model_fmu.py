@@ -1,5 +1,5 @@
-"""FMUs of a model (an operator, an inverse or a :class:`~pimodel.cascade.Cascade`): one FMU per
-operator, each a unit of ``pimodel.fmu.build.MODELS`` whose parameters' start values are the
+"""FMUs of a model (an operator, an inverse or a :class:`~pimodel.operators.cascade.Cascade`): one
+FMU per operator, each a unit of ``pimodel.fmu.build.MODELS`` whose parameters' start values are the
 operator's (in the model description and compiled into the binary), so that an importer that
 sets nothing runs the model. A cascade becomes one FMU per stage, ``<stem>_<i>_<Unit>.fmu``
 (i = 1.. in the order of the stages); connect stage i's output (``y``) to stage i+1's input
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cascade import Cascade
+from ..operators.cascade import Cascade
 from .build import build_fmus
 from .operators import unit_parameters
 from .spec import MODEL_UNITS, MODELS, Var, check_fmi_version
@@ -95,7 +95,7 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
 
     Examples
     --------
-    >>> from pimodel.creep import CreepOperator
+    >>> from pimodel.operators.creep import CreepOperator
     >>> import tempfile
     >>> paths = build_model_fmus(CreepOperator([0.05], [0.1], dt=1e-3), tempfile.mkdtemp())
     >>> paths[0].name
@@ -197,7 +197,7 @@ def cosimulate_chain(paths, u, Ts: float) -> np.ndarray:
     --------
     The FMUs must be built first (seconds), hence skipped here:
 
-    >>> from pimodel.creep import CreepOperator
+    >>> from pimodel.operators.creep import CreepOperator
     >>> import tempfile
     >>> op = CreepOperator([0.05], [0.1], dt=1e-3)
     >>> paths = build_model_fmus(op, tempfile.mkdtemp())  # doctest: +SKIP

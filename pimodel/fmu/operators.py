@@ -1,8 +1,10 @@
 """Parameter values of the pimodel FMU units (``pimodel.fmu.build.MODELS``) for the Python
-operators: :func:`unit_parameters` maps a :class:`~pimodel.generalized.GeneralizedPI`,
-:class:`~pimodel.asymmetric.AsymmetricPI`, :class:`~pimodel.rate_dependent.RateDependentPI`,
-:class:`~pimodel.creep.CreepOperator` (or the inverse of one of them) to the unit that runs it
-and the values of its variables, by the FMI 2 names (``"p[2]"``) that :class:`FMUUnit` also
+operators: :func:`unit_parameters` maps a
+:class:`~pimodel.operators.generalized.GeneralizedPI`,
+:class:`~pimodel.operators.asymmetric.AsymmetricPI`,
+:class:`~pimodel.operators.rate_dependent.RateDependentPI` or
+:class:`~pimodel.operators.creep.CreepOperator` (or the inverse of one of them) to the unit that
+runs it and the values of its variables, by the FMI 2 names (``"p[2]"``) that :class:`FMUUnit` also
 accepts for FMI 3. The unit at sample time ``Ts`` then gives ``u[k] -> y[k]`` exactly as the
 operator's ``simulate`` (the tests hold them equal to 1e-12).
 
@@ -16,11 +18,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..asymmetric import AsymmetricPI, AsymmetricPIInverse
-from ..creep import CreepOperator
-from ..generalized import GeneralizedPI
-from ..operator import PIOperator
-from ..rate_dependent import RateDependentPI, RateDependentPIInverse
+from ..operators.asymmetric import AsymmetricPI, AsymmetricPIInverse
+from ..operators.creep import CreepOperator
+from ..operators.generalized import GeneralizedPI
+from ..operators.pi import PIOperator
+from ..operators.rate_dependent import RateDependentPI, RateDependentPIInverse
 from .spec import ENVELOPE_KINDS, NMAX
 
 __all__ = ["unit_parameters"]
@@ -77,7 +79,7 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
 
     Examples
     --------
-    >>> from pimodel.creep import CreepOperator
+    >>> from pimodel.operators.creep import CreepOperator
     >>> name, params = unit_parameters(CreepOperator([0.05], [0.1], dt=1e-3).inverse())
     >>> name, params["inverse"], params["tau[1]"]
     ('CreepOperator', True, 0.1)

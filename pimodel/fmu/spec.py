@@ -13,6 +13,7 @@ from __future__ import annotations
 import uuid
 from dataclasses import dataclass
 
+from .. import _native
 from .._native import LIMITS
 
 __all__ = ["FMI_VERSIONS", "MAX_INVERSE_SECTIONS", "MAX_LTI_ELEMENTS", "MAX_SUBSTEPS",
@@ -131,7 +132,7 @@ def _inverse_flag(forward: str, inverse: str) -> Var:
                f"false: u = {forward}; true: the exact inverse, u = {inverse}")
 
 
-ENVELOPE_KINDS = {"poly2": 0, "tanh": 1, "poly2_inv": 2, "tanh_inv": 3}  # PIM_ENV_* codes
+ENVELOPE_KINDS = _native.ENVELOPE_KINDS
 
 
 def _envelope_vars(prefix: str, base: int, what: str, field: str) -> list[Var]:
@@ -197,7 +198,7 @@ MODELS: dict[str, dict] = {
     "GeneralizedPI": {
         "id": 4,
         "description": "Generalized PI y = g(sum p_i Gamma_{r_i}[h(v)]) or its exact inverse "
-                       "(pimodel.generalized.GeneralizedPI)",
+                       "(pimodel.operators.generalized.GeneralizedPI)",
         "vars": [*_common(), *_arrays("r", 200, "parameter", "0",
                                       "radius r (>= 0, sorted, envelope units), play"),
                  _inverse_flag("v, y = y", "y_d, y = v"),
@@ -208,7 +209,7 @@ MODELS: dict[str, dict] = {
     "AsymmetricPI": {
         "id": 5,
         "description": "Asymmetric generalized PI (ascending/descending envelopes a phi + d) or "
-                       "its exact inverse (pimodel.asymmetric.AsymmetricPI)",
+                       "its exact inverse (pimodel.operators.asymmetric.AsymmetricPI)",
         "vars": [*_common(z0="initial play state (unit of phi)",
                           weights=("p", "1", "weight p (>= 0), play")),
                  *_arrays("r", 200, "parameter", "0", "radius r (>= 0, sorted), play"),
@@ -224,7 +225,7 @@ MODELS: dict[str, dict] = {
     "RateDependentPI": {
         "id": 6,
         "description": "Rate-dependent PI, radii alpha_i (1 + beta rate), or its exact inverse "
-                       "(pimodel.rate_dependent.RateDependentPI, dt = Ts)",
+                       "(pimodel.operators.rate_dependent.RateDependentPI, dt = Ts)",
         "vars": [*_common(), *_arrays("r", 200, "parameter", "0",
                                       "base radius alpha (>= 0, sorted), play"),
                  _inverse_flag("v, y = y", "y_d, y = v"),
@@ -238,7 +239,7 @@ MODELS: dict[str, dict] = {
     "CreepOperator": {
         "id": 7,
         "description": "Creep: sum of ZOH first-order lags with feedthrough 1, or its exact "
-                       "inverse (pimodel.creep.CreepOperator, dt = Ts)",
+                       "inverse (pimodel.operators.creep.CreepOperator, dt = Ts)",
         "vars": [*_common(elements="lags", z0="initial lag state x_i[0]",
                           weights=("c", "0.05", "gain c (> 0), lag"), weights_field="p"),
                  *_arrays("tau", 200, "parameter", "1", "time constant tau [s] (> 0), lag", "r"),

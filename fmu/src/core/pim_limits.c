@@ -1,5 +1,8 @@
 /* pimodel C core: the table of pim_limits.h, exported for Python (pimodel._native.LIMITS). */
 #include "pim_core.h"
+#include "pim_estimator.h"
+#include "pim_generalized.h"
+#include "pim_limits.h"
 
 typedef struct {
     const char *name;
@@ -8,7 +11,7 @@ typedef struct {
 } pim_limit;
 
 #define PIM_LIMIT_ROW(name, is_integer) {#name, (double)(name), is_integer},
-static const pim_limit limits[] = {PIM_LIMITS(PIM_LIMIT_ROW)};
+static const pim_limit limits[] = {PIM_LIMITS(PIM_LIMIT_ROW) PIM_CODES(PIM_LIMIT_ROW)};
 #undef PIM_LIMIT_ROW
 
 #define PIM_NLIMITS ((int)(sizeof limits / sizeof limits[0]))

@@ -51,4 +51,10 @@
     X(PIM_DINV_MAX_LATENCY, 1) X(PIM_DINV_FMU_SECTIONS, 1) X(PIM_MAX_SUBSTEPS, 1)              \
     X(PIM_MAX_SAMPLE_INDEX, 1) X(PIM_TS_MIN, 0) X(PIM_SAMPLE_TOL, 0)
 
+/* Codes of the core's enumerations, defined in their own headers (pim_estimator.h,
+ * pim_generalized.h) and exported beside the limits so that Python never retypes them. */
+#define PIM_CODES(X)                                                                            \
+    X(PIM_LAW_DATA, 1) X(PIM_LAW_PAPER, 1) X(PIM_ENV_POLY2, 1) X(PIM_ENV_TANH, 1)             \
+    X(PIM_ENV_POLY2_INV, 1) X(PIM_ENV_TANH_INV, 1)
+
 #endif /* PIM_LIMITS_H */
