@@ -5,11 +5,13 @@ Layout of ``fmu/src`` (as the Modelica Reference-FMUs: shared code, then one fol
 - ``core/``: the numeric core ``pim_*.c`` / ``pim_*.h`` shared with the Python extension
   (``pimodel._pim_core``), with every limit in ``core/pim_limits.h``;
 - ``fmi/``: the FMI 2 / FMI 3 glue (``fmi2_pimodel.c``, ``fmi3_pimodel.c``) and the
-  version-independent unit framework ``pim_unit.h`` (modes, sampling rule, state format,
-  logging, the variable lookup);
-- ``units/<Unit>/unit.h``: one unit's own code (its parameter rules and helpers), included by
-  the framework; ``units/shared/``: code shared by some units (``diag_static.h``: the static
-  part of the DiagnosedModel and DiagnosedInverse units).
+  version-independent unit framework ``pim_unit.h`` (modes, sampling rule, step and rollback,
+  state format, logging, the variable lookup), with no unit-specific code;
+- ``units/<Unit>/``: one unit's own code: ``fields.h`` (its fields of ``pim_unit``) and
+  ``unit.h`` (its hooks ``model_*``: defaults, parameter check, derive, setup, sample, state
+  check, ...), included by the framework; ``units/shared/``: code shared by some units (the
+  plays' rule, the play states, the ``inverse`` flag, the inverse PI, the envelope check, the
+  section chains, the static part of the DiagnosedModel and DiagnosedInverse units).
 
 An FMU's ``sources/`` holds these files flat, with the generated ``config.h``
 (:func:`pimodel.fmu.spec.config_h`) and a ``model.c`` including its unit and glue.
@@ -30,8 +32,10 @@ HEADERS = ("pim_limits.h", "pim_core.h", "pim_estimator.h", "pim_est_health.h", 
            "pim_diagnosed.h", "pim_diag_inverse.h")  # core/
 FRAMEWORK = ("pim_unit.h",)  # fmi/
 GLUE = {"2.0": "fmi2_pimodel.c", "3.0": "fmi3_pimodel.c"}  # fmi/, #included by model.c
-UNIT_FILES = ("unit.h",)  # units/<Unit>/
-SHARED_UNIT_FILES = ("diag_static.h",)  # units/shared/: code shared by some units
+UNIT_FILES = ("fields.h", "unit.h")  # units/<Unit>/: its own fields of pim_unit, its hooks
+SHARED_UNIT_FILES = ("plays.h", "play_states.h", "play_state_hooks.h", "inverse_flag.h",
+                     "inverse_pi.h", "envelope_check.h", "sections.h", "diag_fields.h",
+                     "diag_static.h")  # units/shared/: code shared by some units
 
 
 def source_dir() -> Path:
@@ -71,7 +75,7 @@ def unit_dir(unit: str) -> Path:
     Returns
     -------
     pathlib.Path
-        The folder (it holds ``unit.h``).
+        The folder (it holds ``fields.h`` and ``unit.h``).
 
     Examples
     --------
@@ -99,8 +103,8 @@ def source_files(unit: str, fmi_version: str) -> list[Path]:
 
     Examples
     --------
-    >>> [p.name for p in source_files("PIHysteresis", "2.0")][:3]
-    ['fmi2_pimodel.c', 'pim_unit.h', 'unit.h']
+    >>> [p.name for p in source_files("PIHysteresis", "2.0")][:4]
+    ['fmi2_pimodel.c', 'pim_unit.h', 'fields.h', 'unit.h']
     """
     src = source_dir()
     return [src / "fmi" / GLUE[fmi_version], *[src / "fmi" / f for f in FRAMEWORK],

@@ -1,8 +1,19 @@
-/* The static part shared by the DiagnosedModel (8) and DiagnosedInverse (9) units: the plays'
- * arrays joined and their parameter rules, written once for both. */
+/* The static part shared by the DiagnosedModel (8) and DiagnosedInverse (9) units (fields in
+ * diag_fields.h): start values, the plays' arrays joined and their parameter rules, written
+ * once for both. */
 #ifndef PIM_DIAG_STATIC_H
 #define PIM_DIAG_STATIC_H
 
+
+/* Start values of the static part's parameters (the spec's). */
+static void unit_diag_defaults(pim_unit *u)
+{
+    for (int i = 0; i < PIM_NMAX; ++i) {
+        u->w0[i] = u->w0_hi[i] = u->p_hi[i] = 1.0;
+        u->creep_tau[i] = 1.0;
+    }
+    u->half_range = u->rate_scale = u->input_range = 1.0;
+}
 
 /* The plays' arrays joined: plays 1..64 from p, r, w0, rate_band_gain, 65..128 from the _hi
  * arrays (derived, recomputed for every restored state). */
@@ -15,6 +26,31 @@ static void unit_diag_join(pim_unit *u)
         u->dw0[i] = lo ? u->w0[j] : u->w0_hi[j];
         u->drb[i] = lo ? u->rate_band_gain[j] : u->rate_band_gain_hi[j];
     }
+}
+
+/* The derived quantities of the static part: the creep poles and the joined arrays. */
+static void unit_diag_derive(pim_unit *u)
+{
+    for (int j = 0; j < u->n_lags; ++j) u->a[j] = exp(-u->Ts / u->creep_tau[j]);
+    unit_diag_join(u);
+}
+
+/* The flat state (dstate) a step changes, for its rollback: model_save saves its first size
+ * values (pim_diag's or pim_dinv's state size) with unit_diag_save. */
+typedef struct {
+    size_t size;
+    double x[PIM_DIAG_STATE_MAX];
+} model_saved;
+
+static void unit_diag_save(const pim_unit *u, model_saved *s, size_t size)
+{
+    s->size = size;
+    memcpy(s->x, u->dstate, size * sizeof(double));
+}
+
+static void model_restore(pim_unit *u, const model_saved *s)
+{
+    memcpy(u->dstate, s->x, s->size * sizeof(double));
 }
 
 /* "p[3]" or "p_hi[2]" for play i (0-based) of array `name`. */
