@@ -45,11 +45,11 @@ class UnitPrefix(ctypes.Structure):
     """The common part of pim_unit, the same in every unit (fmu/src/fmi/pim_unit.h); the unit's
     own fields (fmu/src/units/<Unit>/fields.h) and the message follow."""
 
-    _fields_ = [("Ts", ctypes.c_double), ("z0", ctypes.c_double), ("n", ctypes.c_int),
+    _fields_ = [("Ts", ctypes.c_double), ("z0", ctypes.c_double),
                 ("p", ctypes.c_double * NMAX), ("r", ctypes.c_double * NMAX),
                 ("in1", ctypes.c_double), ("in2", ctypes.c_double), ("out1", ctypes.c_double),
-                ("out2", ctypes.c_double), ("mode", ctypes.c_int),
-                ("time", ctypes.c_double), ("k_next", ctypes.c_int64)]
+                ("out2", ctypes.c_double), ("time", ctypes.c_double),
+                ("k_next", ctypes.c_int64), ("n", ctypes.c_int), ("mode", ctypes.c_int)]
 
 
 FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q"}  # others are doubles

@@ -101,17 +101,17 @@ enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED };
  * then the unit's own fields (units/<Unit>/fields.h). */
 typedef struct {
     /* common parameters: sample time, initial play state, plays 1..64 (weights p, radii r;
-     * CreepOperator: gains c in p, time constants tau in r) */
+     * CreepOperator: gains c in p, time constants tau in r; 16-byte aligned as the arrays
+     * the core's loops run over) */
     double Ts, z0;
-    int n;
     double p[PIM_NMAX], r[PIM_NMAX];
     /* inputs and outputs (the spec's names: in1 is v, y_d or u; in2 and out2 the
      * RadiusEstimator's y and e) */
     double in1, in2, out1, out2;
-    /* mode, time and sample counter */
-    int mode;
+    /* time and sample counter; the number of plays (a parameter) and the mode */
     double time;    /* the end of the last communication step (the start time before any) */
     int64_t k_next; /* index of the next sample to process */
+    int n, mode;
     /* the unit's own parameters, states and derived quantities */
 #include "fields.h"
     char msg[256]; /* reason of the last failure */
