@@ -1,4 +1,4 @@
-"""Build hook: compiles the shared C core (fmu/src/pim_*.c) into pimodel/_pim_core*.so.
+"""Build hook: compiles the shared C core (fmu/src/core/pim_*.c) into pimodel/_pim_core*.so.
 
 The library is plain C (no Python C-API); pimodel._native loads it with ctypes.  The same
 sources are compiled into the FMUs, so Python and FMI run one implementation.
@@ -10,8 +10,8 @@ from setuptools import Extension, setup
 
 core = Extension(
     "pimodel._pim_core",
-    sources=sorted(glob("fmu/src/pim_*.c")),
-    include_dirs=["fmu/src"],
+    sources=sorted(glob("fmu/src/core/pim_*.c")),
+    include_dirs=["fmu/src/core"],
     extra_compile_args=["-std=c99", "-O3", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden"],
     libraries=["m"],
 )

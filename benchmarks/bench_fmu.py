@@ -17,6 +17,7 @@ import numpy as np
 
 from pimodel.fmu import build_fmus
 from pimodel.fmu.build import find_compiler, fmi_headers, guid
+from pimodel.fmu.spec import config_h
 from pimodel.fmu.unit import FMUUnit
 
 HERE = Path(__file__).resolve().parent
@@ -30,8 +31,10 @@ def main() -> None:
         with zipfile.ZipFile(fmu) as z:
             z.extract("binaries/linux64/PIHysteresis.so", tmp)
         host = tmp / "fmu_host"
+        (tmp / "config.h").write_text(config_h("PIHysteresis"))  # the value references
         subprocess.run([find_compiler(), "-O2", "-std=c99", "-D_POSIX_C_SOURCE=200809L",
-                        "-I", str(fmi_headers()), str(HERE / "fmu_host.c"), "-o", str(host),
+                        "-I", str(fmi_headers()), "-I", str(tmp), str(HERE / "fmu_host.c"),
+                        "-o", str(host),
                         "-ldl"], check=True)
         N = 5_000_000
         out = subprocess.run([str(host), str(tmp / "binaries/linux64/PIHysteresis.so"),

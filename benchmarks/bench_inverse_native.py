@@ -1,5 +1,5 @@
 """Benchmark: a diagnosed model's feedforward on the C core (``NativeInverse``) against the Python
-stream of ``DiagnosedInverse.block()`` (``inverse_stream._InverseStream``), the baseline, in the
+stream of ``DiagnosedInverse.block()`` (``reference_inverse._InverseStream``), the baseline, in the
 same run, with the largest difference of their outputs.
 
 Run: ``.venv/bin/python benchmarks/bench_inverse_native.py [--samples N]``. Models: 80 signed

@@ -9,6 +9,8 @@
 
 #include "fmi2Functions.h"
 
+#include "config.h" /* PIHysteresis: vr_Ts, vr_n, vr_p, vr_r, vr_v, vr_y */
+
 static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status st, fmi2String cat,
                    fmi2String msg, ...)
 {
@@ -39,13 +41,13 @@ int main(int argc, char **argv)
     LOAD(fmi2SetupExperimentTYPE, fmi2SetupExperiment)
     if (fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) != fmi2OK ||
         fmi2EnterInitializationMode(c) != fmi2OK) return 1;
-    fmi2ValueReference vr_n = 1, vr_ts = 0, vr_v = 10, vr_y = 11;
+    const fmi2ValueReference vr_n_ = vr_n, vr_ts = vr_Ts, vr_v_ = vr_v, vr_y_ = vr_y;
     fmi2Integer nn = n;
     double ts = 1e-4;
-    if (fmi2SetInteger(c, &vr_n, 1, &nn) != fmi2OK || fmi2SetReal(c, &vr_ts, 1, &ts) != fmi2OK)
+    if (fmi2SetInteger(c, &vr_n_, 1, &nn) != fmi2OK || fmi2SetReal(c, &vr_ts, 1, &ts) != fmi2OK)
         return 1;
     for (int i = 0; i < n; ++i) {
-        fmi2ValueReference vp = 100 + i, vrr = 200 + i;
+        const fmi2ValueReference vp = vr_p + i, vrr = vr_r + i;
         double p = 1.0 / (i + 1), r = 0.2 * i;
         if (fmi2SetReal(c, &vp, 1, &p) != fmi2OK || fmi2SetReal(c, &vrr, 1, &r) != fmi2OK)
             return 1;
@@ -58,9 +60,9 @@ int main(int argc, char **argv)
     for (long k = 0; k < N; ++k) {
         double v = 3.0 * ((k % 2000) < 1000 ? (k % 1000) / 1000.0 : 1.0 - (k % 1000) / 1000.0);
         double y = 0.0;
-        failed |= fmi2SetReal(c, &vr_v, 1, &v) != fmi2OK;
+        failed |= fmi2SetReal(c, &vr_v_, 1, &v) != fmi2OK;
         failed |= fmi2DoStep(c, k * ts, ts, fmi2True) != fmi2OK;
-        failed |= fmi2GetReal(c, &vr_y, 1, &y) != fmi2OK;
+        failed |= fmi2GetReal(c, &vr_y_, 1, &y) != fmi2OK;
         acc += y;
     }
     clock_gettime(CLOCK_MONOTONIC, &t1);

@@ -27,6 +27,32 @@ def _find_library() -> Path:
 
 lib = ctypes.CDLL(str(_find_library()))
 
+# -- LIMITS: the C core's limits (fmu/src/core/pim_limits.h), read once -------------------------
+# The only copy in Python: use LIMITS["PIM_MAX_PLAYS"] etc., never a retyped number.
+
+lib.pim_limit_count.restype = ctypes.c_int
+lib.pim_limit_count.argtypes = []
+lib.pim_limit_name.restype = ctypes.c_char_p
+lib.pim_limit_name.argtypes = [ctypes.c_int]
+lib.pim_limit_value.restype = ctypes.c_double
+lib.pim_limit_value.argtypes = [ctypes.c_int]
+lib.pim_limit_is_integer.restype = ctypes.c_int
+lib.pim_limit_is_integer.argtypes = [ctypes.c_int]
+
+LIMITS: dict[str, int | float] = {
+    lib.pim_limit_name(i).decode(): (int(lib.pim_limit_value(i)) if lib.pim_limit_is_integer(i)
+                                     else lib.pim_limit_value(i))
+    for i in range(lib.pim_limit_count())
+}
+"""Every limit and enumeration code of the C core and the FMU units (``fmu/src/core/pim_limits.h``)
+by its C name,
+e.g. ``LIMITS["PIM_MAX_PLAYS"]`` (the FMU arrays' size); integers as ``int``, tolerances as
+``float``."""
+#: envelope kinds of pim_generalized.h by name (the PIM_ENV_* codes)
+ENVELOPE_KINDS: dict[str, int] = {k: LIMITS[f"PIM_ENV_{k.upper()}"]
+                                  for k in ("poly2", "tanh", "poly2_inv", "tanh_inv")}
+# -- end LIMITS --------------------------------------------------------------------------------
+
 c_size = ctypes.c_size_t
 c_double_p = ctypes.POINTER(ctypes.c_double)
 
@@ -150,7 +176,7 @@ def estimator_step(buf: ctypes.Array, v: float, y: float) -> tuple[int, float, f
 
 # -- compiled closed loops (fmu/src/pim_loops.h) ------------------------------------------------
 
-LOOP_MAX_PLAYS, LOOP_MAX_DYN = 64, 16  # PIM_MAX_PLAYS, PIM_LOOP_MAX_DYN
+LOOP_MAX_PLAYS, LOOP_MAX_DYN = LIMITS["PIM_MAX_PLAYS"], LIMITS["PIM_MAX_DYN"]
 _EST_WORDS = lib.pim_est_sizeof() // 8
 _D64 = ctypes.c_double * LOOP_MAX_PLAYS
 
@@ -429,7 +455,7 @@ def inverse_run(d: InverseParams, x: np.ndarray, y_d: np.ndarray) -> np.ndarray:
 # -- health of a radius estimate (fmu/src/pim_est_health.h) ------------------------------------
 
 HEALTH_EXCITATION, HEALTH_MERGED, HEALTH_PINNED, HEALTH_MOVING, HEALTH_FIT = 1, 2, 4, 8, 16
-HEALTH_MAX_PLAYS = 64  # PIM_MAX_PLAYS
+HEALTH_MAX_PLAYS = LIMITS["PIM_MAX_PLAYS"]
 
 lib.pim_health_sizeof.restype = c_size
 lib.pim_health_init.restype = ctypes.c_char_p

@@ -10,8 +10,8 @@ with ``status`` the FMI status (0 OK, 3 Error, -1 skipped by the driver) and ``l
 messages the FMU logged during the call. Serialized states can be corrupted (:data:`MUTATIONS`):
 bit flips, truncation, extension, random bytes, or a field edit with the checksum recomputed, so
 that the FMU's semantic checks (not only its checksum) are exercised. The field offsets come
-from a ctypes mirror of ``pim_unit`` (``fmu/src/pim_unit.h``), verified against a real state by
-``tests/test_fuzz_fmu.py``.
+from a ctypes mirror of the common part of ``pim_unit`` (``fmu/src/fmi/pim_unit.h``), verified
+against a real state by ``tests/test_fuzz_fmu.py``.
 """
 
 from __future__ import annotations
@@ -42,21 +42,17 @@ class StateHeader(ctypes.Structure):
 
 
 class UnitPrefix(ctypes.Structure):
-    """The leading fields of pim_unit (the estimator and the message follow)."""
+    """The common part of pim_unit, the same in every unit (fmu/src/fmi/pim_unit.h); the unit's
+    own fields (fmu/src/units/<Unit>/fields.h) and the message follow."""
 
-    _fields_ = [("Ts", ctypes.c_double), ("z0", ctypes.c_double), ("gain", ctypes.c_double),
-                ("guard", ctypes.c_double), ("n", ctypes.c_int), ("adaptive", ctypes.c_int),
-                ("linear_play", ctypes.c_int), ("slope_window", ctypes.c_int),
+    _fields_ = [("Ts", ctypes.c_double), ("z0", ctypes.c_double),
                 ("p", ctypes.c_double * NMAX), ("r", ctypes.c_double * NMAX),
                 ("in1", ctypes.c_double), ("in2", ctypes.c_double), ("out1", ctypes.c_double),
-                ("out2", ctypes.c_double), ("rhat_in", ctypes.c_double * NMAX),
-                ("rhat_out", ctypes.c_double * NMAX), ("mode", ctypes.c_int),
-                ("time", ctypes.c_double), ("k_next", ctypes.c_int64),
-                ("z", ctypes.c_double * NMAX)]
+                ("out2", ctypes.c_double), ("time", ctypes.c_double),
+                ("k_next", ctypes.c_int64), ("n", ctypes.c_int), ("mode", ctypes.c_int)]
 
 
-FIELD_FORMAT = {"n": "i", "adaptive": "i", "linear_play": "i", "slope_window": "i",
-                "mode": "i", "k_next": "q"}  # others are doubles
+FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q"}  # others are doubles
 
 
 def field_offset(field: str, index: int = 0) -> int:
@@ -101,7 +97,7 @@ def mutate(blob: bytes, spec: dict) -> bytes:
         return bytes(rng.randrange(256) for _ in range(spec.get("length", len(blob))))
     if kind == "edit":
         index = 0
-        if spec["field"] in ("p", "r", "z"):  # an element in use (index < n)
+        if spec["field"] in ("p", "r"):  # an element in use (index < n)
             n = read_field(blob, "n")
             index = spec.get("index", 0) % n if 1 <= n <= NMAX else 0
         return edit_field(blob, spec["field"], decode_float(spec["value"]), index)

@@ -121,7 +121,7 @@ def test_rate_step_rule_and_default_range(case):
     assert np.max(np.abs(stream_simulate(filtered, v, t, input_range=tiny) - want)) < 1e-12
     assert np.max(np.abs(want - no_rate.simulate(v, t))) > 1e-3
     assert STEP_SHARE == float(re.search(r"#define PIM_DIAG_STEP_SHARE ([\d.]+)", (
-        source_dir() / "pim_diagnosed.h").read_text()).group(1))
+        source_dir() / "core" / "pim_diagnosed.h").read_text()).group(1))
 
 
 def test_general_lti_coefficients():

@@ -188,22 +188,18 @@ def test_undefined_output_is_an_error_and_the_step_is_not_taken(fmus, fmi):
             u2.close()
 
 
-class OperatorFields(ctypes.Structure):
-    """pim_unit's fields of units 4-7, after z, pinv, rinv and the estimator (pim_unit.h)."""
+class AsymmetricUnit(ctypes.Structure):
+    """pim_unit of the AsymmetricPI unit: the common part, then its own fields
+    (fmu/src/units/AsymmetricPI/fields.h)."""
 
-    _fields_ = [("inverse", ctypes.c_int), ("kind_in", ctypes.c_int), ("kind_out", ctypes.c_int),
-                ("c_in", ctypes.c_double * 4), ("c_out", ctypes.c_double * 4),
+    _fields_ = [*UnitPrefix._fields_, ("z", ctypes.c_double * NMAX), ("inverse", ctypes.c_int),
+                ("kind_in", ctypes.c_int), ("c_in", ctypes.c_double * 4),
                 ("p0", ctypes.c_double), ("a_l", ctypes.c_double), ("d_l", ctypes.c_double),
-                ("a_r", ctypes.c_double), ("d_r", ctypes.c_double),
-                ("rate_gain", ctypes.c_double), ("rate_tc", ctypes.c_double),
-                ("v0", ctypes.c_double), ("lam", ctypes.c_double),
-                ("a", ctypes.c_double * NMAX)]
+                ("a_r", ctypes.c_double), ("d_r", ctypes.c_double)]
 
 
 def _field_offset(blob: bytes, field: str) -> int:
-    header = StateHeader.from_buffer_copy(blob)
-    base = ctypes.sizeof(StateHeader) + UnitPrefix.z.offset + 3 * 8 * NMAX + header.est_size
-    return base + getattr(OperatorFields, field).offset
+    return ctypes.sizeof(StateHeader) + getattr(AsymmetricUnit, field).offset
 
 
 def _edit(blob: bytes, field: str, fmt: str, value) -> bytes:

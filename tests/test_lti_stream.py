@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
+from pimodel._native import LIMITS
 from pimodel.blocks import initial_state
 from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.native_model import (
@@ -32,7 +33,6 @@ from pimodel.diagnosis.native_model import (
     state_labels,
     stream_simulate,
 )
-from pimodel.fmu.build import source_dir
 from pimodel.fmu.model_fmu import cosimulate_chain
 from pimodel.fmu.unit import FMUUnit
 
@@ -120,9 +120,7 @@ def test_sections_are_the_elements_zoh_and_the_bound_matches_the_c_core():
     assert g.tolist() == [0.3, 0.2, 0.05]
     assert element_sections(without_elements(m)) is None
     assert element_sections(replace(m, effects=())) is None  # no dynamics: not used
-    header = (source_dir() / "pim_diagnosed.h").read_text()
-    assert MAX_ELEMENTS == int(re.search(r"#define PIM_DIAG_MAX_ELEMENTS (\d+)",
-                                         header).group(1))
+    assert MAX_ELEMENTS == LIMITS["PIM_DIAG_MAX_ELEMENTS"]
 
 
 @pytest.mark.parametrize(("change", "message"), [
@@ -226,22 +224,19 @@ def test_block_of_a_model_with_report_parameters():
 
 
 def test_diagnosis_limits_are_the_c_cores():
-    """The C limits the diagnosis checks first (one place, pimodel.diagnosis.limits) are those
-    of the C headers and of the FMU builder."""
+    """The C limits the diagnosis checks first (one place, pimodel.diagnosis.limits) are the C
+    core's (pimodel._native.LIMITS, which tests/test_fmu_spec.py holds equal to the header) and
+    the FMU builder's."""
     from pimodel.diagnosis import limits
     from pimodel.fmu.build import MAX_LTI_ELEMENTS, NMAX
 
-    def define(header, name):
-        text = (source_dir() / header).read_text()
-        return int(re.search(rf"#define {name} (\d+)", text).group(1))
-
-    assert limits.NMAX == NMAX and limits.MAX_ELEMENTS == MAX_LTI_ELEMENTS
-    assert limits.MAX_ELEMENTS == define("pim_diagnosed.h", "PIM_DIAG_MAX_ELEMENTS")
-    assert limits.MAX_DELAY == define("pim_diagnosed.h", "PIM_DIAG_MAX_DELAY") - 2
-    assert limits.MAX_ORDER == define("pim_diagnosed.h", "PIM_DIAG_MAX_ORDER")
-    assert limits.SECTION == define("pim_diagnosed.h", "PIM_DIAG_SECTION")
-    assert limits.MAX_SECTIONS == define("pim_diag_inverse.h", "PIM_DINV_MAX_SECTIONS")
-    assert limits.MAX_LATENCY == define("pim_diag_inverse.h", "PIM_DINV_MAX_LATENCY")
+    assert limits.NMAX == NMAX == LIMITS["PIM_MAX_PLAYS"]
+    assert limits.MAX_ELEMENTS == MAX_LTI_ELEMENTS == LIMITS["PIM_DIAG_MAX_ELEMENTS"]
+    assert limits.MAX_DELAY == LIMITS["PIM_DIAG_MAX_DELAY"] - 2
+    assert limits.MAX_ORDER == LIMITS["PIM_DIAG_MAX_ORDER"]
+    assert limits.SECTION == LIMITS["PIM_DIAG_SECTION"]
+    assert limits.MAX_SECTIONS == LIMITS["PIM_DINV_MAX_SECTIONS"]
+    assert limits.MAX_LATENCY == LIMITS["PIM_DINV_MAX_LATENCY"]
 
 
 @pytest.mark.parametrize(("old", "new"), [

@@ -44,6 +44,7 @@ import control
 import numpy as np
 from scipy.signal import sosfilt_zi
 
+from .._native import LIMITS
 from ..blocks.framework import BlockSettings, signal_labels, stepped_block
 from .checks import block_dt
 from .lti import inverse_sos
@@ -54,7 +55,8 @@ from .wiener import inverse_sections
 __all__ = ["StaticInverse", "feedforward_block", "inverse_block", "inverse_latency",
            "solve_static"]
 
-RATE_FEEDBACK_CAP = 2.0  # the solved input's rate fed back: at most this times the fresh rate
+# the solved input's rate fed back: at most this times the fresh rate (the C core's constant)
+RATE_FEEDBACK_CAP = LIMITS["PIM_DINV_RATE_FEEDBACK_CAP"]
 
 
 def inverse_latency(model) -> int:

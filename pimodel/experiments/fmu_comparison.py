@@ -29,6 +29,7 @@ __all__ = [
     "plot_comparison",
 ]
 
+
 DT = 1e-4  # s
 
 

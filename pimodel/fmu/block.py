@@ -24,9 +24,7 @@ from ..blocks.framework import Block
 from ..checks import positive_scalar
 from .unit import FMUUnit
 
-__all__ = [
-    "fmu_block",
-]
+__all__ = ["fmu_block"]
 
 
 def _signals(unit: FMUUnit, causality: str) -> list[str]:

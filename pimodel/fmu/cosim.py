@@ -5,7 +5,7 @@ the linear stage dynamics stepped by the master (discrete state space). Per step
 InversePI gets ``y_d[k]`` and the estimator's ``r_hat`` (the estimate after step k-1) and gives
 ``v[k]``; PIHysteresis gives ``h[k] = PI[v][k]``; the master computes ``y[k] = C xd + D h`` and
 ``xd <- A xd + B h``; the estimator takes ``(v[k], y[k])``. This is the loop of
-:func:`pimodel.loops.compiled.run_loop` with ``feedforward="adaptive"``, so the two agree exactly.
+:func:`pimodel.loops.run_loop` with ``feedforward="adaptive"``, so the two agree exactly.
 """
 
 from __future__ import annotations
@@ -22,9 +22,7 @@ from ..operators.pi import PIOperator
 from .build import fmu_filename
 from .unit import FMUUnit
 
-__all__ = [
-    "cosimulate_adaptive_loop",
-]
+__all__ = ["cosimulate_adaptive_loop"]
 
 LOOP_UNITS = ("PIHysteresis", "RadiusEstimator", "InversePI")  # the FMUs this master runs
 
@@ -94,7 +92,7 @@ def cosimulate_adaptive_loop(fmu_dir, ref, dt: float, plant: PIOperator, *, weig
     >>> from pimodel import PIOperator
     >>> from pimodel.blocks import radius_estimator
     >>> from pimodel.fmu import build_fmus
-    >>> from pimodel.loops.compiled import run_loop
+    >>> from pimodel.loops import run_loop
     >>> plant = PIOperator([1.0, 0.5], [0.0, 0.3])
     >>> ref = np.sin(np.linspace(0, 4 * np.pi, 200))
     >>> est = radius_estimator([1.0, 0.5], dt=1e-3, gains=10.0, initial_radii=[0.0, 0.1],

@@ -1,34 +1,28 @@
 """FMUs of a model (an operator, an inverse or a :class:`~pimodel.operators.cascade.Cascade`): one
 FMU per operator, each a unit of ``pimodel.fmu.build.MODELS`` whose parameters' start values are the
-operator's (in the model description and compiled into the binary), so that an importer that sets
-nothing runs the model. A cascade becomes one FMU per stage, ``<stem>_<i>_<Unit>.fmu`` (i = 1.. in
-the order of the stages); connect stage i's output (``y``) to stage i+1's input (``u``; ``v`` for a
-PIOperator stage, unit PIHysteresis); :func:`cosimulate_chain` does so, in one communication step
-per sample.
+operator's (in the model description and compiled into the binary), so that an importer that
+sets nothing runs the model. A cascade becomes one FMU per stage, ``<stem>_<i>_<Unit>.fmu``
+(i = 1.. in the order of the stages); connect stage i's output (``y``) to stage i+1's input
+(``u``; ``v`` for a PIOperator stage, unit PIHysteresis); :func:`cosimulate_chain` does so, in
+one communication step per sample.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ..operators.cascade import Cascade
-from .build import MODEL_UNITS, MODELS, Var, build_fmus, check_fmi_version
+from .build import build_fmus
 from .operators import unit_parameters
+from .spec import MODEL_UNITS, MODELS, Var, check_fmi_version
 from .unit import FMUUnit
 
 __all__ = ["build_inverse_fmu", "build_model_fmus", "cosimulate_chain"]
-
-# FMU variable -> pim_unit field (fmu/src/pim_unit.h) for the compiled start values
-_FIELDS = {"in_kind": "kind_in", "out_kind": "kind_out", "shape_kind": "kind_in",
-           "rate_time_constant": "rate_tc", "c": "p", "tau": "r",
-           "asymmetry_quadratic": "asym_q", "asymmetry_cubic": "asym_c3",
-           **{f"{k}_c{j}": f"{'c_out' if k == 'out' else 'c_in'}[{j}]"
-              for k in ("in", "out", "shape") for j in range(4)}}
-
 
 def _c_value(value) -> str:
     if isinstance(value, (bool, np.bool_)):
@@ -46,11 +40,12 @@ def _xml_value(var: Var, value) -> str:
     return repr(float(value))
 
 
-def _defaults(params: dict) -> str:
+def _defaults(unit: str, params: dict) -> str:
+    """C statements setting the parameters' start values in the unit's storage (Var.storage)."""
+    variables = {v.name: v for v in MODELS[unit]["vars"]}
     out = []
     for name, value in params.items():
-        base, _, rest = name.partition("[")
-        field = _FIELDS.get(base, base)
+        field, rest = variables[name].storage, name.partition("[")[2]
         if rest:
             field = f"{field}[{int(rest[:-1]) - 1}]"
         out.append(f"(u)->{field} = {_c_value(value)};")
@@ -63,9 +58,9 @@ def _spec(unit: str, params: dict, salt: str) -> dict:
     unknown = set(params) - names
     if unknown:
         raise ValueError(f"parameters {sorted(unknown)} are not variables of {unit}")
-    variables = [Var(v.name, v.vr, v.kind, v.causality, _xml_value(v, params[v.name]),
-                     v.description) if v.name in params else v for v in spec["vars"]]
-    return {**spec, "vars": variables, "salt": salt, "defaults": _defaults(params)}
+    variables = [replace(v, start=_xml_value(v, params[v.name])) if v.name in params else v
+                 for v in spec["vars"]]
+    return {**spec, "vars": variables, "salt": salt, "defaults": _defaults(unit, params)}
 
 
 def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | None = None,

@@ -1,7 +1,8 @@
 """Parameter values of the pimodel FMU units (``pimodel.fmu.build.MODELS``) for the Python
-operators: :func:`unit_parameters` maps a :class:`~pimodel.operators.generalized.GeneralizedPI`,
+operators: :func:`unit_parameters` maps a
+:class:`~pimodel.operators.generalized.GeneralizedPI`,
 :class:`~pimodel.operators.asymmetric.AsymmetricPI`,
-:class:`~pimodel.operators.rate_dependent.RateDependentPI`,
+:class:`~pimodel.operators.rate_dependent.RateDependentPI` or
 :class:`~pimodel.operators.creep.CreepOperator` (or the inverse of one of them) to the unit that
 runs it and the values of its variables, by the FMI 2 names (``"p[2]"``) that :class:`FMUUnit` also
 accepts for FMI 3. The unit at sample time ``Ts`` then gives ``u[k] -> y[k]`` exactly as the
@@ -22,7 +23,7 @@ from ..operators.creep import CreepOperator
 from ..operators.generalized import GeneralizedPI
 from ..operators.pi import PIOperator
 from ..operators.rate_dependent import RateDependentPI, RateDependentPIInverse
-from .build import ENVELOPE_KINDS, NMAX
+from .spec import ENVELOPE_KINDS, NMAX
 
 __all__ = ["unit_parameters"]
 
@@ -53,9 +54,9 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
     op : GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, an inverse of these,
         a PIOperator (unit PIHysteresis, input ``v``; no ``inverse`` variable) or a
         :class:`~pimodel.diagnosis.model.DiagnosedModel` (unit DiagnosedModel, input ``v``,
-        ``Ts`` its ``dt``; :func:`pimodel.diagnosis.stream.fmu_parameters`) or its
+        ``Ts`` its ``dt``; :func:`pimodel.diagnosis.native_model.fmu_parameters`) or its
         :class:`~pimodel.diagnosis.model.DiagnosedInverse` (unit DiagnosedInverse, input
-        ``y_d``, output ``v``; :func:`pimodel.diagnosis.inverse_native.inverse_fmu_parameters`)
+        ``y_d``, output ``v``; :func:`pimodel.diagnosis.native_inverse.inverse_fmu_parameters`)
         The operator (inverses: ``AsymmetricPIInverse``, ``RateDependentPIInverse``, an
         inverted ``CreepOperator``, the result of ``GeneralizedPI.inverse()``).
     Ts : float, optional

@@ -22,9 +22,7 @@ from fmpy.fmi2 import (
 )
 from fmpy.fmi3 import FMU3Slave
 
-__all__ = [
-    "FMUUnit",
-]
+__all__ = ["FMUUnit"]
 
 # FMU variables renamed in the pimodel FMUs; the old names work for one release with a warning.
 RENAMED = {"known_linear": "linear_play"}

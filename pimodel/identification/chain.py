@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._native import LIMITS
 from ..checks import as_signal, integer_in, positive_scalar
 from ..operators.pi import PIOperator
 from .adaptive.health import EstimatorHealth, estimator_health
@@ -42,7 +43,7 @@ __all__ = [
 
 METHODS = ("adaptive", "conventional", "joint")
 HISTORY_LIMIT = 2_000_000  # samples (record x passes) up to which the estimate history is kept
-MAX_PLAYS = 64                  # the FMUs' limit too
+MAX_PLAYS = LIMITS["PIM_MAX_PLAYS"]  # the FMUs' limit too
 MAX_REPEATED_SAMPLES = 20_000_000  # passes * record length: bounds the repeated record's memory
 MIN_LOOP_R2 = 0.5               # below: "no hysteresis loop found" warning
 

@@ -21,7 +21,7 @@ from ..checks import as_signal, as_vector
 
 __all__ = ["Envelope"]
 
-_KINDS = {"poly2": 0, "tanh": 1, "poly2_inv": 2, "tanh_inv": 3}
+_KINDS = _native.ENVELOPE_KINDS
 _INVERSE = {"poly2": "poly2_inv", "tanh": "tanh_inv", "poly2_inv": "poly2", "tanh_inv": "tanh"}
 
 

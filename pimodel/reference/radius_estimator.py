@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._native import LIMITS
+
 __all__ = [
     "BranchProfile",
     "estimate_radii_reference",
     "project_ordered_reference",
 ]
 
-BINS = 256  # PIM_EST_BINS
+BINS = LIMITS["PIM_EST_BINS"]  # the C core's, so that the two stay equal
 
 
 def project_ordered_reference(x: np.ndarray, w: np.ndarray, fix_first: bool) -> np.ndarray:

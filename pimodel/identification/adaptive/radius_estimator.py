@@ -82,11 +82,11 @@ __all__ = [
 ]
 
 _lib = _native.lib
-EST_WINDOW = 64  # PIM_EST_WIN in pim_estimator.h
-EST_BINS = 256  # PIM_EST_BINS
-LAWS = {"data": 0, "paper": 1}  # PIM_LAW_DATA, PIM_LAW_PAPER in pim_estimator.h
+EST_WINDOW = _native.LIMITS["PIM_EST_WIN"]
+EST_BINS = _native.LIMITS["PIM_EST_BINS"]
+LAWS = {"data": _native.LIMITS["PIM_LAW_DATA"], "paper": _native.LIMITS["PIM_LAW_PAPER"]}
 
-MAX_PLAYS = 64
+MAX_PLAYS = _native.LIMITS["PIM_MAX_PLAYS"]
 
 
 def project_ordered(x, weights=None, *, fix_first: bool = False) -> np.ndarray:

@@ -56,8 +56,6 @@
 extern "C" {
 #endif
 
-#define PIM_EST_WIN 64    /* ring buffer for the slope check (max window + 1) */
-#define PIM_EST_BINS 256  /* bins of the branch slope profile (law PIM_LAW_DATA) */
 #define PIM_LAW_DATA 0    /* regime from the measured branch profile (default) */
 #define PIM_LAW_PAPER 1   /* regime from the estimate, as in the paper */
 

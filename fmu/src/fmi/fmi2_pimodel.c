@@ -1,9 +1,9 @@
 /*
- * FMI 2.0 Co-Simulation glue for the pimodel units (pim_unit.h), one source for the three
- * models; the including file defines PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
- * 3 InversePI) and PIM_MODEL_GUID.  Sampling rule, limits, modes, value references and the FMU
- * state format: pim_unit.h (array element p[i+1] has reference 100 + i, r[i+1] 200 + i,
- * r_hat[i+1] 300 + i).  Every failure returns fmi2Error and logs the reason.
+ * FMI 2.0 Co-Simulation glue for the pimodel units (pim_unit.h), one source for every unit,
+ * without unit-specific code; the including model.c includes the unit's config.h first
+ * (PIM_MODEL, PIM_MODEL_GUID, the variables).  Sampling rule, limits, modes, value references
+ * and the FMU state format: pim_unit.h (array element p[i+1] has reference 100 + i, r[i+1]
+ * 200 + i, r_hat[i+1] 300 + i).  Every failure returns fmi2Error and logs the reason.
  */
 #include <stdlib.h>
 
@@ -106,14 +106,12 @@ fmi2Status fmi2Terminate(fmi2Component comp)
     INST(comp);
     IN_MODES(PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) | PIM_IN(PIM_TERMINATED),
              "fmi2Terminate");
-#if PIM_MODEL == 2
-    /* the estimate's health report, once, as a warning (category logStatusWarning) */
+    /* the unit's report (RadiusEstimator: the estimate's health), once, as a warning
+     * (category logStatusWarning) */
     char report[4096];
-    if (c->u.mode == PIM_STEP_MODE && unit_health_report(&c->u, report, sizeof report) &&
-        c->cb.logger)
+    if (unit_terminate_report(&c->u, report, sizeof report) && c->cb.logger)
         c->cb.logger(c->cb.componentEnvironment, c->name, fmi2Warning, "logStatusWarning",
                      report);
-#endif
     c->u.mode = PIM_TERMINATED;
     return fmi2OK;
 }

@@ -26,7 +26,6 @@
 extern "C" {
 #endif
 
-#define PIM_MAX_DYN 16
 
 /*
  * Adaptive inverse step: forward model with weights p and current radii r (sorted, r[0] == 0),

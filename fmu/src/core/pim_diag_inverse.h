@@ -1,7 +1,7 @@
 /*
  * The causal feedforward of a diagnosed model (pimodel.diagnosis.model.DiagnosedInverse.block,
- * pimodel.diagnosis.inverse_stream._InverseStream) streamed sample by sample: one
- * implementation for the Python binding (pimodel.diagnosis.inverse_native) and the
+ * pimodel.diagnosis.reference_inverse._InverseStream) streamed sample by sample: one
+ * implementation for the Python binding (pimodel.diagnosis.native_inverse) and the
  * DiagnosedInverse FMU unit (pim_unit.h, unit 9).
  *
  * Discrete-time semantics, reference sample y_d[k] in, input v[k] out (units: y_d in the
@@ -48,7 +48,7 @@
  * solver]
  * with solver = [started, v_prev, guess, z[n], L[m]] and, with a rate effect, [rho_f, m[n],
  * v0_prev, source] where source is a rate-free solver's state (same layout, no rate).  The
- * layout is that of the Python stream's state (inverse_stream._InverseStream.labels).
+ * layout is that of the Python stream's state (reference_inverse._InverseStream.labels).
  */
 #ifndef PIM_DIAG_INVERSE_H
 #define PIM_DIAG_INVERSE_H
@@ -59,12 +59,8 @@
 extern "C" {
 #endif
 
-#define PIM_DINV_MAX_PLAYS PIM_DIAG_MAX_PLAYS   /* 128 */
-#define PIM_DINV_MAX_LAGS PIM_DIAG_MAX_LAGS     /* 64 */
-#define PIM_DINV_MAX_SECTIONS 32                /* prefilter sections */
-#define PIM_DINV_MAX_LATENCY 1000000            /* samples */
 #define PIM_DINV_HEAD 4
-#define PIM_DINV_RATE_FEEDBACK_CAP 2.0          /* inverse_stream.RATE_FEEDBACK_CAP */
+#define PIM_DINV_RATE_FEEDBACK_CAP 2.0          /* reference_inverse.RATE_FEEDBACK_CAP */
 #define PIM_DINV_SOLVER_MAX (3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS + 2 + PIM_DINV_MAX_PLAYS + \
                              3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS)
 #define PIM_DINV_STATE_MAX (PIM_DINV_HEAD + 4 * PIM_DINV_MAX_SECTIONS + PIM_DINV_SOLVER_MAX)

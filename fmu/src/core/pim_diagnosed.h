@@ -2,7 +2,7 @@
  * The model a diagnosis chose (pimodel.diagnosis.model.DiagnosedModel), streamed sample by
  * sample: the PI hysteresis of a radius grid with signed weights and, in parallel, the effect
  * terms the diagnosis fitted jointly with it.  One implementation for the python-control block
- * (DiagnosedModel.block), the Python runner (pimodel.diagnosis.stream) and the DiagnosedModel
+ * (DiagnosedModel.block), the Python runner (pimodel.diagnosis.native_model) and the DiagnosedModel
  * FMU unit (pim_unit.h, unit 8).
  *
  * Discrete-time semantics, sample k at time t[k], input v[k], plays at rest at z_i[-1] (the
@@ -63,13 +63,7 @@ extern "C" {
 #define PIM_DIAG_STEP_SHARE 0.05     /* pimodel.diagnosis.rate.STEP_SHARE */
 #define PIM_DIAG_RATE_RADIUS 0       /* rate_family: radii growing with the rate */
 #define PIM_DIAG_RATE_WEIGHT 1       /* rate_family: weights growing with the rate */
-#define PIM_DIAG_MAX_DELAY 4096      /* longest delay line (samples), so d <= 4094 */
-#define PIM_DIAG_MAX_ORDER 63        /* LTI order: b[0..order], a[0..order] in 64 values */
-#define PIM_DIAG_MAX_ELEMENTS 8      /* further elements of the linear part (a diagnosis: <= 2) */
-#define PIM_DIAG_SECTION 3           /* coefficients per section: b[0..2], a[0..2] */
 #define PIM_DIAG_HEADER 4            /* started, v_prev, t_start, head */
-#define PIM_DIAG_MAX_PLAYS (2 * PIM_MAX_PLAYS) /* plays of the FMU unit (a diagnosis: <= 80) */
-#define PIM_DIAG_MAX_LAGS PIM_MAX_PLAYS        /* creep lags of the FMU unit */
 #define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + 1 + PIM_DIAG_MAX_LAGS + \
                             PIM_DIAG_MAX_ORDER + 2 * (PIM_DIAG_MAX_ELEMENTS + 1) + \
                             PIM_DIAG_MAX_DELAY + PIM_DIAG_MAX_PLAYS + \

@@ -17,6 +17,9 @@
 
 #include <stddef.h>
 
+#include "pim_limits.h" /* PIM_MAX_PLAYS (the fixed-size users' limit; the array functions
+                            * take any n) and every other limit */
+
 #if defined(_WIN32)
 #define PIM_API __declspec(dllexport)
 #else
@@ -26,9 +29,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* Largest number of plays the fixed-size users (FMUs) accept; the array functions take any n. */
-#define PIM_MAX_PLAYS 64
 
 /* One step of the PI operator: updates z[0..n-1] for input v and returns y. */
 PIM_API double pim_pi_step(size_t n, const double *p, const double *r, double *z, double v);
@@ -63,6 +63,13 @@ PIM_API int pim_pi_inverse(size_t n, const double *p, const double *r, const dou
  * message naming the first offending parameter.  Used by the FMUs to report fmi2Error.
  */
 PIM_API const char *pim_pi_check(size_t n, const double *p, const double *r, int signed_weights);
+
+/* The limits of pim_limits.h by index 0..pim_limit_count()-1: name (NULL out of range), value,
+ * and whether it is an integer (else a real tolerance). */
+PIM_API int pim_limit_count(void);
+PIM_API const char *pim_limit_name(int i);
+PIM_API double pim_limit_value(int i);
+PIM_API int pim_limit_is_integer(int i);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,7 @@
 /*
- * FMI 3.0 Co-Simulation glue for the pimodel units (pim_unit.h), one source for the three
- * models; the including file defines PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator,
- * 3 InversePI) and PIM_MODEL_TOKEN (the instantiation token).  Sampling rule and value
+ * FMI 3.0 Co-Simulation glue for the pimodel units (pim_unit.h), one source for every unit,
+ * without unit-specific code; the including model.c includes the unit's config.h first
+ * (PIM_MODEL, PIM_MODEL_TOKEN the instantiation token, the variables).  Sampling rule and value
  * references, limits, modes and the FMU state format: pim_unit.h.  Here p (100), r (200) and
  * r_hat (300) are real arrays of PIM_NMAX elements (the first n are used): getting or setting
  * one moves PIM_NMAX values.  Reference 9 is the independent variable time (the end of the last
@@ -124,13 +124,11 @@ fmi3Status fmi3Terminate(fmi3Instance inst)
     INST(inst);
     IN_MODES(PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) | PIM_IN(PIM_TERMINATED),
              "fmi3Terminate");
-#if PIM_MODEL == 2
-    /* the estimate's health report, once, as a warning (category logStatusWarning) */
+    /* the unit's report (RadiusEstimator: the estimate's health), once, as a warning
+     * (category logStatusWarning) */
     char report[4096];
-    if (c->u.mode == PIM_STEP_MODE && unit_health_report(&c->u, report, sizeof report) &&
-        c->log)
+    if (unit_terminate_report(&c->u, report, sizeof report) && c->log)
         c->log(c->env, fmi3Warning, "logStatusWarning", report);
-#endif
     c->u.mode = PIM_TERMINATED;
     return fmi3OK;
 }

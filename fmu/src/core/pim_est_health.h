@@ -36,14 +36,11 @@
 extern "C" {
 #endif
 
-#define PIM_HEALTH_CHECKPOINTS 64 /* even */
 #define PIM_HEALTH_EXCITATION 1
 #define PIM_HEALTH_MERGED 2
 #define PIM_HEALTH_PINNED 4
 #define PIM_HEALTH_MOVING 8
 #define PIM_HEALTH_FIT 16
-#define PIM_HEALTH_MOVING_TOL 0.01 /* drift tolerance, fraction of max(final) */
-#define PIM_HEALTH_MERGE_TOL 1e-6  /* merged: gap below this fraction of max(final) */
 
 typedef struct {
     size_t n;

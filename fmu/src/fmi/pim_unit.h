@@ -1,0 +1,571 @@
+/*
+ * The pimodel FMU framework, independent of the FMI version and of the unit: variables, modes,
+ * the common parameter check, the sampling rule, the step and its rollback, and the checked FMU
+ * state format.  Included (static functions) by the FMI 2 and FMI 3 glue after config.h
+ * (generated from pimodel.fmu.spec: MODEL_IDENTIFIER, PIM_MODEL, ValueReference,
+ * PIM_UNIT_VARIABLES).
+ * Functions return 0 on success, or -1 with the reason in u->msg.
+ *
+ * One folder per unit (units/<Unit>/, as the Modelica Reference-FMUs): fields.h declares the
+ * unit's own fields of pim_unit (included inside the struct) and unit.h its hooks, which this
+ * framework calls and which are the only unit-specific code (those marked * are optional: a
+ * unit that defines one says so with HAS_MODEL_<NAME>, e.g. HAS_MODEL_DERIVE):
+ *
+ *   model_defaults(u) *        start values of the unit's own parameters
+ *   model_check_parameters(u)  the unit's parameter rules (after n, Ts, z0 here)
+ *   model_derive(u) *          quantities derived from checked parameters (setup, restored state)
+ *   model_setup(u)             initial states at exitInitializationMode (and model_derive)
+ *   model_check_inputs(u) *    the inputs held over a step, besides the main input (in1)
+ *   model_sample(u)            one internal sample at the held inputs
+ *   model_outputs_finite(u) *  the unit's further outputs are finite (out1, out2 checked here)
+ *   model_saved, model_save(u, s), model_restore(u, s)   the states a step changes, for the
+ *                              rollback of a step that overflows (once per doStep, not per sample)
+ *   model_step_done(u) *       after a step's samples (e.g. the RadiusEstimator's health output)
+ *   model_check_states(u, s)   the states of a loaded FMU state s (parameters already checked)
+ *   model_report(u, buf, size) * a report in words logged once at terminate (0: none)
+ *
+ * Code shared by some units is in units/shared/ (plays.h, play_states.h, play_state_hooks.h,
+ * inverse_flag.h, inverse_pi.h, envelope_check.h, sections.h, diag_fields.h, diag_static.h).
+ * The numerics are the shared C core (core/pim_*.c).  An optional PIM_MODEL_DEFAULTS(u)
+ * (config.h of a model's operator FMU, `pimodel fmu build --model`) sets the parameters' start
+ * values after model_defaults.
+ *
+ * Sampling rule: internal sample k (an int64 counter) happens at time k*Ts.  A step from t over
+ * h processes every sample with k*Ts in [t, t+h) (tolerance 1e-9*Ts), each with the inputs set
+ * before the call (held over the step); outputs are those of the last processed sample and hold
+ * between samples.  A step shorter than Ts that contains no sample instant changes nothing.
+ *
+ * Limits (each breach is an error with a logged reason, never a crash or a hang):
+ *   n in 1..PIM_UNIT_NMAX (64; DiagnosedModel, DiagnosedInverse: 128) plays; Ts finite and
+ *   >= PIM_TS_MIN; start time finite and >= 0; at most PIM_MAX_SUBSTEPS (10^7) samples per
+ *   doStep; sample index (t+h)/Ts below PIM_MAX_SAMPLE_INDEX (2^52, where k*Ts is still exact in
+ *   double); doStep needs t == the FMU's time (the end of the last step) within
+ *   min(1e-9 max(1, |t|), 1e-3 Ts), h finite and > 0, and t + h > t.
+ *
+ * Value references: config.h's enum ValueReference and table PIM_UNIT_VARIABLES (name,
+ * reference, type, causality, size, member of pim_unit), generated from the Python spec like
+ * the model description, are the one source of truth; tests/test_fmu3.py holds every built
+ * modelDescription.xml (FMI 2 and 3) equal to it.  In FMI 2 array element x[i+1] has reference
+ * base + i (p 100, r 200, r_hat 300, ...: pimodel.fmu.spec); in FMI 3 an array is one variable.
+ */
+#ifndef PIM_UNIT_H
+#define PIM_UNIT_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pim_asymmetric.h"
+#include "pim_core.h"
+#include "pim_creep.h"
+#include "pim_diag_inverse.h"
+#include "pim_diagnosed.h"
+#include "pim_est_health.h"
+#include "pim_estimator.h"
+#include "pim_generalized.h"
+#include "pim_loops.h"
+#include "pim_rate_dependent.h"
+
+#include "config.h" /* generated: MODEL_IDENTIFIER, PIM_MODEL, ValueReference, PIM_UNIT_VARIABLES */
+
+#if !defined(PIM_MODEL) || PIM_MODEL < 1 || PIM_MODEL > 9
+#error "define PIM_MODEL (1 PIHysteresis, 2 RadiusEstimator, 3 InversePI, 4 GeneralizedPI, \
+5 AsymmetricPI, 6 RateDependentPI, 7 CreepOperator, 8 DiagnosedModel, 9 DiagnosedInverse)"
+#endif
+
+#define PIM_NMAX PIM_MAX_PLAYS            /* declared array size: p[1..64], r[..], r_hat[..] */
+#define NMAX PIM_NMAX
+
+
+typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
+
+typedef struct {
+    const char *name;
+    unsigned vr;
+    char type; /* 'R' Real/Float64, 'I' Integer/Int32, 'B' Boolean */
+    pim_causality causality;
+    int size;      /* 1, or PIM_NMAX for an array */
+    size_t offset; /* of the value(s) in pim_unit */
+} pim_var;
+
+
+/* Life cycle (FMI 2 and 3 Co-Simulation): instantiated -> initialization mode -> step mode
+ * (after a successful exitInitializationMode) -> terminated; reset goes back to instantiated. */
+enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED };
+
+/* The unit: the common part (the same layout in every unit, mirrored by tests/fmu_driver.py),
+ * then the unit's own fields (units/<Unit>/fields.h). */
+typedef struct {
+    /* common parameters: sample time, initial play state, plays 1..64 (weights p, radii r;
+     * CreepOperator: gains c in p, time constants tau in r; 16-byte aligned as the arrays
+     * the core's loops run over) */
+    double Ts, z0;
+    double p[PIM_NMAX], r[PIM_NMAX];
+    /* inputs and outputs (the spec's names: in1 is v, y_d or u; in2 and out2 the
+     * RadiusEstimator's y and e) */
+    double in1, in2, out1, out2;
+    /* time and sample counter; the number of plays (a parameter) and the mode */
+    double time;    /* the end of the last communication step (the start time before any) */
+    int64_t k_next; /* index of the next sample to process */
+    int n, mode;
+    /* the unit's own parameters, states and derived quantities */
+#include "fields.h"
+    char msg[256]; /* reason of the last failure */
+} pim_unit;
+
+#ifndef PIM_UNIT_NMAX
+#define PIM_UNIT_NMAX PIM_NMAX /* largest n (a unit's fields.h may raise it) */
+#endif
+
+#define PIM_AT(field) offsetof(pim_unit, field)
+
+/* The variables of the unit: the table PIM_UNIT_VARIABLES of config.h, generated from the
+ * Python spec (pimodel.fmu.spec) like the model description; inputs and outputs first, as the
+ * accessors scan it on every call. */
+#define PIM_VAR_ROW(name, vr, type, causality, size, member) \
+    {name, vr, type, causality, size, PIM_AT(member)},
+static const pim_var unit_vars[] = {PIM_UNIT_VARIABLES(PIM_VAR_ROW)};
+#undef PIM_VAR_ROW
+#define PIM_NVARS (sizeof unit_vars / sizeof unit_vars[0])
+
+/* The name of the variable stored at offset (e.g. the main input's, "v", "y_d" or "u"). */
+static const char *unit_name_of(size_t offset)
+{
+    for (size_t i = 0; i < PIM_NVARS; ++i)
+        if (unit_vars[i].offset == offset) return unit_vars[i].name;
+    return "?";
+}
+
+static int unit_error(pim_unit *u, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(u->msg, sizeof u->msg, fmt, ap);
+    va_end(ap);
+    /* hosts may pass the message on as a format string: no '%' in it */
+    for (char *q = u->msg; *q; ++q)
+        if (*q == '%') *q = ' ';
+    return -1;
+}
+
+static const char *unit_mode_name(int mode)
+{
+    switch (mode) {
+    case PIM_INSTANTIATED: return "instantiated";
+    case PIM_INIT_MODE: return "in initialization mode";
+    case PIM_STEP_MODE: return "in step mode";
+    case PIM_TERMINATED: return "terminated";
+    default: return "in an unknown mode";
+    }
+}
+
+/* 0 if the unit's mode is one of the bits in `allowed` (1 << mode), else -1 naming the call. */
+static int unit_require_mode(pim_unit *u, unsigned allowed, const char *call)
+{
+    if (u->mode >= PIM_INSTANTIATED && u->mode <= PIM_TERMINATED && (allowed & (1u << u->mode)))
+        return 0;
+    return unit_error(u, "%s is not allowed now: the FMU is %s", call, unit_mode_name(u->mode));
+}
+#define PIM_IN(m) (1u << (m))
+
+/* Whether x[0..n) are all finite (for the units' state checks). */
+static inline int unit_all_finite(const double *x, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(x[i])) return 0;
+    return 1;
+}
+
+/* The unit's own code: its hooks (model_*, above), after the struct and unit_error.  A unit
+ * declares the optional hooks it defines (HAS_MODEL_DEFAULTS, ...), as the Reference-FMUs'
+ * config.h declares its capabilities; the others do nothing: */
+#include "unit.h"
+
+#ifndef HAS_MODEL_DEFAULTS
+static void model_defaults(pim_unit *u) { (void)u; }
+#endif
+#ifndef HAS_MODEL_DERIVE
+static int model_derive(pim_unit *u) { (void)u; return 0; }
+#endif
+#ifndef HAS_MODEL_CHECK_INPUTS
+static int model_check_inputs(pim_unit *u) { (void)u; return 0; }
+#endif
+#ifndef HAS_MODEL_OUTPUTS_FINITE
+static int model_outputs_finite(const pim_unit *u) { (void)u; return 1; }
+#endif
+#ifndef HAS_MODEL_STEP_DONE
+static void model_step_done(pim_unit *u) { (void)u; }
+#endif
+#ifndef HAS_MODEL_REPORT
+static int model_report(const pim_unit *u, char *buf, size_t size)
+{
+    (void)u, (void)buf, (void)size;
+    return 0;
+}
+#endif
+
+/* Index of the first sample at or after time t. */
+static double unit_first_sample(const pim_unit *u, double t)
+{
+    return ceil(t / u->Ts - PIM_SAMPLE_TOL);
+}
+
+static void unit_defaults(pim_unit *u)
+{
+    memset(u, 0, sizeof *u);
+    u->Ts = 1e-3;
+    u->n = 1;
+    u->mode = PIM_INSTANTIATED;
+    for (int i = 0; i < PIM_NMAX; ++i) u->p[i] = 1.0;
+    model_defaults(u);
+#ifdef PIM_MODEL_DEFAULTS
+    PIM_MODEL_DEFAULTS(u);
+#endif
+}
+
+/* Start time (setupExperiment / enterInitializationMode): finite and >= 0. */
+static int unit_start(pim_unit *u, double t0, int stop_defined, double t_stop)
+{
+    if (!isfinite(t0) || t0 < 0.0)
+        return unit_error(u, "start time = %g: must be finite and >= 0", t0);
+    if (stop_defined && (!isfinite(t_stop) || t_stop < t0))
+        return unit_error(u, "stop time = %g: must be finite and >= the start time %g", t_stop,
+                          t0);
+    u->time = t0;
+    return 0;
+}
+
+/* Quantities derived from checked parameters; at setup and for every restored FMU state. */
+static int unit_derive(pim_unit *u)
+{
+    return model_derive(u);
+}
+
+/* The parameter rules, shared by initialization and by every FMU state that is restored. */
+static int unit_check_parameters(pim_unit *u)
+{
+    if (u->n < 1 || u->n > PIM_UNIT_NMAX)
+        return unit_error(u, "parameter n = %d out of range: 1 <= n <= %d", u->n, PIM_UNIT_NMAX);
+    if (!isfinite(u->Ts) || !(u->Ts >= PIM_TS_MIN))
+        return unit_error(u, "parameter Ts = %g: the sample time must be > 0 (finite, >= %g)",
+                          u->Ts, PIM_TS_MIN);
+    if (!isfinite(u->z0)) return unit_error(u, "parameter z0 = %g: must be finite", u->z0);
+    return model_check_parameters(u);
+}
+
+/* Checks the parameters and sets up the states (exitInitializationMode). */
+static int unit_setup(pim_unit *u)
+{
+    if (unit_check_parameters(u) != 0) return -1;
+    const double k0 = unit_first_sample(u, u->time);
+    if (!(k0 < PIM_MAX_SAMPLE_INDEX))
+        return unit_error(u, "start time %g is beyond the sample counter's range (2^52 samples "
+                             "of Ts = %g)", u->time, u->Ts);
+    u->k_next = (int64_t)k0;
+    return model_setup(u);
+}
+
+/* The inputs held over a step: finite (and the unit's further inputs admissible). */
+static int unit_check_inputs(pim_unit *u)
+{
+    if (!isfinite(u->in1))
+        return unit_error(u, "input %s = %g is not finite (NaN or Inf)",
+                          unit_name_of(PIM_AT(in1)), u->in1);
+    return model_check_inputs(u);
+}
+
+/* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
+static int unit_do_step(pim_unit *u, double t, double h)
+{
+    if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
+    if (!isfinite(t) || t < 0.0)
+        return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
+    if (!isfinite(h) || !(h > 0.0))
+        return unit_error(u, "communication step size h = %g: must be finite and > 0", h);
+    const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
+    const double tol = 1e-9 * scale < 1e-3 * u->Ts ? 1e-9 * scale : 1e-3 * u->Ts;
+    if (t != u->time && fabs(t - u->time) > tol)
+        return unit_error(u, "communication point t = %.17g does not match the FMU's time "
+                             "%.17g (the end of the last step)", t, u->time);
+    const double t_end = t + h;
+    if (!(t_end > t))
+        return unit_error(u, "no progress: t + h == t at t = %g, h = %g (h is below the time "
+                             "resolution at t)", t, h);
+    const double k_end = unit_first_sample(u, t_end);
+    if (!(k_end < PIM_MAX_SAMPLE_INDEX))
+        return unit_error(u, "time t + h = %g is beyond the sample counter's range (2^52 "
+                             "samples of Ts = %g)", t_end, u->Ts);
+    const int64_t k1 = (int64_t)k_end;
+    if (k1 - u->k_next > PIM_MAX_SUBSTEPS)
+        return unit_error(u, "step h = %g spans %lld samples of Ts = %g; at most %lld per doStep "
+                             "(use shorter communication steps)", h,
+                          (long long)(k1 - u->k_next), u->Ts, PIM_MAX_SUBSTEPS);
+    if (k1 <= u->k_next) {
+        u->time = t_end;
+        return 0;
+    }
+    if (unit_check_inputs(u) != 0) return -1;
+    /* a step that overflows is not taken: the states it changes are restored */
+    const int64_t k_saved = u->k_next;
+    const double out_saved[2] = {u->out1, u->out2};
+    model_saved saved;
+    model_save(u, &saved);
+    for (; u->k_next < k1; ++u->k_next) {
+        model_sample(u);
+        if (!isfinite(u->out1) || !isfinite(u->out2) || !model_outputs_finite(u)) {
+            const double y1 = u->out1, y2 = u->out2;
+            u->k_next = k_saved;
+            u->out1 = out_saved[0];
+            u->out2 = out_saved[1];
+            model_restore(u, &saved);
+            return unit_error(u, "the outputs overflowed or are undefined (%g, %g) at sample "
+                                 "%lld with the inputs held over this step (an input beyond an "
+                                 "envelope's domain or range, or a numeric overflow); the step "
+                                 "was not taken", y1, y2,
+                              (long long)u->k_next);
+        }
+    }
+    model_step_done(u);
+    u->time = t_end;
+    return 0;
+}
+
+/* The unit's report in words (no '%') into buf at terminate, after a run in step mode;
+ * returns 0 when there is nothing to report. */
+static int unit_terminate_report(const pim_unit *u, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    return u->mode == PIM_STEP_MODE ? model_report(u, buf, size) : 0;
+}
+
+/* ---- variables by value reference --------------------------------------------------------- */
+
+/* The variable with reference vr, or NULL.  With elements (FMI 2) an array is addressed by
+ * element (reference base + i, *elem = i); without (FMI 3) as a whole (*elem = -1). */
+static const pim_var *unit_var(unsigned vr, int elements, int *elem)
+{
+    for (size_t i = 0; i < PIM_NVARS; ++i) {
+        const pim_var *v = &unit_vars[i];
+        if (v->size > 1 && elements) { /* FMI 2 array elements: v->vr + 0 .. v->vr + size - 1 */
+            if (vr < v->vr || vr - v->vr >= (unsigned)v->size) continue;
+            *elem = (int)(vr - v->vr);
+        } else {
+            if (vr != v->vr) continue;
+            if (elements && v->causality == PIM_INDEPENDENT) return NULL; /* FMI 2: no time */
+            *elem = -1;
+        }
+        return v;
+    }
+    return NULL;
+}
+
+/* "p[3]" or "Ts" into buf. */
+static const char *unit_label(const pim_var *v, int elem, char *buf, size_t size)
+{
+    if (elem >= 0)
+        snprintf(buf, size, "%s[%d]", v->name, elem + 1);
+    else
+        snprintf(buf, size, "%s", v->name);
+    return buf;
+}
+
+/* Whether variable v may be set now: parameters before initialization, inputs until
+ * terminate, never outputs or time. */
+static int unit_settable(const pim_unit *u, const pim_var *v)
+{
+    if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT) return 0;
+    if (v->causality == PIM_PARAMETER)
+        return u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE;
+    return u->mode != PIM_TERMINATED;
+}
+
+/* Error paths out of line, so that the accessors stay small (they run on every get/set). */
+#if defined(__GNUC__)
+#define PIM_COLD __attribute__((noinline, cold))
+#else
+#define PIM_COLD
+#endif
+
+/* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
+PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, unsigned vr, char type)
+{
+    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : "Boolean";
+    char name[40];
+    if (!v)
+        unit_error(u, "no %s variable with value reference %u in the model description", tname,
+                   vr);
+    else if (v->type != type)
+        unit_error(u, "variable %s (value reference %u) is not a %s",
+                   unit_label(v, elem, name, sizeof name), vr, tname);
+    else if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT)
+        unit_error(u, "variable %s (value reference %u) is %s and cannot be set",
+                   unit_label(v, elem, name, sizeof name), vr,
+                   v->causality == PIM_OUTPUT ? "an output" : "the independent variable");
+    else if (v->causality == PIM_PARAMETER)
+        unit_error(u, "cannot set parameter %s (value reference %u) after initialization",
+                   unit_label(v, elem, name, sizeof name), vr);
+    else
+        unit_error(u, "cannot set input %s (value reference %u) after terminate",
+                   unit_label(v, elem, name, sizeof name), vr);
+    return NULL;
+}
+
+/*
+ * Storage of the variable with reference vr, checked against the model description (exists,
+ * has type `type`) and, for set != 0, against the mode (unit_settable).  *count: values it
+ * holds (1, or PIM_NMAX for an FMI 3 array).  NULL with the reason in u->msg on failure.
+ */
+static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set, size_t *count)
+{
+    int elem = -1;
+    const pim_var *v = unit_var(vr, elements, &elem);
+    if (!v || v->type != type || (set && !unit_settable(u, v)))
+        return unit_ref_refused(u, v, elem, vr, type);
+    *count = elem >= 0 ? 1 : (size_t)v->size;
+    return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
+}
+
+/* ---- FMU state: a checked, versioned byte format ------------------------------------------ */
+
+/*
+ * Layout (native byte order), PIM_STATE_SIZE bytes:
+ *   header  magic "PIMSTATE", format version, byte-order mark 0x01020304, unit (PIM_MODEL),
+ *           FMI major version, PIM_NMAX, PIM_EST_WIN, sizeof(pim_unit), sizeof(pim_estimator),
+ *           GUID / instantiation token (64 bytes, NUL padded)
+ *   payload the pim_unit struct (parameters, inputs, outputs, mode, time, counter, states)
+ *   check   FNV-1a 64 of header and payload
+ * Loading checks every header field, the checksum, the mode, time and counter, every parameter
+ * (unit_check_parameters, as at initialization) and that every state is finite; derived
+ * quantities (inverse parameters, estimator settings, r_hat outputs) are recomputed, not read.
+ * The in-memory FMU state (get/set) is the same byte block, checked again when set.
+ */
+#define PIM_STATE_MAGIC "PIMSTATE"
+#define PIM_STATE_VERSION 6u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+                                prefilter (Wiener); 5: DiagnosedInverse fields, post sections;
+                                6: the common part, then the unit's own fields */
+#define PIM_STATE_TOKEN 64
+
+typedef struct {
+    char magic[8];
+    uint32_t version, byte_order, model, fmi, nmax, est_win;
+    uint64_t unit_size, est_size;
+    char token[PIM_STATE_TOKEN];
+} pim_state_header;
+
+#define PIM_STATE_SIZE (sizeof(pim_state_header) + sizeof(pim_unit) + sizeof(uint64_t))
+
+static uint64_t unit_fnv1a(const unsigned char *b, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= b[i];
+        h *= 0x100000001b3ULL;
+    }
+    return h;
+}
+
+static void unit_state_header(pim_state_header *h, const char *token, unsigned fmi)
+{
+    memset(h, 0, sizeof *h);
+    memcpy(h->magic, PIM_STATE_MAGIC, 8);
+    h->version = PIM_STATE_VERSION;
+    h->byte_order = 0x01020304u;
+    h->model = PIM_MODEL;
+    h->fmi = fmi;
+    h->nmax = PIM_NMAX;
+    h->est_win = PIM_EST_WIN;
+    h->unit_size = sizeof(pim_unit);
+    h->est_size = sizeof(pim_estimator);
+    snprintf(h->token, sizeof h->token, "%s", token);
+}
+
+/* Writes the unit's state into buf (PIM_STATE_SIZE bytes). */
+static void unit_state_write(const pim_unit *u, unsigned char *buf, const char *token,
+                             unsigned fmi)
+{
+    pim_state_header h;
+    unit_state_header(&h, token, fmi);
+    memcpy(buf, &h, sizeof h);
+    memcpy(buf + sizeof h, u, sizeof *u);
+    const uint64_t sum = unit_fnv1a(buf, sizeof h + sizeof *u);
+    memcpy(buf + sizeof h + sizeof *u, &sum, sizeof sum);
+}
+
+
+/* Checks the states of a loaded unit s (parameters already checked) and recomputes what derives
+ * from the parameters; on failure the reason goes to u->msg. */
+static int unit_check_states(pim_unit *u, pim_unit *s)
+{
+    const double k = unit_first_sample(s, s->time);
+    if (!(k < PIM_MAX_SAMPLE_INDEX) || s->k_next != (int64_t)k)
+        return unit_error(u, "FMU state rejected: sample counter %lld does not match time %g "
+                             "and Ts = %g", (long long)s->k_next, s->time, s->Ts);
+    if (model_check_states(u, s) != 0) return -1;
+    if (unit_derive(s) != 0) return unit_error(u, "FMU state rejected: %s", s->msg);
+    return 0;
+}
+
+/*
+ * Checks a serialized state (bytes, size) for this unit and token and, when out != NULL,
+ * loads it into *out.  Returns 0, or -1 with the reason in u->msg (u and out unchanged).
+ */
+static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
+                           const char *token, unsigned fmi, pim_unit *out)
+{
+    if (!bytes) return unit_error(u, "FMU state rejected: null state");
+    if (size != PIM_STATE_SIZE)
+        return unit_error(u, "FMU state rejected: %llu bytes, expected %llu (another FMU or "
+                             "version)", (unsigned long long)size,
+                          (unsigned long long)PIM_STATE_SIZE);
+    pim_state_header h, want;
+    memcpy(&h, bytes, sizeof h);
+    unit_state_header(&want, token, fmi);
+    if (memcmp(h.magic, want.magic, 8) != 0)
+        return unit_error(u, "FMU state rejected: not a pimodel FMU state (bad magic)");
+    if (h.version != want.version)
+        return unit_error(u, "FMU state rejected: format version %u, expected %u", h.version,
+                          want.version);
+    if (h.byte_order != want.byte_order)
+        return unit_error(u, "FMU state rejected: written on a machine of another byte order");
+    if (h.model != want.model || h.fmi != want.fmi || memcmp(h.token, want.token,
+                                                             PIM_STATE_TOKEN) != 0)
+        return unit_error(u, "FMU state rejected: written by another model (unit %u, FMI %u); "
+                             "the GUID / instantiation token does not match", h.model, h.fmi);
+    if (h.nmax != want.nmax || h.est_win != want.est_win || h.unit_size != want.unit_size ||
+        h.est_size != want.est_size)
+        return unit_error(u, "FMU state rejected: sizes differ (written by another build of "
+                             "this FMU)");
+    uint64_t sum;
+    memcpy(&sum, bytes + sizeof h + sizeof(pim_unit), sizeof sum);
+    if (sum != unit_fnv1a(bytes, sizeof h + sizeof(pim_unit)))
+        return unit_error(u, "FMU state rejected: checksum mismatch (corrupted bytes)");
+    pim_unit *s = (pim_unit *)malloc(sizeof *s);
+    if (!s) return unit_error(u, "FMU state rejected: out of memory");
+    memcpy(s, bytes + sizeof h, sizeof *s);
+    s->msg[0] = '\0';
+    int rc = 0;
+    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_TERMINATED)
+        rc = unit_error(u, "FMU state rejected: unknown mode %d", s->mode);
+    else if (!isfinite(s->time) || s->time < 0.0)
+        rc = unit_error(u, "FMU state rejected: time %g must be finite and >= 0", s->time);
+    else if (!isfinite(s->out1) || !isfinite(s->out2))
+        rc = unit_error(u, "FMU state rejected: an output is not finite");
+    else if (s->mode >= PIM_STEP_MODE) {
+        if (unit_check_parameters(s) != 0)
+            rc = unit_error(u, "FMU state rejected: %s", s->msg);
+        else
+            rc = unit_check_states(u, s);
+    }
+    if (rc == 0 && out) {
+        s->msg[0] = '\0';
+        *out = *s;
+    }
+    free(s);
+    return rc;
+}
+
+#endif /* PIM_UNIT_H */
