@@ -92,7 +92,6 @@ STRICT_MODULES = [
     "pimodel.experiments.compensation",
     "pimodel.experiments.studies",
     "pimodel.fmu.build",
-    "pimodel.fmu.fmi3",
     "pimodel.fmu.unit",
     "pimodel.fmu.cosim",
     "pimodel.experiments.fmu_comparison",

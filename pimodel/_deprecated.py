@@ -34,6 +34,7 @@ MOVED: dict[str, str] = {
     "pimodel.estimator_reference": "pimodel.reference.radius_estimator",
     "pimodel.identify": "pimodel.identification.chain",
     "pimodel.fmu.compare": "pimodel.experiments.fmu_comparison",
+    "pimodel.fmu.fmi3": "pimodel.fmu.description",  # model_description3, TYPES, token
     "pimodel.slopes": "pimodel.identification.slopes",
     "pimodel.segmented": "pimodel.identification.piecewise_linear",
     "pimodel.conventional": "pimodel.identification.conventional",

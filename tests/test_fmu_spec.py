@@ -109,7 +109,7 @@ def test_no_limit_typed_in_python():
     c_name = re.compile(r"PIM_[A-Z_]+|pim_\w+\.h|fmu/src")
     limit_like = re.compile(r"NMAX|MAX_(?:PLAYS|LAGS|DYN|DELAY|ORDER|ELEMENTS|SECTIONS|LATENCY|"
                             r"SUBSTEPS)|WINDOW|WIN\b|BINS|CHECKPOINTS")
-    values = {float(v) for v in LIMITS.values()}
+    values = {float(v) for v in LIMITS.values() if v > 2}  # small numbers are everywhere
     hits = []
     for f in _python_sources():
         for i, line in enumerate(f.read_text().splitlines(), 1):
