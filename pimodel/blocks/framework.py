@@ -23,6 +23,7 @@ __all__ = [
     "BlockSettings",
     "InitialStateWarning",
     "initial_state",
+    "labelled_values",
     "signal_labels",
     "stepped_block",
     "warn_if_zero_start",
@@ -178,6 +179,39 @@ def signal_labels(base: str, n: int) -> list[str]:
     ['z[1]', 'z[2]', 'z[3]']
     """
     return [f"{base}[{i}]" for i in range(1, n + 1)]
+
+
+def labelled_values(base: str, values, *, split: int | None = None) -> dict[str, float]:
+    """The values of a vector by their 1-based labels, ``{"base[1]": values[0], ...}`` (the
+    FMU variables' names).
+
+    Parameters
+    ----------
+    base : str
+        The vector's name.
+    values : array_like
+        Its values.
+    split : int, optional
+        Values beyond the first ``split`` go to ``base_hi[1], base_hi[2], ...`` (the diagnosed
+        units' plays 65..128). Default: all in ``base[i]``.
+
+    Returns
+    -------
+    dict
+        Label -> float.
+
+    Examples
+    --------
+    >>> labelled_values("p", [1.0, 0.5])
+    {'p[1]': 1.0, 'p[2]': 0.5}
+    >>> labelled_values("r", [0.0, 0.1, 0.2], split=2)
+    {'r[1]': 0.0, 'r[2]': 0.1, 'r_hi[1]': 0.2}
+    """
+    out = {}
+    for i, x in enumerate(np.asarray(values, dtype=float).ravel()):
+        hi = split is not None and i >= split
+        out[f"{base}_hi[{i - split + 1}]" if hi else f"{base}[{i + 1}]"] = float(x)
+    return out
 
 
 def _fingerprint(value):

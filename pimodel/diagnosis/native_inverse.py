@@ -32,7 +32,7 @@ import control
 import numpy as np
 
 from .. import _native
-from ..blocks.framework import signal_labels
+from ..blocks.framework import labelled_values, signal_labels
 from .checks import checked_signal
 from .limits import MAX_LATENCY, MAX_SECTIONS, NMAX
 from .native_model import _band_gains
@@ -350,8 +350,7 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
 
     def arr(name, values):
         """Plays 1..64 in NAME[i], 65..128 in NAME_hi[i] (other arrays: up to 64)."""
-        return {(f"{name}[{i + 1}]" if i < NMAX else f"{name}_hi[{i - NMAX + 1}]"): float(x)
-                for i, x in enumerate(values)}
+        return labelled_values(name, values, split=NMAX)
 
     out = {"Ts": d.dt, "n": int(d.n), **arr("p", k["w"]), **arr("r", k["r"]),
            **arr("w0", k["w0"]), "offset": d.c, "reference_offset": d.c0,

@@ -50,7 +50,7 @@ import control
 import numpy as np
 
 from .. import _native
-from ..blocks.framework import BlockSettings, signal_labels, stepped_block
+from ..blocks.framework import BlockSettings, labelled_values, signal_labels, stepped_block
 from .checks import block_dt, checked_signal
 from .filters import mode_coefficients
 from .limits import MAX_DELAY, MAX_ELEMENTS, MAX_ORDER, NMAX, SECTION
@@ -599,8 +599,7 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
 
     def arr(name, values):
         """Plays 1..64 in NAME[i], 65..128 in NAME_hi[i] (other arrays: up to 64)."""
-        return {(f"{name}[{i + 1}]" if i < NMAX else f"{name}_hi[{i - NMAX + 1}]"): float(x)
-                for i, x in enumerate(values)}
+        return labelled_values(name, values, split=NMAX)
 
     out = {"Ts": model.dt, "n": n, "z0": 0.0, **arr("p", model.weights), **arr("r", model.radii),
            **arr("w0", model.reference_weights), "offset": d.c,

@@ -20,7 +20,7 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from ..blocks.framework import Block
+from ..blocks.framework import Block, signal_labels
 from ..checks import positive_scalar
 from .unit import FMUUnit
 
@@ -33,7 +33,7 @@ def _signals(unit: FMUUnit, causality: str) -> list[str]:
     for v in unit.md.modelVariables:
         if v.causality == causality:
             size = unit._size(v) if v.dimensions else 0
-            names += [f"{v.name}[{i + 1}]" for i in range(size)] if size else [v.name]
+            names += signal_labels(v.name, size) if size else [v.name]
     return names
 
 

@@ -17,6 +17,7 @@ import control
 import numpy as np
 from fmpy import read_model_description
 
+from ..blocks.framework import labelled_values, signal_labels
 from ..loops.compiled import LoopResult
 from ..operators.pi import PIOperator
 from .build import fmu_filename
@@ -27,8 +28,6 @@ __all__ = ["cosimulate_adaptive_loop"]
 LOOP_UNITS = ("PIHysteresis", "RadiusEstimator", "InversePI")  # the FMUs this master runs
 
 
-def _arrays(prefix: str, values) -> dict:
-    return {f"{prefix}[{i + 1}]": float(x) for i, x in enumerate(values)}
 
 
 def _estimator_unit(path, start: dict) -> FMUUnit:
@@ -116,19 +115,21 @@ def cosimulate_adaptive_loop(fmu_dir, ref, dt: float, plant: PIOperator, *, weig
     w = np.asarray(weights, float)
     n = w.size
     plant_fmu = FMUUnit(files["PIHysteresis"], {
-        "Ts": dt, "n": plant.n, **_arrays("p", plant.weights), **_arrays("r", plant.radii)},
+        "Ts": dt, "n": plant.n, **labelled_values("p", plant.weights),
+        **labelled_values("r", plant.radii)},
         instance_name="plant")
     est = _estimator_unit(files["RadiusEstimator"], {
         "Ts": dt, "n": n, "gain": gain, "linear_play": linear_play, "guard": guard,
-        "slope_window": slope_window, **_arrays("p", w), **_arrays("r", initial_radii),
+        "slope_window": slope_window, **labelled_values("p", w),
+        **labelled_values("r", initial_radii),
         **(estimator_start or {})})
     inv = FMUUnit(files["InversePI"], {
-        "Ts": dt, "n": n, "adaptive": True, **_arrays("p", w)}, instance_name="inverse")
+        "Ts": dt, "n": n, "adaptive": True, **labelled_values("p", w)}, instance_name="inverse")
     if dynamics is not None:
         dyn = control.ss(dynamics)
         A, B, C, D = dyn.A, dyn.B[:, 0], dyn.C[0], float(dyn.D[0, 0])
         xd = np.zeros(dyn.nstates)
-    rhat_names = [f"r_hat[{i + 1}]" for i in range(n)]
+    rhat_names = signal_labels("r_hat", n)
     N = ref.size
     y, v, R = np.empty(N), np.empty(N), np.empty((N, n))
     try:

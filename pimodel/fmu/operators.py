@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..blocks.framework import labelled_values
 from ..operators.asymmetric import AsymmetricPI, AsymmetricPIInverse
 from ..operators.creep import CreepOperator
 from ..operators.generalized import GeneralizedPI
@@ -36,8 +37,6 @@ def _uniform(state: np.ndarray, what: str) -> float:
     return float(z[0])
 
 
-def _array(name: str, values) -> dict:
-    return {f"{name}[{i + 1}]": float(x) for i, x in enumerate(values)}
 
 
 def _envelope(prefix: str, env) -> dict:
@@ -114,31 +113,32 @@ def unit_parameters(op, *, Ts: float | None = None) -> tuple[str, dict]:
             raise ValueError("op: a GeneralizedPI with signed weights has no FMU unit; export "
                              "the forward operator (or its inverse()) instead")
         name = "GeneralizedPI"
-        params = {**_array("p", op.weights), **_array("r", op.radii),
+        params = {**labelled_values("p", op.weights), **labelled_values("r", op.radii),
                   **_envelope("in", op.input_envelope), **_envelope("out", op.output_envelope),
                   "z0": _uniform(op.initial_state, "initial_state")}
     elif isinstance(op, AsymmetricPI):
         name = "AsymmetricPI"
-        params = {**_array("p", op.weights), **_array("r", op.radii), "p0": op.direct_weight,
+        params = {**labelled_values("p", op.weights), **labelled_values("r", op.radii),
+                  "p0": op.direct_weight,
                   "a_l": op.ascending[0], "d_l": op.ascending[1], "a_r": op.descending[0],
                   "d_r": op.descending[1], **_envelope("shape", op.shape),
                   "z0": _uniform(op.initial_state, "initial_state")}
     elif isinstance(op, RateDependentPI):
         name = "RateDependentPI"
-        params = {**_array("p", op.weights), **_array("r", op.base_radii),
+        params = {**labelled_values("p", op.weights), **labelled_values("r", op.base_radii),
                   "rate_gain": op.rate_gain, "rate_time_constant": op.rate_time_constant,
                   "v0": op.initial_input, "z0": _uniform(op.initial_state[:op.n],
                                                          "initial_state")}
     elif isinstance(op, CreepOperator):
         name, inverse = "CreepOperator", op.inverted
-        params = {**_array("c", op.gains), **_array("tau", op.time_constants),
+        params = {**labelled_values("c", op.gains), **labelled_values("tau", op.time_constants),
                   "z0": _uniform(op.initial_state, "initial_state")}
     elif isinstance(op, PIOperator):
         if op.signed_weights:
             raise ValueError("op: a PIOperator with signed weights (e.g. an inverse) has no FMU "
                              "unit here; use the InversePI unit with the forward parameters")
-        return "PIHysteresis", {"Ts": Ts, "n": op.n, **_array("p", op.weights),
-                                **_array("r", op.radii),
+        return "PIHysteresis", {"Ts": Ts, "n": op.n, **labelled_values("p", op.weights),
+                                **labelled_values("r", op.radii),
                                 "z0": _uniform(op.initial_state, "initial_state")}
     else:
         raise TypeError(f"op: no FMU unit for {type(op).__name__}; supported: GeneralizedPI, "
