@@ -2,6 +2,8 @@
 # pimodel quick start: sets up a virtual environment (.venv) with everything, then
 #   bash quickstart.sh demo [ARGS...]   runs the main job (pimodel demo)
 #   bash quickstart.sh test             runs lint and the whole test suite (docs build included)
+#   bash quickstart.sh quick            lint and the quick tier: the tests not marked slow
+#                                       (day-to-day work; CI runs the whole suite)
 # Needs only Python >= 3.10, a C compiler and pip access to PyPI.
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -24,14 +26,14 @@ fi
 cmd=${1:-demo}
 shift || true
 extras="test"
-[ "$cmd" = test ] && extras="test,docs"   # the docs build (Sphinx) is part of the test suite
+[ "$cmd" = test ] || [ "$cmd" = quick ] && extras="test,docs"   # the docs build (Sphinx) is tested
 echo "quickstart: installing pimodel[$extras] into .venv (compiles the C core)"
 .venv/bin/python -m pip install -q -e ".[$extras]"
 
 case "$cmd" in
     demo)
         exec .venv/bin/pimodel demo "$@" ;;
-    test)
+    test|quick)
         .venv/bin/ruff check .
         # one pytest worker per core, at most 4 (pytest-xdist); a test file stays on one worker
         # so its module fixtures are built once. PIMODEL_TEST_WORKERS=0 runs in this process.
@@ -41,7 +43,9 @@ case "$cmd" in
                               "(0: one process), got '$workers'" >&2; exit 2 ;;
         esac
         [ "$workers" -gt 4 ] && workers=4
-        exec .venv/bin/python -m pytest -q -n "$workers" --dist loadfile "$@" ;;
+        tier=()
+        [ "$cmd" = quick ] && tier=(-m "not slow")
+        exec .venv/bin/python -m pytest -q -n "$workers" --dist loadfile "${tier[@]}" "$@" ;;
     *)
-        echo "usage: bash quickstart.sh {demo|test} [args...]" >&2; exit 2 ;;
+        echo "usage: bash quickstart.sh {demo|test|quick} [args...]" >&2; exit 2 ;;
 esac

@@ -212,6 +212,7 @@ def fmus(built_fmus) -> Path:
     return built_fmus
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "delay_whole", "rate",
                                   *RATE_VARIANTS])
@@ -244,6 +245,7 @@ def test_unit_with_more_than_64_plays(fmus, fmi):
     assert np.max(np.abs(got - want)) < 1e-12 * max(1.0, float(np.max(np.abs(want))))
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
     """A rate model diagnosed on a ``pimodel.stages.pi_stage`` record (radii growing with the rate,
     80 signed plays): the C stream on the whole validate record and the FMU unit on its first

@@ -25,6 +25,7 @@ def invertible(request):
     return request.param, *_report(request.param)
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_model_equals_the_diagnosis_prediction(invertible):
     effect, rep, rec = invertible
     assert rep.verdict["effects"] == [effect]

@@ -29,6 +29,7 @@ def records(effects, seed, drift_clock="record"):
     return [truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed, "val")]
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("effect", EFFECTS)
 def test_withheld_single_effect(effect):
     train, validate = records([effect], 0)
@@ -44,6 +45,7 @@ def test_withheld_single_effect(effect):
     (("delay", "drift"), 0, "record"),  # drift restarting with each record
     (("asymmetry", "drift"), 0, "absolute"),  # drift on the clock the records share
 ])
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_withheld_pair(pair, seed, clock):
     train, validate = records(list(pair), seed, clock)
     v = diagnose(train, validate).verdict
@@ -84,6 +86,7 @@ def test_bad_input():
         diagnose([], validate)
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_cli_diagnose(tmp_path):
     train, validate = records(["drift"], 5)
     save_record(train[0], tmp_path / "a.csv")
@@ -99,6 +102,7 @@ def test_cli_diagnose(tmp_path):
     assert data["nominal"]["initial_state"] == "unknown"
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_real_record_diagnosis(real_record_path):
     from pimodel import load_record
 

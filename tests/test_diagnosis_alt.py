@@ -54,6 +54,7 @@ def test_alt_rate_with_creep():
     assert v["shrink"] >= 0.5
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("effect", ["dead_zone", "second_input", "bouc_wen"])
 def test_alt_outside_library_is_unexplained(effect):
     v = diagnose(*alt_records([effect], 0), initial_state="unknown").verdict

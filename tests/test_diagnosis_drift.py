@@ -58,6 +58,7 @@ def _records(seed, levels_train=(0.0,), level_validate=0.0):
     return train, [Record(rec.t, rec.v, rec.y + level_validate, source="val")], truth
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("levels_train,level_validate", [((0.0,), 0.12), ((0.0, -0.08), 0.1)])
 def test_record_offsets_are_found_as_drift(levels_train, level_validate):
     train, validate, truth = _records(2, levels_train, level_validate)

@@ -88,6 +88,7 @@ def run_noisy_with_defaults(snr_db, seed, start, *, fs, duration):
                                total=record_length(fs, duration))
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("start", ["below", "zero", "mixed"])
 def test_paper_sinusoid_snr20_within_5_percent_with_defaults(start):
     """SNR 20 dB, 10 kHz for 2000 s (20 M samples), default settings: the mean of the estimate

@@ -38,6 +38,7 @@ def fmus(built_fmus) -> Path:
     return built_fmus
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("name", list(MODELS))
 def test_fmpy_validate_reports_no_problem(fmus, name):
     assert validate_fmu(str(fmus / f"{name}.fmu")) == []
@@ -241,6 +242,7 @@ def test_cosimulation_equals_native_interconnection(fmus):
     np.testing.assert_allclose(co.y[:200], ref["y"], rtol=0, atol=1e-9)
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_fmpy_compile_rebuilds_from_sources(fmus, tmp_path):
     if shutil.which("cmake") is None:
         pytest.skip("cmake not on PATH (fmpy compile needs it)")

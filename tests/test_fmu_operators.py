@@ -339,6 +339,7 @@ def test_cli_exports_a_cascade_that_validates_and_runs_in_the_master(tmp_path, f
         pytest.skip("fmutool (fmu-manipulation-toolbox) is not installed; fmpy checks passed")
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_pi_operator_stage_exports_as_pihysteresis(tmp_path):
     """A PIOperator stage becomes a PIHysteresis FMU (input v) with the model's start values;
     the chain equals the Python cascade in the master; a signed-weight PI is refused."""

@@ -157,6 +157,7 @@ def test_cli_on_hostile_files(tmp_path_factory, files, spellings):
             assert r["code"] == 2 and "never writes over an input file" in r["stderr"], r
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_installed_command_exit_status_on_bad_files(tmp_path):
     """Through ``python -m pimodel`` itself: exit 2 and a one-line error naming the file."""
     cases = {"bad.npz": b"t,v,y\n0,1,2\n", "empty.csv": b"", "junk.csv": b"\xff\xfe\x00\x01"}

@@ -276,6 +276,7 @@ def scenarios(name: str, fmi3: bool) -> dict[str, list]:
     return cases
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_driver_reports_crashes_and_hangs(fmu_dir):
     """The harness itself: a segfault or a hang in the child fails with the run named."""
     fmu = fmu_path(fmu_dir, "PIHysteresis", "2.0")

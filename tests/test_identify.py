@@ -21,6 +21,7 @@ def random_operator(seed: int, n: int) -> PIOperator:
     return PIOperator(rng.uniform(0.3, 1.0, n), np.cumsum(rng.uniform(0.4, 0.8, n)))
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
 def test_slopes_recover_random_operators_noise_free(n):
     op = random_operator(100 + n, n)
@@ -32,6 +33,7 @@ def test_slopes_recover_random_operators_noise_free(n):
     np.testing.assert_allclose(s.radii_guess, op.radii, rtol=0.01)
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
 def test_slopes_recover_random_operators_snr30(n):
     """SNR 30 dB, 200 triangle periods at 2 kHz (400k samples): n exact, weights within 5 %."""
@@ -43,6 +45,7 @@ def test_slopes_recover_random_operators_snr30(n):
     np.testing.assert_allclose(s.weights, op.weights, rtol=0.05)
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_slopes_detect_linear_play_on_stage():
     t, v = triangle(2, 1, fs=1000, duration=3)
     s = identify_slopes(v, STAGE.simulate(v))
@@ -125,6 +128,7 @@ def test_identify_constant_output_and_bad_method():
         fit_conventional(v, v, 0)
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_cli_identify_writes_json_and_plots(tmp_path):
     t, v = triangle(2, 1, fs=1000, duration=3)
     save_record(Record(t, v, STAGE.simulate(v)), tmp_path / "rec.csv")
@@ -150,6 +154,7 @@ def test_cli_identify_writes_json_and_plots(tmp_path):
     assert (tmp_path / "plots" / "identify_joint.png").exists()
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_real_record_identification(real_record_path):
     from pimodel import load_record
 

@@ -161,6 +161,7 @@ def assert_equal_to_python(inv, y_d, spreads, reference_range=None):
     return got
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("case", list(CASES))
 def test_c_step_equals_the_python_stream_and_the_batch(case, single_roots):
     effects, extra = CASES[case]

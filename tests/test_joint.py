@@ -80,6 +80,7 @@ def test_linear_play_known():
     assert np.allclose(res.weights, p, rtol=0.01) and np.allclose(res.radii, r, rtol=0.01)
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_sinusoid_snr20_weights_and_radii_within_5_percent(seed):
     """SNR 20 dB on y, 10 kHz for 30000 s (300 M samples, made and consumed in 1 M chunks):
@@ -92,6 +93,7 @@ def test_sinusoid_snr20_weights_and_radii_within_5_percent(seed):
     assert max_rel_error(res.radius_history[0], R) > 0.0  # an estimate, not the truth
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_sinusoid_snr10_radii_within_10_percent(seed):
     """SNR 10 dB on y, 10 kHz for 20000 s (200 M samples in 1 M chunks)."""
@@ -99,6 +101,7 @@ def test_sinusoid_snr10_radii_within_10_percent(seed):
     assert max_rel_error(res.radii, R) < 0.10
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_sinusoid_snr10_weights_within_10_percent_on_a_long_record():
     """SNR 10 dB, 10 kHz for 100000 s (1 G samples in 1 M chunks), seed 0: every weight and
     every radius within 10 % (seeds 1 and 2 are in the study ``joint_estimation``)."""
@@ -107,6 +110,7 @@ def test_sinusoid_snr10_weights_within_10_percent_on_a_long_record():
     assert max_rel_error(res.weights, P) < 0.10
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_biased_staircase_snr20_within_5_percent(seed):
     """Biased stair-step (-15..25, steps 0.25 held 5 ms), 1 kHz, 40000 s (40 M samples in 1 M
@@ -117,6 +121,7 @@ def test_biased_staircase_snr20_within_5_percent(seed):
     assert max_rel_error(res.weights, P) < 0.05
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_streaming_equals_batch_whatever_the_chunks():
     _, v = sinusoid(30, 1, fs=1000, duration=12)
     y = PIOperator(P, R).simulate(v) + np.random.default_rng(3).normal(0, 0.5, v.size)

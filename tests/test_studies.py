@@ -47,10 +47,12 @@ def test_compensation(tmp_path):
         assert prop["mode"]["max"] < tab[f"conventional n={n}"]["mode"]["max"]
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_cosimulation(tmp_path):
     assert _run("cosimulation", tmp_path).numbers["max_difference"] < 1e-12
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_real_data(tmp_path):
     n = _run("real_data", tmp_path).numbers
     if n.get("skipped"):
@@ -110,6 +112,7 @@ def test_augmented_feedforward(tmp_path):
                    for m in ("nominal", "augmented"))
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
     """A rerun of a sweep study loads its finished cases instead of computing them."""
     from pimodel.experiments.studies import load_study
@@ -148,6 +151,7 @@ def test_unreadable_figure_is_refused(tmp_path):
     assert save_figure(fig, tmp_path / "ok.png").exists()
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_joint_estimation(tmp_path):
     n = _run("joint_estimation", tmp_path).numbers
     assert n["noise_free"]["weights"] < 0.01 and n["noise_free"]["radii"] < 0.01
@@ -178,6 +182,7 @@ def test_limit_cycle(tmp_path):
     assert n["inverse (radii 20 % low), moderate"]["circle_criterion"]["holds"]
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_convergence_map(tmp_path):
     """Quick grid (1 kHz, 60 s): every clean cell, from every start (up to 6x the truth, all
     zero, all equal) and on every input, is within 10 % after 60 s (the full size, 150 s,

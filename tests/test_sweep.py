@@ -114,6 +114,7 @@ def _square_logged_fixed(params: dict) -> dict:
     return _square_logged({**params, "fail_at": []})
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_killed_sweep_resumes_with_only_the_missing_cases(tmp_path):
     """A sweep process killed (SIGKILL, no clean-up) during case 5 of 9 leaves 5 finished
     cases; the rerun computes the other 4."""

@@ -304,6 +304,7 @@ def _diagnosed(stage: str):
     return diagnose(train, validate, initial_state="unknown").model(augmented=True), validate[0]
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("stage", ["truth_lowpass", "alt_mode"])
 def test_diagnosed_wiener_model_exports_an_fmu_equal_to_simulate(tmp_path, stage):
     """A model the diagnosis chose (verdict dynamics before the hysteresis) on a stage written
@@ -331,6 +332,7 @@ def test_diagnosed_wiener_model_exports_an_fmu_equal_to_simulate(tmp_path, stage
     assert np.max(np.abs(r.outputs - want[:1000])) < 1e-12
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 def test_diagnose_export_writes_a_wiener_fmu(tmp_path):
     """pimodel diagnose --export on the records of the first-order driver stage: the augmented
     model's FMU (a Wiener model) validates and equals the exported model's simulate to 1e-12
