@@ -135,3 +135,13 @@ def test_limits_are_the_c_header():
         assert LIMITS[name] == float(literal), name
     assert LIMITS["PIM_DIAG_MAX_PLAYS"] == 2 * LIMITS["PIM_MAX_PLAYS"]
     assert isinstance(LIMITS["PIM_MAX_PLAYS"], int) and isinstance(LIMITS["PIM_TS_MIN"], float)
+
+
+def test_docs_name_the_state_format_version_of_the_code():
+    """docs/fmu.md and fmu/README.md state the FMU state format version that the C code
+    writes (PIM_STATE_VERSION), so the two cannot drift apart."""
+    code = (source_dir() / "fmi" / "pim_unit.h").read_text()
+    version = re.search(r"#define PIM_STATE_VERSION (\d+)u", code).group(1)
+    for doc in (ROOT / "docs" / "fmu.md", ROOT / "fmu" / "README.md"):
+        found = set(re.findall(r"format version (\d+)", doc.read_text()))
+        assert found == {version}, (doc.name, found, version)
