@@ -56,6 +56,8 @@ __all__ = [
 ]
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
+BASELINE_PLAYS = 60  # plays of the plain least-squares baseline (0 to max |v| of train)
+BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor of the baseline's
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
 MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
 NOISE_STOP = 1.5  # no further effect once the validate RMS is within this factor of the noise
@@ -299,19 +301,52 @@ def _segments(records: list[Record], radii, initial_state: str) -> list[Segment]
     return out
 
 
+def _grids(train) -> list[np.ndarray]:
+    """The nominal's radius grids: for each size in ``GRID_SIZES`` the uniform grid over half
+    the train input range and, when a train record's input travels further than that from its
+    first sample, the same grid extended at the same spacing to that travel.
+
+    With the plays at rest at ``v[0]``, play ``r`` first moves once ``|v[k] - v[0]| > r``; a
+    record that starts at one end of its range (a closed-loop record, a multisine with random
+    phases, a record started at its top) moves plays up to its full range, beyond the half-range
+    grid. The train BIC chooses between the grids (the extension costs its columns)."""
+    span = float(np.ptp(np.concatenate([r.v for r in train])))
+    reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
+    out = []
+    for n in GRID_SIZES:
+        half = np.linspace(0.0, span / 2, n)
+        out.append(half)
+        if reach > (1.0 + 1e-9) * span / 2:
+            extra = int(np.ceil((reach - span / 2) / half[1]))
+            out.append(np.arange(n + extra) * half[1])
+    return out
+
+
 def _nominal(train, validate, initial_state):
     """The radius grid with the lowest train BIC and its fitted nominal model."""
-    span = float(np.ptp(np.concatenate([r.v for r in train])))
     best = None
-    for n in GRID_SIZES:
-        radii = np.linspace(0.0, span / 2, n)
+    for radii in _grids(train):
         tr = _segments(train, radii, initial_state)
         model = fit_nominal(tr)
-        bic = _bic(tr, [model.predict(s) for s in tr], n + 1)
+        bic = _bic(tr, [model.predict(s) for s in tr], radii.size + 1)
         if best is None or bic < best[0]:
             best = (bic, radii, tr, model)
     _, radii, tr, model = best
     return radii, tr, _segments(validate, radii, initial_state), model
+
+
+def _baseline(train, validate, initial_state) -> dict:
+    """The plain least-squares PI fit the nominal is checked against: ``BASELINE_PLAYS`` radii
+    uniform from 0 to the train input's largest magnitude, plays at rest at ``v[0]``, one
+    offset, fitted on the same (masked) train samples; its train and validate errors."""
+    vmax = max(float(np.max(np.abs(r.v))) for r in train)
+    radii = np.linspace(0.0, vmax, BASELINE_PLAYS)
+    tr = _segments(train, radii, initial_state)
+    va = _segments(validate, radii, initial_state)
+    model = fit_nominal(tr)
+    return {"kind": "PI, plain least squares", "plays": BASELINE_PLAYS, "max_radius": vmax,
+            "train": _errors(tr, [model.predict(s) for s in tr]),
+            "validate": _errors(va, [model.predict(s) for s in va])}
 
 
 def _compressed(tr, va, nominal: Model):
@@ -358,7 +393,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                               "weights": nominal.coef[:n_plays], "offset": nominal.coef[n_plays],
                               "grid_sizes_tried": list(GRID_SIZES)},
                     "train": _errors(tr, out_tr), "validate": before,
-                    "initial_state": initial_state}
+                    "initial_state": initial_state,
+                    "baseline": _baseline(train, validate, initial_state)}
+    base_rms = nominal_json["baseline"]["validate"]["rms"]
+    if before["rms"] > BASELINE_WARN * base_rms:
+        warnings.warn(f"nominal: validate RMS {before['rms']:.4g} is {before['rms'] / base_rms:.2f}"
+                      f" times that of a plain least-squares PI fit ({base_rms:.4g}; "
+                      "report.nominal['baseline']): the effects are measured against a weak "
+                      "nominal", UserWarning, stacklevel=3)
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
     full_nominal = nominal
     full_segs = tr + va

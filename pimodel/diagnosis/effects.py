@@ -135,7 +135,11 @@ class Segment:
 
 
 def make_segment(t, v, y, radii, mask=None) -> Segment:
-    """Segment of one record with the play outputs of ``radii`` (play states start at 0).
+    """Segment of one record with the play outputs of ``radii``, the plays at rest at ``v[0]``.
+
+    The play states before the first sample are ``z_i[-1] = v[0]`` (the diagnosis' ``"rest"``
+    convention): a record that starts away from 0 starts with every play in its interior, not
+    with the large plays held at 0 until the input has travelled past their radius.
 
     Parameters
     ----------
@@ -162,7 +166,8 @@ def make_segment(t, v, y, radii, mask=None) -> Segment:
     >>> seg.Z.tolist()
     [[0.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5]]
     """
-    Z = PIOperator(np.ones(len(radii)), radii).play_outputs(v)
+    v = np.asarray(v, float)
+    Z = PIOperator(np.ones(len(radii)), radii, initial_state=float(v[0])).play_outputs(v)
     return Segment(t, v, y, Z, mask)
 
 

@@ -195,12 +195,14 @@ class WienerBasis:
         Returns
         -------
         numpy.ndarray
-            Shape (N, q) or (N, ncols): ``Gamma[F[v]] V`` (plays at rest at 0).
+            Shape (N, q) or (N, ncols): ``Gamma[F[v]] V`` (plays at rest at ``F[v][0]``, as
+            the plays of ``v`` in :func:`.effects.make_segment`).
         """
         key = (tuple(tuple(e) for e in elements), ncols)
         if key not in self._cache:
             x = prefilter(self.v, elements, self.dt)
-            Z = PIOperator(np.ones(self.radii.size), self.radii).play_outputs(x)
+            Z = PIOperator(np.ones(self.radii.size), self.radii,
+                           initial_state=float(x[0])).play_outputs(x)
             if self.projection is not None:
                 Z = Z @ (self.projection if ncols is None else self.projection[:, :ncols])
             elif ncols is not None:
