@@ -304,7 +304,8 @@ def _segments(records: list[Record], radii, initial_state: str) -> list[Segment]
 def _grids(train) -> list[np.ndarray]:
     """The nominal's radius grids: for each size in ``GRID_SIZES`` the uniform grid over half
     the train input range and, when a train record's input travels further than that from its
-    first sample, the same grid extended at the same spacing to that travel.
+    first sample, the same grid extended to that travel at the coarsest grid's spacing (the
+    extension's plays move in few samples, mostly at a record's start: finer, they overfit).
 
     With the plays at rest at ``v[0]``, play ``r`` first moves once ``|v[k] - v[0]| > r``; a
     record that starts at one end of its range (a closed-loop record, a multisine with random
@@ -313,12 +314,13 @@ def _grids(train) -> list[np.ndarray]:
     span = float(np.ptp(np.concatenate([r.v for r in train])))
     reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
     out = []
+    step = span / 2 / (GRID_SIZES[0] - 1)  # the extension's spacing: the coarsest grid's
+    extra = step * np.arange(1, int(np.ceil((reach - span / 2) / step)) + 1) + span / 2
     for n in GRID_SIZES:
         half = np.linspace(0.0, span / 2, n)
         out.append(half)
-        if reach > (1.0 + 1e-9) * span / 2:
-            extra = int(np.ceil((reach - span / 2) / half[1]))
-            out.append(np.arange(n + extra) * half[1])
+        if extra.size:
+            out.append(np.concatenate((half, extra)))
     return out
 
 
