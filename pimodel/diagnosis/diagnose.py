@@ -82,7 +82,12 @@ class DiagnosisReport:
     Parameters
     ----------
     nominal : dict
-        The nominal PI model: its grid, parameters and train/validate errors.
+        The nominal PI model: its grid, parameters and train/validate errors, and
+        ``baseline``: the plain least-squares PI fit it is checked against (``BASELINE_PLAYS``
+        radii uniform from 0 to the train input's largest magnitude, plays at rest at ``v[0]``,
+        one offset; ``kind``, ``plays``, ``max_radius``, ``train`` and ``validate`` errors).
+        :func:`diagnose` warns when the nominal's validate RMS exceeds ``BASELINE_WARN`` times
+        the baseline's.
     where : dict
         Where the nominal's validate residual lies (:mod:`.where`).
     candidates : list of dict
