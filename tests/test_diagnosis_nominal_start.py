@@ -103,6 +103,7 @@ def test_nominal_reaches_the_noise_on_records_away_from_zero(kind, seed):
     assert rep.verdict["effects"] == ["none"], rep.verdict
     baseline = rep.nominal["baseline"]
     assert baseline["plays"] == 60
+    assert rep.nominal["model"]["plays_start"] == "at rest at v[0]"
     # the diagnosis' own baseline (same grid; its least squares are scaled normal equations,
     # so on these ill-conditioned grids it lands near, not on, the plain lstsq fit)
     assert nominal <= 1.2 * baseline["validate"]["rms"]
@@ -114,7 +115,7 @@ def test_warns_when_the_nominal_is_worse_than_the_baseline(monkeypatch):
     import importlib
 
     mod = importlib.import_module("pimodel.diagnosis.diagnose")
-    monkeypatch.setattr(mod, "_grids", lambda train: [np.linspace(0.0, 0.2, 5)])
+    monkeypatch.setattr(mod, "_grids", lambda train: ([np.linspace(0.0, 0.2, 5)], []))
     p, r = _stage(0)
     rng = np.random.default_rng(7)
     train, validate = (Record(*_multisine(p, r, rng), source=f"m{i}") for i in range(2))

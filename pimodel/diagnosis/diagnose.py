@@ -296,50 +296,71 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         return _diagnose(train, validate, max_effects, initial_state)
 
 
-def _segments(records: list[Record], radii, initial_state: str) -> list[Segment]:
+def _segments(records: list[Record], radii, initial_state: str,
+              at_rest: bool = True) -> list[Segment]:
     out = []
     for r in records:
         mask = None
         if initial_state == "unknown":
             mask = np.arange(len(r)) >= startup_length(r.v)
-        out.append(make_segment(r.t, r.v, r.y, radii, mask))
+        out.append(make_segment(r.t, r.v, r.y, radii, mask, at_rest=at_rest))
     return out
 
 
-def _grids(train) -> list[np.ndarray]:
+def _grids(train) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """The nominal's radius grids: for each size in ``GRID_SIZES`` the uniform grid over half
     the train input range and, when a train record's input travels further than that from its
-    first sample, the same grid extended to that travel at the coarsest grid's spacing (the
-    extension's plays move in few samples, mostly at a record's start: finer, they overfit).
+    first sample, the same grid extended to that travel at the coarsest grid's spacing.
 
     With the plays at rest at ``v[0]``, play ``r`` first moves once ``|v[k] - v[0]| > r``; a
     record that starts at one end of its range (a closed-loop record, a multisine with random
     phases, a record started at its top) moves plays up to its full range, beyond the half-range
-    grid. The train BIC chooses between the grids (the extension costs its columns)."""
+    grid. A play beyond half the range moves only until the input has spanned its range (it can
+    never cross to the other envelope), so the extension is informed by the records' start-up
+    alone, where the stage's memory is an assumption (rest). Returns (half-range grids,
+    extended grids; empty when no record travels that far)."""
     span = float(np.ptp(np.concatenate([r.v for r in train])))
     reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
-    out = []
     step = span / 2 / (GRID_SIZES[0] - 1)  # the extension's spacing: the coarsest grid's
     extra = step * np.arange(1, int(np.ceil((reach - span / 2) / step)) + 1) + span / 2
-    for n in GRID_SIZES:
-        half = np.linspace(0.0, span / 2, n)
-        out.append(half)
-        if extra.size:
-            out.append(np.concatenate((half, extra)))
-    return out
+    half = [np.linspace(0.0, span / 2, n) for n in GRID_SIZES]
+    return half, [np.concatenate((h, extra)) for h in half] if extra.size else []
 
 
 def _nominal(train, validate, initial_state):
-    """The radius grid with the lowest train BIC and its fitted nominal model."""
-    best = None
-    for radii in _grids(train):
-        tr = _segments(train, radii, initial_state)
-        model = fit_nominal(tr)
-        bic = _bic(tr, [model.predict(s) for s in tr], radii.size + 1)
-        if best is None or bic < best[0]:
-            best = (bic, radii, tr, model)
-    _, radii, tr, model = best
-    return radii, tr, _segments(validate, radii, initial_state), model
+    """The radius grid with the lowest train BIC and its fitted nominal model.
+
+    The half-range grids and the extended grids (:func:`_grids`) each give the one with the
+    lowest train BIC; the extended one is kept only when it also has the lower validate BIC
+    (its extra plays are informed by the start-up alone: on a record whose memory at the
+    start is not at rest they fit that start and mispredict every other record's). The plays
+    start at rest at ``v[0]``, or at 0 when that has the lower train BIC (a record cut from
+    periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0). Returns
+    the radii, the train and validate segments, the model, whether the grid is extended and
+    whether the plays start at rest at ``v[0]``."""
+    half, extended = _grids(train)
+    picks = []
+    for at_rest, grids in ((True, half), (True, extended), (False, half)):
+        best = None
+        for radii in grids:
+            tr = _segments(train, radii, initial_state, at_rest)
+            model = fit_nominal(tr)
+            bic = _bic(tr, [model.predict(s) for s in tr], radii.size + 1)
+            if best is None or bic < best[0]:
+                best = (bic, radii, tr, model, at_rest)
+        picks.append(best)
+    if picks[1] is not None:  # the extension: kept only when validate agrees
+        vbic = []
+        for _, radii, _tr, model, at_rest in picks[:2]:
+            va = _segments(validate, radii, initial_state, at_rest)
+            vbic.append(_bic(va, [model.predict(s) for s in va], radii.size + 1))
+        if vbic[1] >= vbic[0]:
+            picks[1] = None
+    ext = picks[1] is not None
+    rest = picks[1] if ext else picks[0]
+    _, radii, tr, model, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
+    ext = ext and at_rest
+    return radii, tr, _segments(validate, radii, initial_state, at_rest), model, ext, at_rest
 
 
 def _baseline(train, validate, initial_state) -> dict:
@@ -391,14 +412,16 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             raise ValueError(f"{src}: sample time {dt:g} s differs from {dts[0][0]} "
                              f"({dts[0][1]:g} s); resample the records to one sample time")
     dt = dts[0][1]
-    radii, tr, va, nominal = _nominal(train, validate, initial_state)
+    radii, tr, va, nominal, extended, at_rest = _nominal(train, validate, initial_state)
     n_plays = radii.size
     out_tr = [nominal.predict(s) for s in tr]
     out_va = [nominal.predict(s) for s in va]
     before = _errors(va, out_va)
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
                               "weights": nominal.coef[:n_plays], "offset": nominal.coef[n_plays],
-                              "grid_sizes_tried": list(GRID_SIZES)},
+                              "grid_sizes_tried": list(GRID_SIZES),
+                              "grid_extended": extended,
+                              "plays_start": "at rest at v[0]" if at_rest else "at 0"},
                     "train": _errors(tr, out_tr), "validate": before,
                     "initial_state": initial_state,
                     "baseline": _baseline(train, validate, initial_state)}
@@ -417,7 +440,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
     for s, f in zip(segs, full_segs, strict=True):
         s.rate_basis = RateBasis(f.Z, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
-        s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt)  # dynamics before the plays
+        s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt,  # dynamics before the plays
+                                     at_rest=at_rest)
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
 
