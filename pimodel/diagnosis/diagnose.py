@@ -337,10 +337,14 @@ def _nominal(train, validate, initial_state):
     start at rest at ``v[0]``, or at 0 when that has the lower train BIC (a record cut from
     periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0). Returns
     the radii, the train and validate segments, the model, whether the grid is extended and
-    whether the plays start at rest at ``v[0]``."""
+    whether the plays start at rest at ``v[0]``. With ``initial_state="unknown"`` (the
+    start-up is not fitted) the plays start at 0 on the half-range grids, as before issue 33
+    (from ``v[0]`` the shared real record's validate gap was 0.154 um against 0.048 um noise)."""
     half, extended = _grids(train)
+    if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
+        half, extended = [], []
     picks = []
-    for at_rest, grids in ((True, half), (True, extended), (False, half)):
+    for at_rest, grids in ((True, half), (True, extended), (False, _grids(train)[0])):
         best = None
         for radii in grids:
             tr = _segments(train, radii, initial_state, at_rest)
@@ -349,6 +353,9 @@ def _nominal(train, validate, initial_state):
             if best is None or bic < best[0]:
                 best = (bic, radii, tr, model, at_rest)
         picks.append(best)
+    if picks[0] is None:
+        _, radii, tr, model, at_rest = picks[2]
+        return radii, tr, _segments(validate, radii, initial_state, False), model, False, False
     if picks[1] is not None:  # the extension: kept only when validate agrees
         vbic = []
         for _, radii, _tr, model, at_rest in picks[:2]:
