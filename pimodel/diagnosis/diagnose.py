@@ -5,7 +5,11 @@ Train records fit every model; validate records only score. The nominal model is
 operator in the conventional parametrisation (plays on a uniform radius grid over half the input
 range, weights and an output offset by least squares, linear in its parameters). The grid is
 refined (20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits
-clean hysteresis whose radii lie off a coarse grid down to the noise. Each candidate effect is
+clean hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
+``v[0]``, or at 0 when the train BIC prefers it; records that travel further than half the range
+from ``v[0]`` also try the grid extended to that travel, kept when validate agrees (issue 33,
+:func:`_nominal`). A plain least-squares PI fit is reported beside it as a check
+(``nominal["baseline"]``), with a warning when the nominal is worse. Each candidate effect is
 refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are added greedily:
 each round fits every remaining candidate on train (on top of those already chosen) and scores
 it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by more
