@@ -53,6 +53,18 @@ ENVELOPE_KINDS: dict[str, int] = {k: LIMITS[f"PIM_ENV_{k.upper()}"]
                                   for k in ("poly2", "tanh", "poly2_inv", "tanh_inv")}
 # -- end LIMITS --------------------------------------------------------------------------------
 
+lib.pim_struct_size.restype = ctypes.c_size_t
+lib.pim_struct_size.argtypes = [ctypes.c_char_p]
+
+
+def _check_layout(mirror: type, c_name: str) -> None:
+    """ImportError when a ctypes mirror and its C struct differ in size (a build mismatch)."""
+    size = lib.pim_struct_size(c_name.encode())
+    if ctypes.sizeof(mirror) != size:  # a build mismatch
+        raise ImportError(f"pimodel: the ctypes layout of {c_name} ({ctypes.sizeof(mirror)} "
+                          f"bytes) does not match the C core's ({size} bytes)")
+
+
 c_size = ctypes.c_size_t
 c_double_p = ctypes.POINTER(ctypes.c_double)
 
@@ -310,6 +322,7 @@ class AsymParams(ctypes.Structure):
                 ("dr", c_double), ("kind", c_int), ("c", c_double * 4), ("kind_inv", c_int)]
 
 
+_check_layout(AsymParams, "pim_asym")
 lib.pim_asym_run.restype = c_size
 lib.pim_asym_run.argtypes = [ctypes.POINTER(AsymParams), c_size, c_size, F64, F64, F64, F64, F64]
 lib.pim_asym_inverse_run.restype = c_size
@@ -346,6 +359,7 @@ class DiagParams(ctypes.Structure):
                 ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP)]
 
 
+_check_layout(DiagParams, "pim_diag")
 lib.pim_diag_state_size.restype = c_size
 lib.pim_diag_state_size.argtypes = [ctypes.POINTER(DiagParams)]
 lib.pim_diag_check.restype = ctypes.c_char_p
@@ -409,6 +423,7 @@ class InverseParams(ctypes.Structure):
                 ("post", _DP)]
 
 
+_check_layout(InverseParams, "pim_dinv")
 _IP = ctypes.POINTER(InverseParams)
 lib.pim_dinv_state_size.restype = c_size
 lib.pim_dinv_state_size.argtypes = [_IP]

@@ -145,3 +145,24 @@ def test_docs_name_the_state_format_version_of_the_code():
     for doc in (ROOT / "docs" / "fmu.md", ROOT / "fmu" / "README.md"):
         found = set(re.findall(r"format version (\d+)", doc.read_text()))
         assert found == {version}, (doc.name, found, version)
+
+
+def test_ctypes_mirrors_have_the_c_structs_sizes():
+    """The parameter structs that pimodel._native mirrors with ctypes have the C core's size
+    (checked at import too; here the check itself is shown to compare something)."""
+    import ctypes
+
+    from pimodel import _native
+
+    for mirror, name in ((_native.AsymParams, "pim_asym"), (_native.DiagParams, "pim_diag"),
+                         (_native.InverseParams, "pim_dinv"), (_native.Loop, None)):
+        size = (_native.lib.pim_struct_size(name.encode()) if name
+                else _native.lib.pim_loop_sizeof())
+        assert size > 0 and ctypes.sizeof(mirror) == size, name
+    assert _native.lib.pim_struct_size(b"pim_unknown") == 0
+
+    class Short(ctypes.Structure):
+        _fields_ = [("p0", ctypes.c_double)]
+
+    with pytest.raises(ImportError, match="pim_asym"):
+        _native._check_layout(Short, "pim_asym")

@@ -71,6 +71,11 @@ PIM_API const char *pim_limit_name(int i);
 PIM_API double pim_limit_value(int i);
 PIM_API int pim_limit_is_integer(int i);
 
+/* sizeof of the parameter structs that Python mirrors with ctypes ("pim_asym", "pim_diag",
+ * "pim_dinv"), so that pimodel._native refuses a layout that does not match; 0 for another
+ * name. */
+PIM_API size_t pim_struct_size(const char *name);
+
 #ifdef __cplusplus
 }
 #endif
