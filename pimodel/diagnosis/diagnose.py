@@ -560,7 +560,12 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     fitted = {"radii": radii, "projection": proj, "nominal": full_nominal,
               "reference": current.reference or nominal,
               "chosen": chosen,
-              "model": current, "dt": dt, "initial_state": initial_state}
+              "model": current, "dt": dt, "initial_state": initial_state,
+              # the exported model's plays (DiagnosedModel.plays_start): at v[0] as fitted;
+              # at 0 when every record starts at 0 (the same columns; the nominal then keeps
+              # its operator form, DiagnosedModel.operator_form)
+              "plays_start": "v0" if at_rest and any(r.v[0] != 0.0 for r in train + validate)
+              else "zero"}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
                            fitted)
 
