@@ -134,8 +134,14 @@ class Segment:
         return rows[:n if ncols is None else min(ncols, n)]
 
 
-def make_segment(t, v, y, radii, mask=None) -> Segment:
-    """Segment of one record with the play outputs of ``radii`` (play states start at 0).
+def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
+    """Segment of one record with the play outputs of ``radii``, the plays at rest at ``v[0]``.
+
+    The play states before the first sample are ``z_i[-1] = v[0]`` (the diagnosis' ``"rest"``
+    convention): a record that starts away from 0 starts with every play in its interior, not
+    with the large plays held at 0 until the input has travelled past their radius. With
+    ``at_rest=False`` they are 0 (the memory of a record cut from periodic motion near an
+    extreme, where the plays sit near ``v[0] -+ r``).
 
     Parameters
     ----------
@@ -149,6 +155,8 @@ def make_segment(t, v, y, radii, mask=None) -> Segment:
         Play radii of the grid [input units], ``n`` of them.
     mask : numpy.ndarray or None
         Samples fitted and scored (see :class:`Segment`); None: all.
+    at_rest : bool
+        Plays at rest at ``v[0]`` (default); False: at 0.
 
     Returns
     -------
@@ -162,7 +170,9 @@ def make_segment(t, v, y, radii, mask=None) -> Segment:
     >>> seg.Z.tolist()
     [[0.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5]]
     """
-    Z = PIOperator(np.ones(len(radii)), radii).play_outputs(v)
+    v = np.asarray(v, float)
+    z0 = float(v[0]) if at_rest else 0.0
+    Z = PIOperator(np.ones(len(radii)), radii, initial_state=z0).play_outputs(v)
     return Segment(t, v, y, Z, mask)
 
 
