@@ -46,6 +46,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
+from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
 from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment
@@ -264,7 +265,9 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     DiagnosisReport
         ``verdict`` holds ``effects`` (``["none"]``, effect names, possibly followed by
         ``"unexplained"``, or ``["unexplained"]``), ``gap_before``/``gap_after`` (validate
-        RMS), ``shrink``, ``noise_floor`` (and how it was measured), ``unexplained``.
+        RMS), ``shrink``, ``noise_floor`` (and how it was measured), ``unexplained``, and
+        with creep among the effects ``creep_law`` (:func:`.creep.creep_law`: percent per
+        decade, total creep, time constants; None when the lags have no immediate response).
 
     Raises
     ------
@@ -557,6 +560,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
                "unexplained": unexplained, "alternatives": alternatives,
                "model": current.params, "evidence": evidence}
+    if "creep" in chosen:
+        verdict["creep_law"] = _creep_law(current.params)
     fitted = {"radii": radii, "projection": proj, "nominal": full_nominal,
               "reference": current.reference or nominal,
               "chosen": chosen,
@@ -568,6 +573,13 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
               else "zero"}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
                            fitted)
+
+
+def _creep_law(params: dict) -> dict | None:
+    try:
+        return creep_law(params["creep_lag_gains"], params["creep_time_constants_s"])
+    except ValueError:
+        return None
 
 
 def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
