@@ -8,9 +8,12 @@ import time
 from pathlib import Path
 
 __all__ = [
+    "HELP",
     "register",
     "run",
 ]
+
+HELP = "run a study (figures and results tables into an output folder)"
 
 
 def register(sub) -> None:
@@ -19,7 +22,7 @@ def register(sub) -> None:
     names = ", ".join(available_studies()) or "none found"
     p = sub.add_parser(
         "study",
-        help="run a study (figures and results tables into an output folder)",
+        help=HELP,
         description=f"Run a study from studies/ and write its figures (PNG) and results "
         f"(Markdown and JSON) to an output folder. A sweep study maps its cases on Dask "
         f"(--workers, --scheduler) and keeps each finished case in OUT/cases, so a rerun "

@@ -10,10 +10,13 @@ import time
 from pathlib import Path
 
 __all__ = [
+    "HELP",
     "build_cases",
     "register",
     "run",
 ]
+
+HELP = "sweep the truth simulator and diagnosis/identification settings (tidy table)"
 
 
 def _value(text: str):
@@ -57,7 +60,7 @@ def register(sub) -> None:
 
     p = sub.add_parser(
         "sweep",
-        help="sweep the truth simulator and diagnosis/identification settings (tidy table)",
+        help=HELP,
         description="Run the diagnosis or the identification on records of the truth simulator "
         "over a grid (--grid) or a random sample (--random) of parameters, on a local Dask "
         "cluster or a given scheduler, and write OUT/table.csv (one row per case; "
