@@ -157,7 +157,6 @@ def refuse_overwrite(inputs: dict[str, list[str]], outputs: dict[str, str | None
     ...     print(str(exc)[:41])
     --json ./d.csv is the input file DATA (d.csv)
     """
-    check_outputs(outputs, folders)
     files = [(arg, Path(p)) for arg, paths in inputs.items() for p in paths]
     for out_arg, out in outputs.items():
         if out is None:
@@ -175,6 +174,7 @@ def refuse_overwrite(inputs: dict[str, list[str]], outputs: dict[str, str | None
                 raise ValueError(f"{out_arg} {folder} would write over the input file {in_arg} "
                                  f"({path}); pimodel never writes over an input file: choose "
                                  "another folder")
+    check_outputs(outputs, folders)
 
 
 def _writable_folder(option: str, path: Path) -> None:
