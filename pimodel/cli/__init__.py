@@ -19,8 +19,12 @@ COMMANDS = ["simulate", "identify", "fmu", "diagnose", "split", "demo", "study",
 def build_parser(full: Iterable[str] | None = None) -> argparse.ArgumentParser:
     """The argument parser; ``full`` names the commands registered with all their options
     (default: every command); the others are listed with their help line only."""
-    from .. import __version__
+    from importlib.metadata import PackageNotFoundError, version
 
+    try:
+        __version__ = version("pimodel")
+    except PackageNotFoundError:  # pragma: no cover - run from a source tree, not installed
+        __version__ = "unknown (not installed)"
     parser = argparse.ArgumentParser(
         prog="pimodel",
         description="Prandtl-Ishlinskii hysteresis: simulate, identify, compensate, build FMUs.",
