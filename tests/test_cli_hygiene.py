@@ -7,23 +7,16 @@ from __future__ import annotations
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from pimodel import PIOperator, Record, load_record, save_record
+from pimodel import Record, load_record, save_record
 from pimodel.cli import main
 
-SIM = ["--weights", "1,0.5", "--radii", "0,0.2"]
-
-
-@pytest.fixture
-def record(tmp_path):
-    t = np.arange(400) * 1e-3
-    v = 2 * np.sin(2 * np.pi * 5 * t)
-    path = tmp_path / "d.csv"
-    save_record(Record(t, v, PIOperator([1, 0.5], [0, 0.2]).simulate(v)), path)
-    return path
+sys.path.insert(0, str(Path(__file__).parent))
+from test_cli_safety import SIM, record  # noqa: E402, F401 (the record fixture)
 
 
 def test_version(capsys):
@@ -45,7 +38,7 @@ def test_help_lists_every_command_without_loading_numpy():
     assert all(f"    {name} " in out for name in COMMANDS)
 
 
-def test_json_folder_refused_before_any_work(record, tmp_path, capsys, monkeypatch):
+def test_json_folder_refused_before_any_work(record, tmp_path, capsys, monkeypatch):  # noqa: F811
     import pimodel.identification.chain as chain
 
     monkeypatch.setattr(chain, "identify", lambda *a, **k: pytest.fail("the fit ran"))
@@ -109,7 +102,7 @@ def test_columns_per_file(tmp_path, capsys, monkeypatch):
     assert "c.csv is not an input file" in capsys.readouterr().err
 
 
-def test_split_command(record, tmp_path, capsys):
+def test_split_command(record, tmp_path, capsys):  # noqa: F811
     train, validate = tmp_path / "train.csv", tmp_path / "val.npz"
     assert main(["split", str(record), "--fraction", "0.75", "--train", str(train),
                  "--validate", str(validate)]) == 0
