@@ -158,3 +158,27 @@ def test_interrupted_export_leaves_the_earlier_run(tmp_path, monkeypatch):
     assert paths == [out / "augmented.json", out / "nominal.json"]
     assert {p.name: p.read_text() for p in out.iterdir()} == {"augmented.json": "new",
                                                               "nominal.json": "new"}
+
+
+def test_sweep_reports_reused_and_computed_and_one_line_when_interrupted(tmp_path, capsys,
+                                                                         monkeypatch):
+    import pimodel.experiments.stage_sweeps as stage_sweeps
+    from pimodel.experiments.sweeps import Interrupted
+
+    def finished(cases, counts, **kwargs):
+        counts.update(reused=3, computed=1)
+        return [{}] * 4
+
+    def interrupted(cases, counts, **kwargs):
+        raise Interrupted(2, 4, tmp_path / "cases")
+
+    argv = ["sweep", "identify", "--grid", "noise_um=0.005,0.05", "--seeds", "2",
+            "--workers", "0", "--out", str(tmp_path)]
+    monkeypatch.setattr(stage_sweeps, "truth_sweep", finished)
+    assert main(argv) == 0
+    assert f"4 cases (3 reused from {tmp_path / 'cases'}, 1 computed)" in capsys.readouterr().out
+    monkeypatch.setattr(stage_sweeps, "truth_sweep", interrupted)
+    assert main(argv) == 130
+    out = capsys.readouterr()
+    assert out.err == (f"pimodel sweep: interrupted: 2 of 4 cases kept in {tmp_path / 'cases'}; "
+                       "rerun the same command to resume\n") and out.out == ""

@@ -67,6 +67,9 @@ def main(argv: list[str] | None = None) -> int:
         except (ValueError, OSError) as exc:
             print(f"pimodel {args.command}: error: {exc}", file=sys.stderr)
             return 2
+        except KeyboardInterrupt:  # a sweep or study says what it kept before this
+            print(f"pimodel {args.command}: interrupted", file=sys.stderr)
+            return 130
 
 
 if __name__ == "__main__":  # pragma: no cover
