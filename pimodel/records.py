@@ -224,7 +224,7 @@ class Record:
         --------
         >>> rec = Record(np.arange(10) * 0.1, np.arange(10.0), np.arange(10.0))
         >>> train, validate = rec.split(0.6)
-        >>> len(train), len(validate), float(validate.t[0])
+        >>> len(train), len(validate), round(float(validate.t[0]), 12)
         (6, 4, 0.6)
         """
         if isinstance(fraction, bool) or not isinstance(fraction, int | float) or \
