@@ -13,9 +13,9 @@ Signal path, one sample ``k`` at a time (``dt = 1 / FS``; input ``v`` in V, outp
   ``r_i = (i + 1/2) R / N_PLAYS`` and a smooth density ``w_i = c r_i exp(-r_i / r0) R /
   N_PLAYS``; each play ``z_i[k] = min(max(z_i[k-1], v[k] - rho_i[k]), v[k] + rho_i[k])``
   starts at ``z_i[-1] = 0`` (rest at 0 V; :func:`density_records` starts each record at
-  0 V). With ``rate``, ``rho_i[k] = r_i (1 + beta s[k])``, ``s`` the
-  input speed ``|v[k] - v[k-1]| / dt / RATE_REF`` low-passed with time constant ``tau_rate``;
-  without it ``rho_i = r_i``.
+  0 V). With ``rate``, ``rho_i[k] = r_i (1 + beta s[k] / (1 + s[k]))`` (saturating: at most
+  ``1 + beta``), ``s`` the input speed ``|v[k] - v[k-1]| / dt / RATE_REF`` low-passed with
+  time constant ``tau_rate``; without it ``rho_i = r_i``.
 - asymmetry: ``h -> h + q (h - h_mid)^2 / H`` (``H`` the nominal output span), a quadratic
   map with a sign of its own.
 - creep: ``c_j`` times first-order lags of ``h`` with time constants ``CREEP_LAGS`` (up to
@@ -51,7 +51,7 @@ __all__ = [
 FS = 2000.0  # Hz
 V_MAX = 120.0  # V, input range 0..V_MAX
 N_PLAYS = 240
-RATE_REF = 400.0  # V/s
+RATE_REF = 500.0  # V/s
 CREEP_LAGS = (0.5, 5.0, 30.0, 100.0)  # s
 INPUT_KINDS = ("multisine", "chirp", "ramps", "random")
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
@@ -70,7 +70,7 @@ class DensityStage:
     density_c, density_r0 : float
         Density scale ``c`` [um/V^2] and decay radius ``r0`` [V].
     rate_beta, rate_tau : float or None
-        Radius growth per unit of the low-passed speed, and its time constant [s].
+        Largest relative radius growth with the low-passed speed, and its time constant [s].
     asymmetry : float or None
         Quadratic output map coefficient ``q`` (signed).
     creep : tuple of float or None
@@ -147,7 +147,7 @@ class DensityStage:
             if self.rate_beta is not None:
                 speed = abs(v[k] - v[k - 1]) / dt / RATE_REF if k else 0.0
                 s += alpha * (speed - s)
-                rho = self.radii * (1.0 + self.rate_beta * s)
+                rho = self.radii * (1.0 + self.rate_beta * s / (1.0 + s))
             z = np.minimum(np.maximum(z, v[k] - rho), v[k] + rho)
             h[k] = self.a_lin * v[k] + self.weights @ z
         return h
@@ -315,7 +315,7 @@ def random_density_stage(effects, seed: int) -> DensityStage:
     span = DensityStage(**kw).span
     kw["noise"] = rng.uniform(5e-4, 1.5e-3) * span  # 0.05-0.15 % of the span
     if "rate" in effects:
-        kw["rate_beta"] = rng.uniform(0.4, 0.8)
+        kw["rate_beta"] = rng.uniform(0.3, 0.6)
         kw["rate_tau"] = rng.uniform(0.02, 0.06)
     if "asymmetry" in effects:
         kw["asymmetry"] = rng.uniform(0.06, 0.12) * rng.choice([-1, 1])
