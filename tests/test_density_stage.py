@@ -111,3 +111,20 @@ def test_bad_names_raise():
         random_density_stage(["hum"], 0)
     with pytest.raises(ValueError, match="kind"):
         density_records([], 0, kind="square")
+
+
+def test_sim_to_real_holds_its_cases_at_full_size_only():
+    """The study's density cases: a clean stage on every input kind, the single effects, the
+    pairs and the outside effects (expected "unexplained"); none in the quick size, whose
+    table tests/test_studies.py holds."""
+    from pimodel.experiments.studies import load_study
+
+    study = load_study("sim_to_real")
+    full = [c for c in study.cases(False) if c["generator"] == "density"]
+    assert not [c for c in study.cases(True) if c["generator"] == "density"]
+    assert {c["kind"] for c in full if not c["effects"]} == {"mixed", *INPUT_KINDS}
+    assert len({c["seed"] for c in full}) == 10
+    outside = [c for c in full if set(c["effects"]) & {"clipping", "second_input",
+                                                         "sensor_gain"}]
+    assert outside and all(study.expected(c) == ["unexplained"] for c in outside)
+    assert study.expected({"effects": ["creep", "delay"]}) == ["creep", "delay"]
