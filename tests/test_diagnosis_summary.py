@@ -109,3 +109,13 @@ def test_cli_prints_the_summary_and_writes_the_report(tmp_path, capsys):
     figs = [ln[ln.index("(") + 1:-1] for ln in text.splitlines() if ln.startswith("![")]
     assert len(figs) == 2 and all((out / f).exists() for f in figs)
     assert "| creep |" in text  # the table of each effect alone
+
+
+def test_report_tables_escape_pipes_in_region_names(tmp_path):
+    rep = _report()
+    rep.where["regions"].insert(0, {"region": "fast input (top quarter of |dv/dt|)",
+                                    "concentration": 3.0, "energy_share": 0.6,
+                                    "sample_share": 0.2})
+    text = write_report(rep, tmp_path).read_text()
+    row = next(ln for ln in text.splitlines() if ln.startswith("| fast input"))
+    assert row.replace("\\|", "").count("|") == 5  # four cells

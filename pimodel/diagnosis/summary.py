@@ -219,7 +219,7 @@ def summarize(rep) -> str:
 
 def _table(cols, rows) -> str:
     out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    out += ["| " + " | ".join(str(x) for x in r) + " |" for r in rows]
+    out += ["| " + " | ".join(str(x).replace("|", "\\|") for x in r) + " |" for r in rows]
     return "\n".join(out) + "\n"
 
 
