@@ -119,3 +119,14 @@ def test_report_tables_escape_pipes_in_region_names(tmp_path):
     text = write_report(rep, tmp_path).read_text()
     row = next(ln for ln in text.splitlines() if ln.startswith("| fast input"))
     assert row.replace("\\|", "").count("|") == 5  # four cells
+
+
+def test_report_folder_that_is_an_input_is_refused(tmp_path, capsys):
+    from pimodel import Record, save_record
+
+    t = np.arange(200) * 1e-3
+    rec = save_record(Record(t, np.sin(20 * t), np.sin(20 * t)), tmp_path / "d.csv")
+    code = main(["diagnose", "--train", str(rec), "--validate", str(rec), "--json",
+                 str(tmp_path / "r.json"), "--report", str(rec)])
+    assert code == 2 and "--report" in capsys.readouterr().err
+    assert not (tmp_path / "r.json").exists()  # refused before any work
