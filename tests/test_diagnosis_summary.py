@@ -59,6 +59,7 @@ def test_startup_hint_only_when_started_at_rest():
     assert "--initial-state unknown" in summarize(rep).splitlines()[-1]
     quiet = _report(startup=3.0, initial_state="unknown")
     assert not any("--initial-state" in h for h in hints(quiet))
+    assert "start-up" in summarize(rep) and "start-up" not in summarize(quiet)
     assert not any("--initial-state" in h for h in hints(_report(startup=1.2)))
 
 

@@ -180,7 +180,9 @@ def summarize(rep) -> str:
     Returns
     -------
     str
-        Four lines, output units as in the records (um for pimodel's stages).
+        Four lines, output units as in the records (um for pimodel's stages). With
+        ``initial_state="unknown"`` the start-up region (left out of fitting and scoring) is
+        not named among the regions.
 
     Examples
     --------
@@ -204,7 +206,10 @@ def summarize(rep) -> str:
     lines.append(f"How sure: {level}: validate gap {v['gap_before']:.3g} -> "
                  f"{v['gap_after']:.3g} (shrink {100 * v['shrink']:.0f} %), noise floor "
                  f"{v['noise_floor']:.3g} ({v.get('noise_floor_method', '?')}); {why}.")
-    regs = _regions(rep.where)
+    regs = _regions(rep.where, 4)
+    if rep.nominal.get("initial_state", "rest") == "unknown":  # left out of fit and score
+        regs = [r for r in regs if not r["region"].startswith(STARTUP)]
+    regs = regs[:3]
     spectrum = rep.where.get("spectrum") or []
     band = max(spectrum, key=lambda b: b["energy_share"]) if spectrum else None
     where = "; ".join(f"{r['region']}: {100 * r['energy_share']:.0f} % of the residual in "
