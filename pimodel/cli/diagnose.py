@@ -52,6 +52,9 @@ def register(sub) -> None:
                    "nominal.model.json is the nominal model as an operator (GeneralizedPI)")
     p.add_argument("--no-fmu", action="store_true",
                    help="with --export: write the JSON files only (no C compiler needed)")
+    p.add_argument("--report", default=None, metavar="DIR",
+                   help="write report.md (the summary in words, the figures, the numbers, "
+                   "each effect alone, where the gap lies, hints) and its figures here")
     add_columns_option(p)
     p.set_defaults(func=run)
 
@@ -64,6 +67,10 @@ def run(args: argparse.Namespace) -> int:
     refuse_overwrite({"--train": args.train, "--validate": args.validate},
                      {"--json": args.json, **exported}, {"--plots": args.plots,
                                                          "--export": args.export})
+    if args.report:
+        refuse_overwrite({"--train": args.train, "--validate": args.validate},
+                         {"--report report.md": str(Path(args.report) / "report.md")},
+                         {"--report": args.report})
     inputs = args.train + args.validate
     train = load_inputs(args, args.train, inputs)
     validate = load_inputs(args, args.validate, inputs)
@@ -78,6 +85,11 @@ def run(args: argparse.Namespace) -> int:
     print(json.dumps({k: v[k] for k in ("effects", "gap_before", "gap_after", "shrink",
                                         "noise_floor", "noise_floor_method")}, indent=1))
     print(f"wrote {args.json}")
+    from ..diagnosis.summary import summarize, write_report
+
+    print(summarize(rep))
+    if args.report:
+        print(f"wrote {write_report(rep, args.report)}")
     if args.export:
         for path in export_models(rep, args.export, fmu=not args.no_fmu):
             print(f"wrote {path}")
