@@ -35,6 +35,7 @@ from ..checks import as_signal, as_vector, positive_scalar, scalar_or_vector
 from .base import (
     InverseStreaming,
     Streaming,
+    check_finite,
     freeze,
     operator_repr,
     read_only,
@@ -137,7 +138,7 @@ class AsymmetricPI(Streaming):
         """
         self._restart()
 
-    def _run(self, x: np.ndarray, z: np.ndarray, *, inverse: bool, name: str) -> np.ndarray:
+    def _run(self, x: np.ndarray, z: np.ndarray, *, inverse: bool, name: str = "v") -> np.ndarray:
         out, bad = _native.asym_run(self._c, self._p, self._r, z, x, inverse=inverse)
         if bad > x.size:
             raise ValueError(f"weights: the inverse handles at most 64 plays, got {self.n}")
@@ -146,7 +147,7 @@ class AsymmetricPI(Streaming):
             what = ("has no input: it lies beyond the range of the shape function"
                     if inverse else "lies outside the domain of the shape function")
             raise ValueError(f"{name}: sample {k} ({float(x[k])!r}) {what} {self.shape!r}")
-        return out
+        return check_finite(out, x, name, state=z)
 
     def simulate(self, v, *, state=None, return_state: bool = False):
         """Output ``y[k]`` for ``v[k]`` from ``state`` (default the initial state).
@@ -205,7 +206,7 @@ class AsymmetricPI(Streaming):
         >>> op.step(1.0), op.state
         (1.4, array([0.8]))
         """
-        return self._advance(self._run, as_signal(v, "v"), inverse=False, name="v")
+        return self._advance(self._run, as_signal(v, "v"), "v", inverse=False)
 
     def to_dict(self) -> dict:
         """JSON-ready parameters.
@@ -338,5 +339,4 @@ class AsymmetricPIInverse(InverseStreaming):
         >>> round(inv.step(1.5), 12), inv.state
         (1.066666666667, array([0.86666667]))
         """
-        return self._advance(self.forward._run, as_signal(y_d, "y_d"), inverse=True,
-                             name="y_d")
+        return self._advance(self.forward._run, as_signal(y_d, "y_d"), "y_d", inverse=True)

@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import _native
 from ..checks import as_signal, as_vector, scalar_or_vector
-from .base import Streaming, freeze, operator_repr, read_only, size_of, streaming_state
+from .base import Streaming, check_finite, freeze, operator_repr, read_only, size_of, streaming_state
 from .describing_function import PIDescribingFunction
 
 __all__ = [
@@ -30,16 +30,11 @@ __all__ = [
 
 INVERSE_CONDITION_WARN = 1e6    # max/min branch slope above which inverse() warns
 INVERSE_CONDITION_ERROR = 1e12  # ... and above which it raises (rounding dominates)
-
-
-def _check_output(y: np.ndarray, v: np.ndarray) -> None:
-    """ValueError when a finite input gave a non-finite output (float64 overflow)."""
-    if not np.all(np.isfinite(y)):
-        k = int(np.flatnonzero(~np.isfinite(y))[0])
-        raise ValueError(
-            f"v: sample {k} ({float(v[k]):.6g}) makes the output overflow to {float(y[k])!r}; "
-            f"expected |v| * sum |p_i| below {np.finfo(float).max:.3g}: scale the input"
-        )
+# The inverse's weights -p_i / (P_i P_(i-1)) need the product of two partial sums P_i = p_1 +
+# ... + p_i to be a normal float64: P_i in [sqrt(tiny), sqrt(max)] = [1.49e-154, 1.34e154].
+# Outside it the product overflows (weights -0.0) or loses digits (subnormal), silently.
+INVERSE_WEIGHT_MIN = float(np.sqrt(np.finfo(float).tiny))
+INVERSE_WEIGHT_MAX = float(np.sqrt(np.finfo(float).max))
 
 
 def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -168,7 +163,7 @@ class PIOperator(Streaming):
         x = as_signal(v, "v")
         z = self._start_state(state)
         y, _ = _native.pi_run(self._p, self._r, z, x)
-        _check_output(y, x)
+        check_finite(y, x, "v", state=z)
         return (y, z) if return_state else y
 
     def play_outputs(self, v, *, state=None) -> np.ndarray:
@@ -239,7 +234,7 @@ class PIOperator(Streaming):
         Raises
         ------
         ValueError
-            If ``v`` is not finite or the output overflows.
+            If ``v`` is not finite or the output overflows; the state is then unchanged.
 
         Examples
         --------
@@ -247,12 +242,11 @@ class PIOperator(Streaming):
         >>> op.step(0.5), op.step(1.0), op.state
         (0.6, 1.35, array([1. , 0.7]))
         """
-        vk = float(v)
-        if not np.isfinite(vk):
-            raise ValueError(f"v: input sample is {v!r}; expected a finite number")
-        y = _native.pi_step(self._p, self._r, self._z, vk)
-        _check_output(np.array([y]), np.array([vk]))
-        return y
+        return self._advance(self._step, as_signal(v, "v"))
+
+    def _step(self, x: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """One sample through the C core's step, advancing ``z`` in place."""
+        return np.array([_native.pi_step(self._p, self._r, z, float(x[0]))])
 
     def output(self, state=None) -> float:
         """Output ``sum_i p_i z_i`` for a state (default: the current streaming state).
@@ -339,7 +333,9 @@ class PIOperator(Streaming):
         Raises
         ------
         ValueError
-            If ``r_1 > 0``, a partial sum of weights is not positive, the branch slopes range
+            If ``r_1 > 0``, a partial sum of weights is not positive or lies outside
+            ``[INVERSE_WEIGHT_MIN, INVERSE_WEIGHT_MAX]`` (about 1.5e-154 to 1.3e154, where
+            the products ``P_i P_(i-1)`` stay normal float64 numbers), the branch slopes range
             over more than ``INVERSE_CONDITION_ERROR`` (a RuntimeWarning above
             ``INVERSE_CONDITION_WARN``), or the inverse's parameters overflow float64.
 
@@ -365,6 +361,13 @@ class PIOperator(Streaming):
                 "PIOperator.inverse: not invertible, a partial sum of weights is not positive"
             )
         P = np.cumsum(self._p)
+        if P.max() > INVERSE_WEIGHT_MAX or P.min() < INVERSE_WEIGHT_MIN:
+            raise ValueError(
+                f"PIOperator.inverse: weights out of range, the partial sums P_i = p_1 + ... + "
+                f"p_i run from {float(P.min()):.3g} to {float(P.max()):.3g}; the inverse's "
+                "weights -p_i / (P_i P_(i-1)) are representable only for P_i within "
+                f"[{INVERSE_WEIGHT_MIN:.3g}, {INVERSE_WEIGHT_MAX:.3g}] (float64): rescale the "
+                "output units")
         cond = float(P.max() / P.min())
         if cond > INVERSE_CONDITION_ERROR:
             raise ValueError(
