@@ -110,13 +110,14 @@ class Cascade:
         >>> Cascade(PIOperator([1.0], [0.0]), PIOperator([2.0], [0.0])).step(0.5)
         1.0
         """
-        saved = [s.state for s in self.stages if hasattr(s, "state")]
+        kept = [s for s in self.stages if hasattr(s, "state")]
+        saved = [s.state for s in kept]
         x = float(v)
         try:
             for s in self.stages:
                 x = s.step(x)
         except ValueError:   # a stage refused: every stage keeps its state (base.py's rule)
-            for s, z in zip((s for s in self.stages if hasattr(s, "state")), saved):
+            for s, z in zip(kept, saved, strict=True):
                 s.state = z
             raise
         return x

@@ -29,7 +29,15 @@ import numpy as np
 
 from .. import _native
 from ..checks import as_signal, as_vector, positive_scalar, scalar_or_vector
-from .base import Streaming, check_finite, freeze, operator_repr, read_only, size_of, streaming_state
+from .base import (
+    Streaming,
+    check_finite,
+    freeze,
+    operator_repr,
+    read_only,
+    size_of,
+    streaming_state,
+)
 
 __all__ = ["CreepOperator"]
 

@@ -20,7 +20,15 @@ import numpy as np
 
 from .. import _native
 from ..checks import as_signal, as_vector, scalar_or_vector
-from .base import Streaming, check_finite, freeze, operator_repr, read_only, size_of, streaming_state
+from .base import (
+    Streaming,
+    check_finite,
+    freeze,
+    operator_repr,
+    read_only,
+    size_of,
+    streaming_state,
+)
 from .describing_function import PIDescribingFunction
 
 __all__ = [
@@ -242,7 +250,10 @@ class PIOperator(Streaming):
         >>> op.step(0.5), op.step(1.0), op.state
         (0.6, 1.35, array([1. , 0.7]))
         """
-        return self._advance(self._step, as_signal(v, "v"))
+        vk = float(v)
+        if not np.isfinite(vk):
+            raise ValueError(f"v: input sample is {v!r}; expected a finite number")
+        return self._advance(self._step, np.array([vk]))
 
     def _step(self, x: np.ndarray, z: np.ndarray) -> np.ndarray:
         """One sample through the C core's step, advancing ``z`` in place."""
@@ -363,9 +374,9 @@ class PIOperator(Streaming):
         P = np.cumsum(self._p)
         if P.max() > INVERSE_WEIGHT_MAX or P.min() < INVERSE_WEIGHT_MIN:
             raise ValueError(
-                f"PIOperator.inverse: weights out of range, the partial sums P_i = p_1 + ... + "
-                f"p_i run from {float(P.min()):.3g} to {float(P.max()):.3g}; the inverse's "
-                "weights -p_i / (P_i P_(i-1)) are representable only for P_i within "
+                "PIOperator.inverse: not representable in float64, the partial sums P_i = "
+                f"p_1 + ... + p_i run from {float(P.min()):.3g} to {float(P.max()):.3g}; the "
+                "inverse's weights -p_i / (P_i P_(i-1)) are representable only for P_i within "
                 f"[{INVERSE_WEIGHT_MIN:.3g}, {INVERSE_WEIGHT_MAX:.3g}] (float64): rescale the "
                 "output units")
         cond = float(P.max() / P.min())
