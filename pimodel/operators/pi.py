@@ -13,6 +13,7 @@ no role, only the sequence of input values. Units: ``v`` and the radii share the
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 
@@ -253,11 +254,12 @@ class PIOperator(Streaming):
         vk = float(v)
         if not np.isfinite(vk):
             raise ValueError(f"v: input sample is {v!r}; expected a finite number")
-        return self._advance(self._step, np.array([vk]))
-
-    def _step(self, x: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """One sample through the C core's step, advancing ``z`` in place."""
-        return np.array([_native.pi_step(self._p, self._r, z, float(x[0]))])
+        z = self._z.copy()   # the state moves only when the step succeeds (base.py's rule)
+        y = _native.pi_step(self._p, self._r, z, vk)
+        if not math.isfinite(y):   # a non-finite play state makes y non-finite too
+            check_finite(np.array([y]), np.array([vk]), "v", state=z)
+        self._z = z
+        return y
 
     def output(self, state=None) -> float:
         """Output ``sum_i p_i z_i`` for a state (default: the current streaming state).
