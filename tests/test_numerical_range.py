@@ -175,3 +175,16 @@ def test_case7_estimate_jointly_warns_on_a_fit_far_outside_the_noise():
         warnings.simplefilter("error")
         good = estimate_jointly(v, y, 4, linear_play=True)
     assert good.fit_rms < 1e-3 * np.ptp(y) < bad.fit_rms
+
+
+def test_asymmetric_inverse_takes_the_c_play_limit():
+    most = LIMITS["PIM_MAX_PLAYS"]
+    rng = np.random.default_rng(11)
+    for n, ok in ((most, True), (most + 1, False)):
+        op = AsymmetricPI(1.0, rng.uniform(0.1, 1, n), np.sort(rng.uniform(0, 1, n)))
+        if ok:
+            v = rng.uniform(-1, 1, 20)
+            np.testing.assert_allclose(op.inverse().simulate(op.simulate(v)), v, atol=1e-9)
+        else:
+            with pytest.raises(ValueError, match=f"forward: {n} plays; .* at most {most}"):
+                op.inverse()

@@ -46,6 +46,8 @@ from .envelopes import Envelope
 
 __all__ = ["AsymmetricPI", "AsymmetricPIInverse"]
 
+_MAX_PLAYS = _native.LIMITS["PIM_MAX_PLAYS"]
+
 
 class AsymmetricPI(Streaming):
     """Generalized PI with distinct ascending/descending envelopes (module docstring).
@@ -140,8 +142,9 @@ class AsymmetricPI(Streaming):
 
     def _run(self, x: np.ndarray, z: np.ndarray, *, inverse: bool, name: str = "v") -> np.ndarray:
         out, bad = _native.asym_run(self._c, self._p, self._r, z, x, inverse=inverse)
-        if bad > x.size:
-            raise ValueError(f"weights: the inverse handles at most 64 plays, got {self.n}")
+        if bad > x.size:  # AsymmetricPIInverse checks first; kept for a direct _run
+            raise ValueError(f"weights: the inverse handles at most {_MAX_PLAYS} plays, got "
+                             f"{self.n}")
         if bad:
             k = bad - 1
             what = ("has no input: it lies beyond the range of the shape function"
@@ -263,6 +266,9 @@ class AsymmetricPIInverse(InverseStreaming):
     """
 
     def __init__(self, forward: AsymmetricPI):
+        if forward.n > _MAX_PLAYS:  # the C solve sorts its kinks in a fixed-size array
+            raise ValueError(f"forward: {forward.n} plays; the inverse (and the FMU) takes at "
+                             f"most {_MAX_PLAYS}")
         self.forward = forward
         self.reset()
 
