@@ -188,3 +188,14 @@ def test_asymmetric_inverse_takes_the_c_play_limit():
         else:
             with pytest.raises(ValueError, match=f"forward: {n} plays; .* at most {most}"):
                 op.inverse()
+
+
+def test_pi_block_step_refuses_an_overflowing_sample():
+    from pimodel.blocks.pi import _Stepper
+
+    stepper = _Stepper(PIOperator([1.0, 1.0], [0.0, 0.3]))
+    x = np.zeros(2)
+    y, z = stepper.step(x, 0.5)
+    assert np.isfinite(y) and np.all(np.isfinite(z))
+    with pytest.raises(ValueError, match="v: sample 0 .*overflow"):
+        stepper.step(z, 1e308)
