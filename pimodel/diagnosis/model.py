@@ -93,6 +93,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.optimize import brentq
 
+from .._native import LIMITS
+from ..operators.base import check_finite
 from ..operators.pi import PIOperator
 from .checks import checked_signal
 from .drift import drift_term
@@ -180,6 +182,7 @@ class DiagnosedModel:
             raise ValueError(f"weights: expected {r.size} values like radii, got {w.shape}")
         if np.any(r < 0) or np.any(np.diff(r) < 0):
             raise ValueError("radii: expected non-negative, ascending values")
+        _check_limits(r.size, self.params)
         if not self.dt > 0:
             raise ValueError(f"dt: expected > 0, got {self.dt!r}")
         bad = set(self.effects) - {"creep", "asymmetry", "rate", "drift", "dynamics", "delay"}
@@ -265,7 +268,8 @@ class DiagnosedModel:
         Raises
         ------
         ValueError
-            ``v`` not a finite 1-D signal, ``t`` of another length.
+            ``v`` not a finite 1-D signal, ``t`` of another length, or an output float64
+            cannot hold (the sample is named; docs/reliability.md).
 
         Examples
         --------
@@ -309,7 +313,7 @@ class DiagnosedModel:
                 raise ValueError(f"measured: expected {v.size} samples like v, got "
                                  f"{y_meas.shape}")
             y = y + drift_term(p, tk, y, y_meas)
-        return y
+        return check_finite(y, v, "v")
 
     def _plays(self, x: np.ndarray) -> np.ndarray:
         """Play outputs of ``x`` on the grid, at rest at ``x[0]`` or 0 (:attr:`plays_start`)."""
@@ -752,7 +756,8 @@ class DiagnosedInverse:
         Raises
         ------
         ValueError
-            ``y_d`` not a finite 1-D signal, an unknown ``initial_state``.
+            ``y_d`` not a finite 1-D signal, an unknown ``initial_state``, or an input float64
+            cannot hold (the sample is named).
 
         Examples
         --------
@@ -771,13 +776,14 @@ class DiagnosedInverse:
             raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got {state!r}")
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
         x = self.prefilter(yd)
+        _check_headroom(x, self.model)
         z0 = self.initial_memory(x[0]) if state == "unknown" else None
         if state == "rest" and self.model.plays_start == "v0":
             z0 = np.full(self.model.radii.size, self.first_input(x[0]))
         x = _solve_static(self.model.static_part(), x, rng, z0)
         if self.model.dynamics_before:  # the filter's output -> its input (approximate)
-            return inverse_prefilter(x, self.model.params["wiener_elements"], self.model.dt)
-        return x
+            x = inverse_prefilter(x, self.model.params["wiener_elements"], self.model.dt)
+        return check_finite(x, yd, "y_d")
 
     def block(self, dt: float | None = None, *, name: str = "inverse", input: str = "y_d",
               output: str = "v", input_range: float | None = None,
@@ -846,6 +852,38 @@ def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
         x = (float(z @ m.reference_weights) + m.reference_offset - p["center"]) / p["half_range"]
         y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
     return y
+
+
+def _check_limits(n_plays: int, params: dict) -> None:
+    """ValueError above the C core's limits, the FMUs' too (``LIMITS``): at most
+    ``PIM_DIAG_MAX_PLAYS`` plays and ``PIM_DIAG_MAX_LAGS`` creep lags, so a model that loads
+    also exports and each sample costs a bounded time (issue 32, docs/reliability.md)."""
+    most = LIMITS["PIM_DIAG_MAX_PLAYS"]
+    if n_plays > most:
+        raise ValueError(f"radii: {n_plays} plays; a diagnosed model (and its FMU) takes at "
+                         f"most {most}")
+    lags = params.get("creep_lag_gains", ()) if isinstance(params, dict) else ()
+    most = LIMITS["PIM_DIAG_MAX_LAGS"]
+    if hasattr(lags, "__len__") and len(lags) > most:
+        raise ValueError(f"params: creep_lag_gains: {len(lags)} creep lags; a diagnosed model "
+                         f"(and its FMU) takes at most {most}")
+
+
+def _check_headroom(x: np.ndarray, model: DiagnosedModel) -> None:
+    """ValueError naming the ``y_d`` sample when the static inverse's root bracket, the
+    breakpoints plus 10 input spans (``pim_diag_inverse.c``), would overflow float64: the
+    input scale ``(max |x| + ptp x) / |sum w| + 2 r_n`` must stay below ``float max / 32``.
+    Beyond it the C solve returned a finite, wrong input (issue 32)."""
+    wsum = max(abs(float(model.weights.sum())), 1e-12)
+    with np.errstate(over="ignore"):
+        scale = (np.max(np.abs(x)) + np.ptp(x)) / wsum + 2 * float(model.radii[-1])
+    bound = np.finfo(float).max / 32
+    if not scale < bound:
+        k = int(np.argmax(np.abs(x)))
+        raise ValueError(
+            f"y_d: sample {k} ({float(x[k]):.6g}) is out of the inverse's range: the input it "
+            f"asks for, about {scale:.3g}, leaves no float64 headroom for the root bracket "
+            f"(expected below {bound:.3g}); scale the reference down")
 
 
 def _solve_static(static: DiagnosedModel, x: np.ndarray, input_range: float, z0) -> np.ndarray:
