@@ -388,6 +388,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 m = fit_effect(name, tr, combo, fx, nominal)
                 cache[key] = (m, [m.predict(s) for s in va])
                 m.params.update(level_report(m, va, tr))
+                _release(m, segs)
             m, o = cache[key]
             score = _bic(va, o, m.k)
             if best is None or score < best[0]:
@@ -479,6 +480,17 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
               "model": current, "dt": dt, "initial_state": initial_state}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
                            fitted)
+
+
+def _release(model: Model, segs: list[Segment]) -> None:
+    """Drop what a fit memoised over the records (the model's columns, the rate and filter
+    bases' columns): the diagnosis keeps every fitted candidate and its validate outputs, so
+    its memory stays that of the records' play columns, not one copy per candidate."""
+    model.release()
+    for s in segs:
+        for basis in (s.rate_basis, s.wiener_basis):
+            if basis is not None:
+                basis.release()
 
 
 def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):

@@ -207,6 +207,22 @@ class Model:
     adjust: object = field(repr=False, default=None)
     reference: object = field(repr=False, default=None)
 
+    def release(self) -> None:
+        """Drop the columns the model's features memoised per record (filtered plays, lags,
+        rate columns); a later :meth:`predict` rebuilds them. A diagnosis keeps every fitted
+        candidate: without this, each kept a few copies of its records' columns.
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(2) * 1e-3, np.array([0.0, 1.0]), np.zeros(2), [0.0])
+        >>> m = Model("nominal", 0, base_features, np.array([3.0, 0.0]))
+        >>> m.release(); m.predict(seg).tolist()
+        [0.0, 3.0]
+        """
+        release = getattr(self.features, "release", None)
+        if release is not None:
+            release()
+
     def predict(self, seg: Segment) -> np.ndarray:
         """Model output of a record.
 
@@ -660,7 +676,12 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     def feats(s: Segment) -> np.ndarray:
         return _stack_rows(rows(s)).T
 
+    def release() -> None:  # drop the memoised columns (rebuilt on the next use)
+        for key in [key for key in static if key != "train"]:
+            del static[key]
+
     feats.parts = rows
+    feats.release = release
     return feats
 
 

@@ -269,6 +269,21 @@ class RateBasis:
                 self._cache[key] = np.add.reduceat(per_play, self._starts, axis=1)
         return self._cache[key]
 
+    def release(self) -> None:
+        """Drop the memoised columns and contact tables (rebuilt on the next use), keeping
+        only what the basis was built from.
+
+        Examples
+        --------
+        >>> v = np.array([0.0, 0.01, 0.02, 0.02])
+        >>> basis = RateBasis(v[:, None], [0.0], v, 1.0, 0.01, [2.0], 1)
+        >>> a = basis.columns(1.0, "weight"); basis.release()
+        >>> bool(np.array_equal(a, basis.columns(1.0, "weight")))
+        True
+        """
+        self._cache.clear()
+        self._contact = self._weighted = None
+
     def _contacts(self):
         if self._contact is None:
             r, Z = self.radii, self.Z
