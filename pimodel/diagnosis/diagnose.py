@@ -42,9 +42,10 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
+from .chunked import chunks
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
-from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment
+from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment, segment_of_rows
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
@@ -321,7 +322,7 @@ def _compressed(tr, va, nominal: Model):
     Returns the new segments, the nominal refitted on them (with the full model's
     ``params``) and the projection ``V`` (play columns = ``Z @ V``; None: not compressed)."""
     n = tr[0].Z.shape[1]
-    G = sum(s.Z[s.used].T @ s.Z[s.used] for s in tr)
+    G = sum(_play_gram(s) for s in tr)
     _, vecs = np.linalg.eigh(G)
     w = nominal.coef[:n]
     rss_full = sum(float(np.sum((nominal.predict(s) - s.y)[s.used] ** 2)) for s in tr)
@@ -329,14 +330,32 @@ def _compressed(tr, va, nominal: Model):
         if q >= n:
             return tr, va, nominal, None
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :q]))
-        ctr = [Segment(s.t, s.v, s.y, s.Z @ V, s.mask) for s in tr]
+        ctr = [_projected(s, V) for s in tr]
         m = fit_nominal(ctr)
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
         if rss <= 1.01 * rss_full:
             m.params = dict(nominal.params)
-            return (ctr, [Segment(s.t, s.v, s.y, s.Z @ V, s.mask) for s in va],
-                    m, V)
+            return ctr, [_projected(s, V) for s in va], m, V
     return tr, va, nominal, None
+
+
+def _play_gram(s: Segment) -> np.ndarray:
+    """``Z^T Z`` over the fitted samples of ``s``, chunk by chunk."""
+    P = s.play_rows()
+    G = np.zeros((P.shape[0], P.shape[0]))
+    for c in chunks(s.y.size):
+        X = P[:, c] if s.mask is None else P[:, c][:, s.mask[c]]
+        G += X @ X.T
+    return G
+
+
+def _projected(s: Segment, V: np.ndarray) -> Segment:
+    """The segment with play columns ``Z V``, built chunk by chunk as rows."""
+    rows = np.empty((V.shape[1] + 1, s.y.size))
+    P = s.play_rows()
+    for c in chunks(s.y.size):
+        np.matmul(V.T, P[:, c], out=rows[:-1, c])
+    return segment_of_rows(s.t, s.v, s.y, rows, s.mask)
 
 
 def _diagnose(train: list[Record], validate: list[Record], max_effects: int,

@@ -33,6 +33,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
+from .chunked import chunks
+
 RATE_TAUS = (0.0, 1e-3, 3e-3, 10e-3, 30e-3)  # s: low-pass of the input rate, half decades
 RATE_TAU_START = 0.0  # the filter held while other grids (mode, delay, ...) are searched
 RATE_TAU_REFINE = (10**0.25, 10**0.125)  # then steps around the optimum: 1/4, 1/8 decade
@@ -197,7 +199,6 @@ class RateBasis:
         self.bands = play_bands(self.radii.size, bands)
         self.weights = np.asarray(weights, float)
         self._starts = [int(g[0]) for g in self.bands]
-        self._contact = None  # (last contact sample, -s_i r_i there), built on first use
         self._weighted = None  # band sums of w0_i z_i, built on first use
         self._cache: dict = {}
 
@@ -261,17 +262,16 @@ class RateBasis:
                     for b, g in enumerate(self.bands):
                         member[g, b] = self.weights[g]
                     self._weighted = self.Z @ member
-                self._cache[key] = rho[:, None] * self._weighted
+                cols = rho[:, None] * self._weighted
             else:
-                last, signed = self._contacts()
-                per_play = np.take(rho, last)
-                per_play *= signed
-                self._cache[key] = np.add.reduceat(per_play, self._starts, axis=1)
+                cols = self._radius_columns(rho)
+            self._cache.clear()  # the latest only: a search asks for each filter once
+            self._cache[key] = cols
         return self._cache[key]
 
     def release(self) -> None:
-        """Drop the memoised columns and contact tables (rebuilt on the next use), keeping
-        only what the basis was built from.
+        """Drop the memoised columns (rebuilt on the next use), keeping only what the basis
+        was built from.
 
         Examples
         --------
@@ -282,22 +282,30 @@ class RateBasis:
         True
         """
         self._cache.clear()
-        self._contact = self._weighted = None
+        self._weighted = None
 
-    def _contacts(self):
-        if self._contact is None:
-            r, Z = self.radii, self.Z
-            gap = self.v[:, None] - Z  # +-r_i while play i is in contact
+    def _radius_columns(self, rho: np.ndarray) -> np.ndarray:
+        """Band sums of ``rho_f[last contact of play i] * (-s_i r_i)``, chunk by chunk (the last
+        contact and its sign carried from chunk to chunk; nothing of size N x n is kept)."""
+        r, Z, v = self.radii, self.Z, self.v
+        out = np.empty((Z.shape[0], len(self.bands)))
+        last_prev = np.full(r.size, -1, dtype=np.int64)
+        signed_prev = np.zeros(r.size)
+        for c in chunks(Z.shape[0]):
+            gap = v[c, None] - Z[c]  # +-r_i while play i is in contact
             contact = np.abs(gap) >= r * (1 - 1e-9)
             contact &= r > 0
-            k = np.arange(Z.shape[0], dtype=np.int32)[:, None]
-            last = np.maximum.accumulate(np.where(contact, k, np.int32(-1)), axis=0)
-            at = np.maximum(last, 0)
-            signed = np.take_along_axis(gap, at, axis=0)  # -(-s_i r_i) at the last contact
-            signed *= -1.0
-            signed[last < 0] = 0.0
-            self._contact = (at, signed)
-        return self._contact
+            k = np.arange(gap.shape[0], dtype=np.int64)[:, None]
+            local = np.maximum.accumulate(np.where(contact, k, -1), axis=0)
+            inside = local >= 0
+            signed = np.where(inside, -np.take_along_axis(gap, np.maximum(local, 0), axis=0),
+                              signed_prev)  # -(-s_i r_i) at the last contact
+            last = np.where(inside, local + c.start, last_prev)
+            per_play = np.take(rho, np.maximum(last, 0))
+            per_play *= signed
+            out[c] = np.add.reduceat(per_play, self._starts, axis=1)
+            last_prev, signed_prev = last[-1], signed[-1]
+        return out
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,
