@@ -24,7 +24,7 @@ import numpy as np
 
 __all__ = ["CHUNK", "ChunkedQR", "NormalEquations", "chunks"]
 
-CHUNK = 1 << 16  # samples per chunk (65,536: a 40-column chunk of rows is 21 MB)
+CHUNK = 1 << 14  # samples per chunk (16,384: an 80-column chunk of rows is 10 MB)
 
 
 def chunks(n: int, size: int = CHUNK) -> Iterator[slice]:

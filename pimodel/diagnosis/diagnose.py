@@ -304,13 +304,15 @@ def _nominal(train, validate, initial_state):
     """The radius grid with the lowest train BIC and its fitted nominal model."""
     span = float(np.ptp(np.concatenate([r.v for r in train])))
     best = None
-    for n in GRID_SIZES:
+    for n in GRID_SIZES:  # train only; the validate segments for the grid kept
         radii = np.linspace(0.0, span / 2, n)
         tr = _segments(train, radii, initial_state)
         model = fit_nominal(tr)
         bic = _bic(tr, [model.predict(s) for s in tr], n + 1)
         if best is None or bic < best[0]:
+            best = None  # the previous grid's play outputs go before the next is built
             best = (bic, radii, tr, model)
+        del tr
     _, radii, tr, model = best
     return radii, tr, _segments(validate, radii, initial_state), model
 
@@ -335,7 +337,13 @@ def _compressed(tr, va, nominal: Model):
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
         if rss <= 1.01 * rss_full:
             m.params = dict(nominal.params)
-            return ctr, [_projected(s, V) for s in va], m, V
+            for s in tr:
+                _drop_plays(s)
+            cva = []
+            for s in va:  # one record's full play outputs at a time
+                cva.append(_projected(s, V))
+                _drop_plays(s)
+            return ctr, cva, m, V
     return tr, va, nominal, None
 
 
@@ -347,6 +355,12 @@ def _play_gram(s: Segment) -> np.ndarray:
         X = P[:, c] if s.mask is None else P[:, c][:, s.mask[c]]
         G += X @ X.T
     return G
+
+
+def _drop_plays(s: Segment) -> None:
+    """Free the play outputs of a segment replaced by its projection (its ``Z`` is None)."""
+    s.__dict__.pop("_rows", None)
+    s.Z = None
 
 
 def _projected(s: Segment, V: np.ndarray) -> Segment:
@@ -380,13 +394,13 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                     "initial_state": initial_state}
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
     full_nominal = nominal
-    full_segs = tr + va
     tr, va, nominal, proj = _compressed(tr, va, nominal)
     segs = tr + va
-    # the rate columns from the full play outputs, weighted as the model will hold them
+    # the rate columns from the full play outputs (computed chunk by chunk from the input
+    # when needed), weighted as the model will hold them
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
-    for s, f in zip(segs, full_segs, strict=True):
-        s.rate_basis = RateBasis(f.Z, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
+    for s in segs:
+        s.rate_basis = RateBasis(None, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
         s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt)  # dynamics before the plays
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]

@@ -33,6 +33,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
+from ..operators.pi import PIOperator
 from .chunked import chunks
 
 RATE_TAUS = (0.0, 1e-3, 3e-3, 10e-3, 30e-3)  # s: low-pass of the input rate, half decades
@@ -164,8 +165,10 @@ class RateBasis:
 
     Parameters
     ----------
-    Z : numpy.ndarray
-        Play outputs ``z_i[k]``, shape (N, n).
+    Z : numpy.ndarray or None
+        Play outputs ``z_i[k]``, shape (N, n); None: computed from ``v`` chunk by chunk
+        whenever the columns need them (plays at rest at 0 before ``v[0]``), so the basis
+        holds no N x n array.
     radii : array_like
         Play radii ``r_i`` [input units], ascending.
     v : numpy.ndarray
@@ -261,7 +264,9 @@ class RateBasis:
                     member = np.zeros((self.radii.size, len(self.bands)))
                     for b, g in enumerate(self.bands):
                         member[g, b] = self.weights[g]
-                    self._weighted = self.Z @ member
+                    self._weighted = np.empty((self.v.size, member.shape[1]))
+                    for c, Zc in self._play_chunks():
+                        self._weighted[c] = Zc @ member
                 cols = rho[:, None] * self._weighted
             else:
                 cols = self._radius_columns(rho)
@@ -284,15 +289,28 @@ class RateBasis:
         self._cache.clear()
         self._weighted = None
 
+    def _play_chunks(self):
+        """``(slice, Z[slice])`` over the record, the plays computed chunk by chunk (their
+        states carried over) when the basis was built without ``Z``."""
+        op = None if self.Z is not None else PIOperator(np.ones(self.radii.size), self.radii)
+        state = None
+        for c in chunks(self.v.size):
+            if op is None:
+                yield c, self.Z[c]
+            else:
+                Zc = op.play_outputs(self.v[c], state=state)
+                state = Zc[-1]
+                yield c, Zc
+
     def _radius_columns(self, rho: np.ndarray) -> np.ndarray:
         """Band sums of ``rho_f[last contact of play i] * (-s_i r_i)``, chunk by chunk (the last
         contact and its sign carried from chunk to chunk; nothing of size N x n is kept)."""
-        r, Z, v = self.radii, self.Z, self.v
-        out = np.empty((Z.shape[0], len(self.bands)))
+        r, v = self.radii, self.v
+        out = np.empty((v.size, len(self.bands)))
         last_prev = np.full(r.size, -1, dtype=np.int64)
         signed_prev = np.zeros(r.size)
-        for c in chunks(Z.shape[0]):
-            gap = v[c, None] - Z[c]  # +-r_i while play i is in contact
+        for c, Zc in self._play_chunks():
+            gap = v[c, None] - Zc  # +-r_i while play i is in contact
             contact = np.abs(gap) >= r * (1 - 1e-9)
             contact &= r > 0
             k = np.arange(gap.shape[0], dtype=np.int64)[:, None]
