@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -233,7 +234,8 @@ def _check(records: list[Record], role: str) -> None:
 
 
 def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 3,
-             initial_state: str = "rest") -> DiagnosisReport:
+             initial_state: str = "rest",
+             progress: Callable[[str], None] | None = None) -> DiagnosisReport:
     """Diagnose the gap between a PI model fitted on ``train`` and the ``validate`` records.
 
     Parameters
@@ -248,6 +250,9 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         fitted and scored. ``"unknown"``: the stage's memory at the start of a record is
         unknown; the start-up region (until the input first spans 90 % of the record's range)
         is left out of fitting and scoring.
+    progress : callable or None
+        Called with a short message (``"candidate creep (1/6)"``) as each stage of the
+        diagnosis starts (for a progress line on long records); None: silent.
 
     Returns
     -------
@@ -287,7 +292,8 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         warnings.warn(f"validate: {shared} also in train; nothing is held out, so the validate "
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
     with threadpool_limits(1, user_api="blas"):
-        return _diagnose(train, validate, max_effects, initial_state)
+        return _diagnose(train, validate, max_effects, initial_state,
+                         progress or (lambda message: None))
 
 
 def _segments(records: list[Record], radii, initial_state: str) -> list[Segment]:
@@ -373,7 +379,7 @@ def _projected(s: Segment, V: np.ndarray) -> Segment:
 
 
 def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
-              initial_state: str) -> DiagnosisReport:
+              initial_state: str, progress: Callable[[str], None]) -> DiagnosisReport:
     _check(train, "train")
     _check(validate, "validate")
     dts = [(r.source, r.dt) for r in train + validate]
@@ -382,6 +388,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             raise ValueError(f"{src}: sample time {dt:g} s differs from {dts[0][0]} "
                              f"({dts[0][1]:g} s); resample the records to one sample time")
     dt = dts[0][1]
+    progress("nominal model (radius grids)")
     radii, tr, va, nominal = _nominal(train, validate, initial_state)
     n_plays = radii.size
     out_tr = [nominal.predict(s) for s in tr]
@@ -402,6 +409,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     for s in segs:
         s.rate_basis = RateBasis(None, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
         s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt)  # dynamics before the plays
+    progress("noise floor")
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
 
@@ -429,7 +437,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return best[1], best[2]
 
     candidates = []
-    for name in EFFECTS:
+    for i, name in enumerate(EFFECTS):
+        progress(f"candidate {name} ({i + 1}/{len(EFFECTS)})")
         m, o = fit(name)
         params = dict(m.params)
         if "delay_samples" in params:
@@ -443,7 +452,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     fixed: dict = {}
     current: Model = nominal
     cur_out = out_va
-    for _ in range(max_effects):
+    for round_ in range(max_effects):
+        progress(f"combinations, round {round_ + 1}")
         rms_now = _errors(va, cur_out)["rms"]
         if rms_now <= NOISE_STOP * noise:
             break
@@ -478,6 +488,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
         current, cur_out = m, o
+    progress("revising the choice")
     chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
                                        (nominal, out_va), noise)
     chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
