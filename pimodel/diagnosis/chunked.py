@@ -181,20 +181,9 @@ class ChunkedQR:
         self.samples = 0
 
     def add(self, X: np.ndarray, y: np.ndarray) -> None:
-        """Add the samples of one chunk (same arguments as :meth:`NormalEquations.add`).
-
-        Parameters
-        ----------
-        X : numpy.ndarray
-            Regressors as rows, shape (p, m).
-        y : numpy.ndarray
-            Outputs, shape (m,).
-
-        Raises
-        ------
-        ValueError
-            Shapes that do not fit ``p`` or each other.
-        """
+        """Add the samples of one chunk: regressors ``X`` as rows, shape (p, m), and outputs
+        ``y``, shape (m,) (a ValueError for shapes that do not fit), as
+        :meth:`NormalEquations.add` takes them; the factor is updated in place."""
         X, y = _check_chunk(X, y, self.p)
         self.R = np.linalg.qr(np.vstack((self.R, np.column_stack((X.T, y)))), mode="r")
         self.samples += y.size
