@@ -310,16 +310,16 @@ def _nominal(train, validate, initial_state):
     """The radius grid with the lowest train BIC and its fitted nominal model."""
     span = float(np.ptp(np.concatenate([r.v for r in train])))
     best = None
-    for n in GRID_SIZES:  # train only; the validate segments for the grid kept
+    for n in GRID_SIZES:  # train only, one grid's play outputs at a time
         radii = np.linspace(0.0, span / 2, n)
         tr = _segments(train, radii, initial_state)
         model = fit_nominal(tr)
         bic = _bic(tr, [model.predict(s) for s in tr], n + 1)
         if best is None or bic < best[0]:
-            best = None  # the previous grid's play outputs go before the next is built
-            best = (bic, radii, tr, model)
+            best = (bic, radii, model)
         del tr
-    _, radii, tr, model = best
+    _, radii, model = best
+    tr = _segments(train, radii, initial_state)  # built again: cheaper than keeping two grids
     return radii, tr, _segments(validate, radii, initial_state), model
 
 
