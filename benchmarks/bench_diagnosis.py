@@ -1,21 +1,26 @@
-"""Benchmark: the sim-to-real gap diagnosis on two 100k-sample records.
+"""Benchmark: the sim-to-real gap diagnosis of a train and a validate record of N samples each.
 
-Run: ``.venv/bin/python benchmarks/bench_diagnosis.py [--samples N]``. Goal (issues 6, 16): a
-diagnosis of a 100k-sample train and a 100k-sample validate record in under 30 s. Baseline in
-the same run: one plain least-squares fit of a PI model (``np.linalg.lstsq`` on the 20-play
-design matrix of the train record), so the ratio says how many such fits a whole diagnosis
-(grid refinement, noise floor, breakdown, six candidates, combinations) costs.
+Run: ``.venv/bin/python benchmarks/bench_diagnosis.py [--samples 100000 300000 1000000]``.
+Goals (issue 31): two 1M-sample records diagnosed in under 30 s and under 2 GB peak memory
+on two cores, time and memory growing at most linearly from 100k to 1M samples. Each size
+runs in a fresh process (its peak resident memory is the process' own, ``ru_maxrss``), with
+wall time and process CPU time (less sensitive to the load of a shared machine). Baseline in
+the same run, also in its own process: one plain least-squares fit of a PI model
+(``np.linalg.lstsq`` on the 20-play design matrix of the train record), so the ratio says how
+many such fits a whole diagnosis costs.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import resource
+import subprocess
+import sys
 import time
 
 import numpy as np
 
-from pimodel.diagnosis import diagnose
-from pimodel.operators.pi import PIOperator
 from pimodel.records import Record
 from pimodel.stages.pi_stage import excitation, random_truth
 
@@ -32,34 +37,76 @@ def long_record(kind: str, n: int, truth, seed: int) -> Record:
     return truth.record(t, v, seed, kind)
 
 
+def records(n: int) -> tuple[Record, Record]:
+    """The train and validate records of ``n`` samples (truth: creep + dynamics)."""
+    truth = random_truth(["creep", "dynamics"], 0)
+    return long_record("train", n, truth, 1), long_record("validate", n, truth, 100)
+
+
+def run_one(n: int, what: str) -> dict:
+    """Time and peak memory of the diagnosis (``what="diagnosis"``) or of the plain fit."""
+    tr, va = records(n)
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    t0, c0 = time.perf_counter(), time.process_time()
+    out: dict = {}
+    if what == "diagnosis":
+        from pimodel.diagnosis import diagnose
+
+        rep = diagnose([tr], [va])
+        out = {"effects": rep.verdict["effects"], "shrink": rep.verdict["shrink"],
+               "plays": len(rep.nominal["model"]["radii"])}
+    else:
+        from pimodel.operators.pi import PIOperator
+
+        radii = np.linspace(0, np.ptp(tr.v) / 2, 20)
+        A = np.column_stack((PIOperator(np.ones(20), radii).play_outputs(tr.v),
+                             np.ones(tr.v.size)))
+        np.linalg.lstsq(A, tr.y, rcond=None)
+    out.update(wall=time.perf_counter() - t0, cpu=time.process_time() - c0,
+               peak_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+               records_mb=rss0 / 1024)
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--samples", type=int, default=100_000)
+    ap.add_argument("--samples", type=int, nargs="+", default=[100_000, 300_000, 1_000_000])
+    ap.add_argument("--one", nargs=2, metavar=("N", "WHAT"), help=argparse.SUPPRESS)
     args = ap.parse_args()
-    truth = random_truth(["creep", "dynamics"], 0)
-    tr = long_record("train", args.samples, truth, 1)
-    va = long_record("validate", args.samples, truth, 100)
-    t0, c0 = time.perf_counter(), time.process_time()
-    rep = diagnose([tr], [va])
-    t_diag, c_diag = time.perf_counter() - t0, time.process_time() - c0
-
-    radii = np.linspace(0, np.ptp(tr.v) / 2, 20)
-    t0 = time.perf_counter()
-    A = np.column_stack((PIOperator(np.ones(20), radii).play_outputs(tr.v), np.ones(tr.v.size)))
-    np.linalg.lstsq(A, tr.y, rcond=None)
-    t_base = time.perf_counter() - t0
-    print(f"diagnosis of a {args.samples:,}-sample train and a {args.samples:,}-sample validate "
-          "record (truth: creep + dynamics)")
-    print(f"{'step':<44}{'time [s]':>10}")
-    print(f"{'baseline: one nominal PI least-squares fit':<44}{t_base:>10.3f}")
-    print(f"{'whole diagnosis':<44}{t_diag:>10.3f}")
-    print(f"{'whole diagnosis, process CPU time':<44}{c_diag:>10.3f}  (less sensitive to the "
-          "load of a shared machine)")
-    print(f"nominal grid {len(rep.nominal['model']['radii'])} plays; noise floor "
-          f"{rep.verdict['noise_floor']:.4f} um ({rep.verdict['noise_floor_method']})")
-    print(f"ratio {t_diag / t_base:.0f} plain fits; verdict {rep.verdict['effects']}, "
-          f"shrink {rep.verdict['shrink']:.2f}; goal < 30 s -> "
-          f"{'met' if t_diag < 30 else 'NOT met'}")
+    if args.one:
+        print(json.dumps(run_one(int(args.one[0]), args.one[1])))
+        return
+    print("diagnosis of a train and a validate record of N samples each (truth: creep + "
+          "dynamics); each row a fresh process")
+    print(f"{'N':>10} {'step':<34}{'wall [s]':>10}{'CPU [s]':>10}{'peak [MB]':>11}")
+    rows = {}
+    for n in args.samples:
+        for what in ("baseline", "diagnosis"):
+            p = subprocess.run([sys.executable, __file__, "--one", str(n), what],
+                               capture_output=True, text=True)
+            if p.returncode != 0:
+                print(f"{n:>10,} {what:<34} failed (exit {p.returncode}): "
+                      f"{p.stderr.strip().splitlines()[-1:]}")
+                continue
+            r = rows[(n, what)] = json.loads(p.stdout.strip().splitlines()[-1])
+            label = "plain PI least squares (baseline)" if what == "baseline" else \
+                "whole diagnosis"
+            print(f"{n:>10,} {label:<34}{r['wall']:>10.2f}{r['cpu']:>10.2f}"
+                  f"{r['peak_mb']:>11.0f}")
+            if what == "diagnosis":
+                print(f"{'':>10} verdict {r['effects']}, shrink {r['shrink']:.2f}, "
+                      f"{r['plays']} plays; {r['cpu'] / rows[(n, 'baseline')]['cpu']:.0f} "
+                      "baseline fits of CPU")
+    diag = sorted((n, r) for (n, w), r in rows.items() if w == "diagnosis")
+    if len(diag) >= 2:
+        (n0, a), (n1, b) = diag[0], diag[-1]
+        print(f"growth {n0:,} -> {n1:,} samples ({n1 / n0:.0f}x): CPU x{b['cpu'] / a['cpu']:.1f}, "
+              f"peak memory x{b['peak_mb'] / a['peak_mb']:.1f}")
+    if (1_000_000, "diagnosis") in rows:
+        r = rows[(1_000_000, "diagnosis")]
+        print(f"goal 2 x 1M samples < 30 s and < 2 GB: wall {r['wall']:.0f} s, CPU "
+              f"{r['cpu']:.0f} s, peak {r['peak_mb'] / 1024:.2f} GB -> "
+              f"{'met' if r['wall'] < 30 and r['peak_mb'] < 2048 else 'NOT met'}")
 
 
 if __name__ == "__main__":

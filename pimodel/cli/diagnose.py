@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 from .common import add_columns_option, load_inputs, refuse_overwrite
@@ -11,6 +12,7 @@ from .common import add_columns_option, load_inputs, refuse_overwrite
 __all__ = [
     "HELP",
     "export_models",
+    "progress_line",
     "register",
     "run",
 ]
@@ -55,8 +57,30 @@ def register(sub) -> None:
     p.add_argument("--report", default=None, metavar="DIR",
                    help="write report.md (the summary in words, the figures, the numbers, "
                    "each effect alone, where the gap lies, hints) and its figures here")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress line on stderr (it is shown only when stderr is a "
+                   "terminal)")
     add_columns_option(p)
     p.set_defaults(func=run)
+
+
+def progress_line(quiet: bool = False, stream=None):
+    """A ``progress(message)`` callback that rewrites one line on ``stream`` (default stderr)
+    with the message and the seconds elapsed; None when ``quiet`` or the stream is not a
+    terminal (logs and pipes stay clean)."""
+    import sys
+    import time
+
+    stream = stream or sys.stderr
+    if quiet or not stream.isatty():
+        return None
+    t0 = time.perf_counter()
+
+    def show(message: str) -> None:
+        stream.write(f"\r\x1b[Kdiagnose: {message} [{time.perf_counter() - t0:.0f} s]")
+        stream.flush()
+
+    return show
 
 
 def run(args: argparse.Namespace) -> int:
@@ -74,7 +98,11 @@ def run(args: argparse.Namespace) -> int:
     inputs = args.train + args.validate
     train = load_inputs(args, args.train, inputs)
     validate = load_inputs(args, args.validate, inputs)
-    rep = diagnose(train, validate, initial_state=args.initial_state)
+    show = progress_line(args.quiet)
+    rep = diagnose(train, validate, initial_state=args.initial_state, progress=show)
+    if show is not None:
+        show("done")
+        sys.stderr.write("\n")
     rep.save_json(args.json)
     if args.plots:
         from ..diagnosis.plots import plot_diagnosis

@@ -14,6 +14,7 @@ Modules
 
     diagnose            diagnose() and the DiagnosisReport
     effects             records as segments, the nominal model, the candidate effects' fits
+    chunked             least squares over chunks of a record (normal equations, running QR)
     filters             the discrete filters effects are built of: lag, mode, delay shift
     rate                the rate candidate's columns (radii or weights growing with the rate)
     drift               the drift candidate: clocks, levels per record, its term

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,10 +47,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
+from .chunked import chunks
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
-from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment
+from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment, segment_of_rows
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
@@ -244,7 +246,8 @@ def _check(records: list[Record], role: str) -> None:
 
 
 def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 3,
-             initial_state: str = "rest") -> DiagnosisReport:
+             initial_state: str = "rest",
+             progress: Callable[[str], None] | None = None) -> DiagnosisReport:
     """Diagnose the gap between a PI model fitted on ``train`` and the ``validate`` records.
 
     Parameters
@@ -259,6 +262,9 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         fitted and scored. ``"unknown"``: the stage's memory at the start of a record is
         unknown; the start-up region (until the input first spans 90 % of the record's range)
         is left out of fitting and scoring.
+    progress : callable or None
+        Called with a short message (``"candidate creep (1/6)"``) as each stage of the
+        diagnosis starts (for a progress line on long records); None: silent.
 
     Returns
     -------
@@ -300,7 +306,8 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         warnings.warn(f"validate: {shared} also in train; nothing is held out, so the validate "
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
     with threadpool_limits(1, user_api="blas"):
-        return _diagnose(train, validate, max_effects, initial_state)
+        return _diagnose(train, validate, max_effects, initial_state,
+                         progress or (lambda message: None))
 
 
 def _segments(records: list[Record], radii, initial_state: str,
@@ -358,10 +365,12 @@ def _nominal(train, validate, initial_state):
             model = fit_nominal(tr)
             bic = _bic(tr, [model.predict(s) for s in tr], radii.size + 1)
             if best is None or bic < best[0]:
-                best = (bic, radii, tr, model, at_rest)
+                best = (bic, radii, None, model, at_rest)
+            del tr  # one grid's play outputs at a time (rebuilt for the pick below)
         picks.append(best)
     if picks[0] is None:
-        _, radii, tr, model, at_rest = picks[2]
+        _, radii, _, model, at_rest = picks[2]
+        tr = _segments(train, radii, initial_state, False)
         return radii, tr, _segments(validate, radii, initial_state, False), model, False, False
     if picks[1] is not None:  # the extension: kept only when validate agrees
         vbic = []
@@ -372,8 +381,9 @@ def _nominal(train, validate, initial_state):
             picks[1] = None
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
-    _, radii, tr, model, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
+    _, radii, _, model, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
     ext = ext and at_rest
+    tr = _segments(train, radii, initial_state, at_rest)  # again: cheaper than keeping all
     return radii, tr, _segments(validate, radii, initial_state, at_rest), model, ext, at_rest
 
 
@@ -398,7 +408,7 @@ def _compressed(tr, va, nominal: Model):
     Returns the new segments, the nominal refitted on them (with the full model's
     ``params``) and the projection ``V`` (play columns = ``Z @ V``; None: not compressed)."""
     n = tr[0].Z.shape[1]
-    G = sum(s.Z[s.used].T @ s.Z[s.used] for s in tr)
+    G = sum(_play_gram(s) for s in tr)
     _, vecs = np.linalg.eigh(G)
     w = nominal.coef[:n]
     rss_full = sum(float(np.sum((nominal.predict(s) - s.y)[s.used] ** 2)) for s in tr)
@@ -406,18 +416,48 @@ def _compressed(tr, va, nominal: Model):
         if q >= n:
             return tr, va, nominal, None
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :q]))
-        ctr = [Segment(s.t, s.v, s.y, s.Z @ V, s.mask) for s in tr]
+        ctr = [_projected(s, V) for s in tr]
         m = fit_nominal(ctr)
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
         if rss <= 1.01 * rss_full:
             m.params = dict(nominal.params)
-            return (ctr, [Segment(s.t, s.v, s.y, s.Z @ V, s.mask) for s in va],
-                    m, V)
+            for s in tr:
+                _drop_plays(s)
+            cva = []
+            for s in va:  # one record's full play outputs at a time
+                cva.append(_projected(s, V))
+                _drop_plays(s)
+            return ctr, cva, m, V
     return tr, va, nominal, None
 
 
+def _play_gram(s: Segment) -> np.ndarray:
+    """``Z^T Z`` over the fitted samples of ``s``, chunk by chunk."""
+    P = s.play_rows()
+    G = np.zeros((P.shape[0], P.shape[0]))
+    for c in chunks(s.y.size):
+        X = P[:, c] if s.mask is None else P[:, c][:, s.mask[c]]
+        G += X @ X.T
+    return G
+
+
+def _drop_plays(s: Segment) -> None:
+    """Free the play outputs of a segment replaced by its projection (its ``Z`` is None)."""
+    s.__dict__.pop("_rows", None)
+    s.Z = None
+
+
+def _projected(s: Segment, V: np.ndarray) -> Segment:
+    """The segment with play columns ``Z V``, built chunk by chunk as rows."""
+    rows = np.empty((V.shape[1] + 1, s.y.size))
+    P = s.play_rows()
+    for c in chunks(s.y.size):
+        np.matmul(V.T, P[:, c], out=rows[:-1, c])
+    return segment_of_rows(s.t, s.v, s.y, rows, s.mask)
+
+
 def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
-              initial_state: str) -> DiagnosisReport:
+              initial_state: str, progress: Callable[[str], None]) -> DiagnosisReport:
     _check(train, "train")
     _check(validate, "validate")
     dts = [(r.source, r.dt) for r in train + validate]
@@ -426,6 +466,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             raise ValueError(f"{src}: sample time {dt:g} s differs from {dts[0][0]} "
                              f"({dts[0][1]:g} s); resample the records to one sample time")
     dt = dts[0][1]
+    progress("nominal model (radius grids)")
     radii, tr, va, nominal, extended, at_rest = _nominal(train, validate, initial_state)
     n_plays = radii.size
     out_tr = [nominal.predict(s) for s in tr]
@@ -447,15 +488,17 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       "nominal", UserWarning, stacklevel=3)
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
     full_nominal = nominal
-    full_segs = tr + va
     tr, va, nominal, proj = _compressed(tr, va, nominal)
     segs = tr + va
-    # the rate columns from the full play outputs, weighted as the model will hold them
+    # the rate columns from the full play outputs (computed chunk by chunk from the input
+    # when needed), weighted as the model will hold them
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
-    for s, f in zip(segs, full_segs, strict=True):
-        s.rate_basis = RateBasis(f.Z, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref)
+    for s in segs:
+        s.rate_basis = RateBasis(None, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref,
+                                 at_rest=at_rest)
         s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt,  # dynamics before the plays
                                      at_rest=at_rest)
+    progress("noise floor")
     noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
     noise = noise_info["value"]
 
@@ -475,6 +518,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 m = fit_effect(name, tr, combo, fx, nominal)
                 cache[key] = (m, [m.predict(s) for s in va])
                 m.params.update(level_report(m, va, tr))
+                _release(m, segs)
             m, o = cache[key]
             score = _bic(va, o, m.k)
             if best is None or score < best[0]:
@@ -482,7 +526,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return best[1], best[2]
 
     candidates = []
-    for name in EFFECTS:
+    for i, name in enumerate(EFFECTS):
+        progress(f"candidate {name} ({i + 1}/{len(EFFECTS)})")
         m, o = fit(name)
         params = dict(m.params)
         if "delay_samples" in params:
@@ -496,7 +541,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     fixed: dict = {}
     current: Model = nominal
     cur_out = out_va
-    for _ in range(max_effects):
+    for round_ in range(max_effects):
+        progress(f"combinations, round {round_ + 1}")
         rms_now = _errors(va, cur_out)["rms"]
         if rms_now <= NOISE_STOP * noise:
             break
@@ -531,6 +577,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
         current, cur_out = m, o
+    progress("revising the choice")
     chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
                                        (nominal, out_va), noise)
     chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
@@ -580,6 +627,17 @@ def _creep_law(params: dict) -> dict | None:
         return creep_law(params["creep_lag_gains"], params["creep_time_constants_s"])
     except ValueError:
         return None
+
+
+def _release(model: Model, segs: list[Segment]) -> None:
+    """Drop what a fit memoised over the records (the model's columns, the rate and filter
+    bases' columns): the diagnosis keeps every fitted candidate and its validate outputs, so
+    its memory stays that of the records' play columns, not one copy per candidate."""
+    model.release()
+    for s in segs:
+        for basis in (s.rate_basis, s.wiener_basis):
+            if basis is not None:
+                basis.release()
 
 
 def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):

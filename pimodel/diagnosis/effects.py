@@ -15,6 +15,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..operators.pi import PIOperator
+from .chunked import NormalEquations, chunks
 from .creep import creep_time_constants
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 from .filters import lag, mode, mode_coefficients, mode_rows, shift
@@ -34,6 +35,7 @@ __all__ = [
     "mode_rows",
     "Model",
     "Segment",
+    "segment_of_rows",
     "shift",
 ]
 
@@ -170,10 +172,49 @@ def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
     >>> seg.Z.tolist()
     [[0.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5]]
     """
+    radii = np.asarray(radii, float)
     v = np.asarray(v, float)
     z0 = float(v[0]) if at_rest else 0.0
-    Z = PIOperator(np.ones(len(radii)), radii, initial_state=z0).play_outputs(v)
-    return Segment(t, v, y, Z, mask)
+    op = PIOperator(np.ones(radii.size), radii, initial_state=z0)
+    rows = np.empty((radii.size + 1, np.size(v)))
+    state = None
+    for c in chunks(rows.shape[1]):  # the plays chunk by chunk, their states carried over
+        Zc = op.play_outputs(v[c], state=state)
+        rows[:-1, c], state = Zc.T, Zc[-1]
+    return segment_of_rows(t, v, y, rows, mask)
+
+
+def segment_of_rows(t, v, y, rows: np.ndarray, mask=None) -> Segment:
+    """Segment whose play columns are the leading rows of ``rows``, shape (n + 1, N), C-contiguous
+    (the last row is set to ones: the offset): ``Z`` is a view of them, so the segment holds the
+    play outputs once, in the layout the fits use.
+
+    Parameters
+    ----------
+    t, v, y : numpy.ndarray
+        Time [s], input and output, shape (N,).
+    rows : numpy.ndarray
+        Play outputs as rows with one spare last row, shape (n + 1, N); taken over, not copied.
+    mask : numpy.ndarray or None
+        Samples fitted and scored (see :class:`Segment`); None: all.
+
+    Returns
+    -------
+    Segment
+        With ``Z = rows[:n].T`` and ``play_rows(offset=True) is rows``.
+
+    Examples
+    --------
+    >>> rows = np.array([[0.0, 1.0, 0.5], [0.0, 0.0, 0.0]])
+    >>> seg = segment_of_rows(np.arange(3) * 1e-3, rows[0].copy(), np.zeros(3), rows)
+    >>> seg.Z.tolist(), seg.play_rows(offset=True)[1].tolist()
+    ([[0.0], [1.0], [0.5]], [1.0, 1.0, 1.0])
+    """
+    rows = np.ascontiguousarray(rows, float)
+    rows[-1] = 1.0
+    seg = Segment(t, v, y, rows[:-1].T, mask)
+    seg.__dict__["_rows"] = rows
+    return seg
 
 
 @dataclass
@@ -217,6 +258,22 @@ class Model:
     adjust: object = field(repr=False, default=None)
     reference: object = field(repr=False, default=None)
 
+    def release(self) -> None:
+        """Drop the columns the model's features memoised per record (filtered plays, lags,
+        rate columns); a later :meth:`predict` rebuilds them. A diagnosis keeps every fitted
+        candidate: without this, each kept a few copies of its records' columns.
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(2) * 1e-3, np.array([0.0, 1.0]), np.zeros(2), [0.0])
+        >>> m = Model("nominal", 0, base_features, np.array([3.0, 0.0]))
+        >>> m.release(); m.predict(seg).tolist()
+        [0.0, 3.0]
+        """
+        release = getattr(self.features, "release", None)
+        if release is not None:
+            release()
+
     def predict(self, seg: Segment) -> np.ndarray:
         """Model output of a record.
 
@@ -242,22 +299,34 @@ class Model:
 
 
 def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
-    """Least squares over all train records through the normal equations (columns scaled to
-    unit norm; the Gram matrix is small), so a grid search costs one pass over the data per
-    point; the residual sum of squares is computed from the residuals themselves. The
-    regressors are taken as blocks of rows when the builder has them (:func:`_row_parts`): no
-    copy of the play columns at each point of a search."""
-    blocks = [tuple(P[:, s.used] for P in _row_parts(features, s)) for s in train]
-    ys = [s.y[s.used] for s in train]
-    G = sum(_gram(P) for P in blocks)
-    g = sum(np.concatenate([X @ y for X in P]) for P, y in zip(blocks, ys, strict=True))
-    d = np.sqrt(np.diag(G))
-    d[d == 0] = 1.0
-    c, *_ = np.linalg.lstsq(G / d[:, None] / d[None, :], g / d, rcond=1e-13)
-    coef = c / d
-    rss = float(sum(np.sum((_combine(P, coef) - y) ** 2) for P, y in zip(blocks, ys,
-                                                                          strict=True)))
+    """Least squares over all train records through normal equations accumulated chunk by
+    chunk (:class:`~pimodel.diagnosis.chunked.NormalEquations`: columns scaled to unit norm, the
+    Gram matrix is small), so a grid search costs one pass over the data per point and no
+    temporary larger than a chunk; the residual sum of squares is computed from the residuals
+    themselves, chunk by chunk. The regressors are taken as blocks of rows when the builder has
+    them (:func:`_row_parts`): no copy of the play columns at each point of a search."""
+    blocks = [_row_parts(features, s) for s in train]
+    ne = NormalEquations(sum(X.shape[0] for X in blocks[0]))
+    for P, s in zip(blocks, train, strict=True):
+        for c in chunks(s.y.size):
+            Pc, y = _used_chunk(P, s, c)
+            ne.add_gram(_gram(Pc), np.concatenate([X @ y for X in Pc]), y.size)
+    coef = ne.solve()
+    rss = 0.0
+    for P, s in zip(blocks, train, strict=True):
+        for c in chunks(s.y.size):
+            Pc, y = _used_chunk(P, s, c)
+            rss += float(np.sum((_combine(Pc, coef) - y) ** 2))
     return Model(name, k, features, coef, params or {}), rss
+
+
+def _used_chunk(P: tuple, s: Segment, c: slice) -> tuple[tuple, np.ndarray]:
+    """The blocks of rows ``P`` and the output of segment ``s`` on the chunk ``c``, its fitted
+    samples only."""
+    if s.mask is None:
+        return tuple(X[:, c] for X in P), s.y[c]
+    m = s.mask[c]
+    return tuple(X[:, c][:, m] for X in P), s.y[c][m]
 
 
 def _stack_rows(parts) -> np.ndarray:
@@ -660,10 +729,10 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
         if "rate" in effects:
-            key = ("rate", id(s), p["rate_tau"], p["rate_family"])
-            if key not in static:
-                static[key] = (s, np.ascontiguousarray(
-                    s.rate_basis.columns(p["rate_tau"], p["rate_family"]).T))
+            key, which = ("rate", id(s)), (p["rate_tau"], p["rate_family"])
+            if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
+                static[key] = (which, np.ascontiguousarray(
+                    s.rate_basis.columns(p["rate_tau"], p["rate_family"]).T), s)
             parts.append(static[key][1])
         if "drift" in effects:  # the trend column last
             parts.append(drift_columns(s.t, p, static["train"].get(id(s)),
@@ -673,7 +742,12 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     def feats(s: Segment) -> np.ndarray:
         return _stack_rows(rows(s)).T
 
+    def release() -> None:  # drop the memoised columns (rebuilt on the next use)
+        for key in [key for key in static if key != "train"]:
+            del static[key]
+
     feats.parts = rows
+    feats.release = release
     return feats
 
 

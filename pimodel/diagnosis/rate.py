@@ -33,6 +33,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
+from ..operators.pi import PIOperator
+from .chunked import chunks
+
 RATE_TAUS = (0.0, 1e-3, 3e-3, 10e-3, 30e-3)  # s: low-pass of the input rate, half decades
 RATE_TAU_START = 0.0  # the filter held while other grids (mode, delay, ...) are searched
 RATE_TAU_REFINE = (10**0.25, 10**0.125)  # then steps around the optimum: 1/4, 1/8 decade
@@ -162,8 +165,10 @@ class RateBasis:
 
     Parameters
     ----------
-    Z : numpy.ndarray
-        Play outputs ``z_i[k]``, shape (N, n).
+    Z : numpy.ndarray or None
+        Play outputs ``z_i[k]``, shape (N, n); None: computed from ``v`` chunk by chunk
+        whenever the columns need them (plays at rest before ``v[0]``: see ``at_rest``), so
+        the basis holds no N x n array.
     radii : array_like
         Play radii ``r_i`` [input units], ascending.
     v : numpy.ndarray
@@ -178,6 +183,10 @@ class RateBasis:
         Bands of plays (one column each).
     input_range : float, optional
         The range of the step rule (default ``ptp(v)``).
+    at_rest : bool
+        With ``Z`` None: the plays at rest at ``v[0]`` before the first sample (the
+        nominal's start, :func:`~pimodel.diagnosis.effects.make_segment`); False (default):
+        at 0.
 
     Examples
     --------
@@ -191,13 +200,13 @@ class RateBasis:
     """
 
     def __init__(self, Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
-                 weights, bands: int = RATE_BANDS, *, input_range: float | None = None):
-        self.Z, self.radii = Z, np.asarray(radii, float)
+                 weights, bands: int = RATE_BANDS, *, input_range: float | None = None,
+                 at_rest: bool = False):
+        self.Z, self.radii, self.at_rest = Z, np.asarray(radii, float), at_rest
         self.v, self.dt, self.rate_scale, self.input_range = v, dt, rate_scale, input_range
         self.bands = play_bands(self.radii.size, bands)
         self.weights = np.asarray(weights, float)
         self._starts = [int(g[0]) for g in self.bands]
-        self._contact = None  # (last contact sample, -s_i r_i there), built on first use
         self._weighted = None  # band sums of w0_i z_i, built on first use
         self._cache: dict = {}
 
@@ -260,29 +269,68 @@ class RateBasis:
                     member = np.zeros((self.radii.size, len(self.bands)))
                     for b, g in enumerate(self.bands):
                         member[g, b] = self.weights[g]
-                    self._weighted = self.Z @ member
-                self._cache[key] = rho[:, None] * self._weighted
+                    self._weighted = np.empty((self.v.size, member.shape[1]))
+                    for c, Zc in self._play_chunks():
+                        self._weighted[c] = Zc @ member
+                cols = rho[:, None] * self._weighted
             else:
-                last, signed = self._contacts()
-                per_play = np.take(rho, last)
-                per_play *= signed
-                self._cache[key] = np.add.reduceat(per_play, self._starts, axis=1)
+                cols = self._radius_columns(rho)
+            self._cache.clear()  # the latest only: a search asks for each filter once
+            self._cache[key] = cols
         return self._cache[key]
 
-    def _contacts(self):
-        if self._contact is None:
-            r, Z = self.radii, self.Z
-            gap = self.v[:, None] - Z  # +-r_i while play i is in contact
+    def release(self) -> None:
+        """Drop the memoised columns (rebuilt on the next use), keeping only what the basis
+        was built from.
+
+        Examples
+        --------
+        >>> v = np.array([0.0, 0.01, 0.02, 0.02])
+        >>> basis = RateBasis(v[:, None], [0.0], v, 1.0, 0.01, [2.0], 1)
+        >>> a = basis.columns(1.0, "weight"); basis.release()
+        >>> bool(np.array_equal(a, basis.columns(1.0, "weight")))
+        True
+        """
+        self._cache.clear()
+        self._weighted = None
+
+    def _play_chunks(self):
+        """``(slice, Z[slice])`` over the record, the plays computed chunk by chunk (their
+        states carried over) when the basis was built without ``Z``."""
+        z0 = float(self.v[0]) if self.at_rest else 0.0
+        op = None if self.Z is not None else PIOperator(np.ones(self.radii.size), self.radii,
+                                                        initial_state=z0)
+        state = None
+        for c in chunks(self.v.size):
+            if op is None:
+                yield c, self.Z[c]
+            else:
+                Zc = op.play_outputs(self.v[c], state=state)
+                state = Zc[-1]
+                yield c, Zc
+
+    def _radius_columns(self, rho: np.ndarray) -> np.ndarray:
+        """Band sums of ``rho_f[last contact of play i] * (-s_i r_i)``, chunk by chunk (the last
+        contact and its sign carried from chunk to chunk; nothing of size N x n is kept)."""
+        r, v = self.radii, self.v
+        out = np.empty((v.size, len(self.bands)))
+        last_prev = np.full(r.size, -1, dtype=np.int64)
+        signed_prev = np.zeros(r.size)
+        for c, Zc in self._play_chunks():
+            gap = v[c, None] - Zc  # +-r_i while play i is in contact
             contact = np.abs(gap) >= r * (1 - 1e-9)
             contact &= r > 0
-            k = np.arange(Z.shape[0], dtype=np.int32)[:, None]
-            last = np.maximum.accumulate(np.where(contact, k, np.int32(-1)), axis=0)
-            at = np.maximum(last, 0)
-            signed = np.take_along_axis(gap, at, axis=0)  # -(-s_i r_i) at the last contact
-            signed *= -1.0
-            signed[last < 0] = 0.0
-            self._contact = (at, signed)
-        return self._contact
+            k = np.arange(gap.shape[0], dtype=np.int64)[:, None]
+            local = np.maximum.accumulate(np.where(contact, k, -1), axis=0)
+            inside = local >= 0
+            signed = np.where(inside, -np.take_along_axis(gap, np.maximum(local, 0), axis=0),
+                              signed_prev)  # -(-s_i r_i) at the last contact
+            last = np.where(inside, local + c.start, last_prev)
+            per_play = np.take(rho, np.maximum(last, 0))
+            per_play *= signed
+            out[c] = np.add.reduceat(per_play, self._starts, axis=1)
+            last_prev, signed_prev = last[-1], signed[-1]
+        return out
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,

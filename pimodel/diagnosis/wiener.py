@@ -218,6 +218,18 @@ class WienerBasis:
             self._cache[key] = np.ascontiguousarray(Z.T)  # kept as rows, the fits' layout
         return self._cache[key].T
 
+    def release(self) -> None:
+        """Drop the memoised play columns (rebuilt on the next use).
+
+        Examples
+        --------
+        >>> basis = WienerBasis(np.array([0.0, 1.0, 1.0]), [0.0, 0.5], None, 1e-3)
+        >>> a = basis.columns([("lowpass", 1e-3)]); basis.release()
+        >>> bool(np.array_equal(a, basis.columns([("lowpass", 1e-3)])))
+        True
+        """
+        self._cache.clear()
+
 
 def _admissible(element, fmax: float) -> bool:
     if element[0] == "lowpass":

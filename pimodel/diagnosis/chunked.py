@@ -1,0 +1,210 @@
+"""Least squares over a record taken in chunks of samples, so a fit holds the model (a ``p x p``
+matrix), not the record's ``N x p`` design matrix.
+
+Two accumulators, both fed the regressors as rows (``X`` of shape (p, m) for ``m`` samples, the
+layout the diagnosis builds them in) and the outputs of the same samples:
+
+- :class:`NormalEquations` sums ``X X^T`` and ``X y``; :meth:`~NormalEquations.solve` scales
+  the columns to unit norm first (the normal equations square the condition number; scaling
+  removes the part due to columns of different size) and solves by least squares with a
+  relative cut-off ``rcond``. One pass, ``p^2 m`` flops per chunk: the diagnosis' searches use it.
+- :class:`ChunkedQR` keeps a running triangular factor: each chunk is stacked under the ``R``
+  so far (with the output as a last column) and factored again by ``numpy.linalg.qr``, so
+  the condition number is never squared; the last diagonal element of the factor gives the
+  residual sum of squares. Use it where the normal equations lose digits (``cond(X) > 1e7``).
+
+The chunks are cut by :func:`chunks` (``CHUNK`` samples each).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+
+__all__ = ["CHUNK", "ChunkedQR", "NormalEquations", "chunks"]
+
+CHUNK = 1 << 14  # samples per chunk (16,384: an 80-column chunk of rows is 10 MB)
+
+
+def chunks(n: int, size: int = CHUNK) -> Iterator[slice]:
+    """Slices ``a:b`` that cut ``range(n)`` into consecutive chunks of ``size`` samples.
+
+    Parameters
+    ----------
+    n : int
+        Samples in all.
+    size : int
+        Samples per chunk (the last one may be shorter).
+
+    Returns
+    -------
+    iterator of slice
+        ``slice(0, size), slice(size, 2 size), ...`` up to ``n``.
+
+    Raises
+    ------
+    ValueError
+        ``size`` below 1 or ``n`` negative.
+
+    Examples
+    --------
+    >>> list(chunks(5, 2))
+    [slice(0, 2, None), slice(2, 4, None), slice(4, 5, None)]
+    """
+    if size < 1:
+        raise ValueError(f"size: expected at least 1 sample per chunk, got {size}")
+    if n < 0:
+        raise ValueError(f"n: expected a sample count >= 0, got {n}")
+    for a in range(0, n, size):
+        yield slice(a, min(a + size, n))
+
+
+def _check_chunk(X: np.ndarray, y: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray]:
+    X, y = np.asarray(X, float), np.asarray(y, float)
+    if X.ndim != 2 or X.shape[0] != p:
+        raise ValueError(f"X: expected regressor rows of shape ({p}, m), got {X.shape}")
+    if y.shape != (X.shape[1],):
+        raise ValueError(f"y: expected {X.shape[1]} outputs (one per column of X), got "
+                         f"shape {y.shape}")
+    return X, y
+
+
+class NormalEquations:
+    """``G = sum X X^T`` and ``g = sum X y`` over chunks, solved with columns scaled to unit norm.
+
+    Parameters
+    ----------
+    p : int
+        Regressors (rows of each chunk).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> X, y = rng.normal(size=(3, 50)), rng.normal(size=50)
+    >>> ne = NormalEquations(3)
+    >>> for s in chunks(50, 16):
+    ...     ne.add(X[:, s], y[s])
+    >>> bool(np.allclose(ne.solve(), np.linalg.lstsq(X.T, y, rcond=None)[0]))
+    True
+    """
+
+    def __init__(self, p: int):
+        if p < 1:
+            raise ValueError(f"p: expected at least 1 regressor, got {p}")
+        self.G = np.zeros((p, p))
+        self.g = np.zeros(p)
+        self.samples = 0
+
+    def add(self, X: np.ndarray, y: np.ndarray) -> None:
+        """Add the samples of one chunk.
+
+        Parameters
+        ----------
+        X : numpy.ndarray
+            Regressors as rows, shape (p, m).
+        y : numpy.ndarray
+            Outputs, shape (m,).
+
+        Raises
+        ------
+        ValueError
+            Shapes that do not fit ``p`` or each other.
+        """
+        X, y = _check_chunk(X, y, self.g.size)
+        self.G += X @ X.T
+        self.g += X @ y
+        self.samples += y.size
+
+    def add_gram(self, G: np.ndarray, g: np.ndarray, samples: int) -> None:
+        """Add sums ``X X^T`` and ``X y`` formed elsewhere (by blocks of regressors).
+
+        Parameters
+        ----------
+        G : numpy.ndarray
+            Shape (p, p).
+        g : numpy.ndarray
+            Shape (p,).
+        samples : int
+            Samples they sum over.
+        """
+        self.G += G
+        self.g += g
+        self.samples += samples
+
+    def solve(self, rcond: float = 1e-13) -> np.ndarray:
+        """The least-squares coefficients (columns scaled to unit norm for the solve).
+
+        Parameters
+        ----------
+        rcond : float
+            Relative cut-off of the singular values of the scaled ``G``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (p,); coefficients of columns that are all zero are 0.
+        """
+        d = np.sqrt(np.diag(self.G))
+        d[d == 0] = 1.0
+        c, *_ = np.linalg.lstsq(self.G / d[:, None] / d[None, :], self.g / d, rcond=rcond)
+        return c / d
+
+
+class ChunkedQR:
+    """A running triangular factor ``R`` of ``[X^T | y]``: each chunk is stacked under it and
+    factored again (``numpy.linalg.qr``), so the fit never forms ``X X^T``.
+
+    Parameters
+    ----------
+    p : int
+        Regressors (rows of each chunk).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(1)
+    >>> X, y = rng.normal(size=(4, 70)), rng.normal(size=70)
+    >>> qr = ChunkedQR(4)
+    >>> for s in chunks(70, 32):
+    ...     qr.add(X[:, s], y[s])
+    >>> coef, rss = qr.solve()
+    >>> ref, res, *_ = np.linalg.lstsq(X.T, y, rcond=None)
+    >>> bool(np.allclose(coef, ref)), bool(np.isclose(rss, res[0]))
+    (True, True)
+    """
+
+    def __init__(self, p: int):
+        if p < 1:
+            raise ValueError(f"p: expected at least 1 regressor, got {p}")
+        self.p = p
+        self.R = np.zeros((0, p + 1))
+        self.samples = 0
+
+    def add(self, X: np.ndarray, y: np.ndarray) -> None:
+        """Add the samples of one chunk: regressors ``X`` as rows, shape (p, m), and outputs
+        ``y``, shape (m,) (a ValueError for shapes that do not fit), as
+        :meth:`NormalEquations.add` takes them; the factor is updated in place."""
+        X, y = _check_chunk(X, y, self.p)
+        self.R = np.linalg.qr(np.vstack((self.R, np.column_stack((X.T, y)))), mode="r")
+        self.samples += y.size
+
+    def solve(self, rcond: float = 1e-13) -> tuple[np.ndarray, float]:
+        """The least-squares coefficients and the residual sum of squares.
+
+        Parameters
+        ----------
+        rcond : float
+            Relative cut-off of the singular values of the factor (rank-deficient columns).
+
+        Returns
+        -------
+        coef : numpy.ndarray
+            Shape (p,).
+        rss : float
+            ``sum (y - X^T coef)^2`` over every sample added.
+        """
+        R = np.zeros((self.p + 1, self.p + 1))
+        R[:self.R.shape[0]] = self.R[:self.p + 1]
+        coef, *_ = np.linalg.lstsq(R[:self.p, :self.p], R[:self.p, self.p], rcond=rcond)
+        rest = R[:, self.p] - R[:, :self.p] @ coef
+        return coef, float(rest @ rest)

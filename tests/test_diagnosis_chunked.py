@@ -1,0 +1,145 @@
+"""The chunked least squares of the diagnosis (pimodel.diagnosis.chunked) equals the full
+least squares, and a diagnosis of long records stays under a memory limit (issue 31)."""
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from pimodel.diagnosis.chunked import ChunkedQR, NormalEquations, chunks
+from pimodel.diagnosis.effects import fit_nominal, make_segment
+from pimodel.operators.pi import PIOperator
+from pimodel.stages.pi_stage import excitation, random_truth
+
+
+def _problem(seed: int, n: int = 3000, p: int = 6, scale_spread: float = 1e3):
+    rng = np.random.default_rng(seed)
+    X = rng.normal(size=(p, n)) * np.geomspace(1.0, scale_spread, p)[:, None]
+    coef = rng.normal(size=p)
+    return X, X.T @ coef + 0.01 * rng.normal(size=n)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_chunked_fits_equal_full_least_squares(seed):
+    X, y = _problem(seed)
+    size = int(np.random.default_rng(seed).integers(50, 900))
+    ref, res, *_ = np.linalg.lstsq(X.T, y, rcond=None)
+    ne, qr = NormalEquations(X.shape[0]), ChunkedQR(X.shape[0])
+    for c in chunks(y.size, size):
+        ne.add(X[:, c], y[c])
+        qr.add(X[:, c], y[c])
+    coef_qr, rss_qr = qr.solve()
+    scale = np.max(np.abs(ref))
+    assert np.max(np.abs(ne.solve() - ref)) < 1e-8 * scale
+    assert np.max(np.abs(coef_qr - ref)) < 1e-10 * scale
+    assert abs(rss_qr - res[0]) < 1e-8 * res[0]
+    assert ne.samples == qr.samples == y.size
+
+
+def test_chunked_qr_keeps_digits_where_normal_equations_lose_them():
+    # nearly collinear columns: cond(X) ~ 1e9, so cond(X X^T) ~ 1e18 is beyond double
+    rng = np.random.default_rng(5)
+    t = np.linspace(0.0, 1.0, 4000)
+    X = np.vstack((np.ones_like(t), t, t + 1e-9 * rng.normal(size=t.size)))
+    y = X.T @ np.array([1.0, 2.0, -1.0])
+    ref = np.linalg.lstsq(X.T, y, rcond=None)[0]
+    qr = ChunkedQR(3)
+    for c in chunks(t.size, 700):
+        qr.add(X[:, c], y[c])
+    coef, rss = qr.solve()
+    assert np.max(np.abs(X.T @ coef - y)) < 1e-9
+    assert np.max(np.abs(X.T @ coef - X.T @ ref)) < 1e-9
+    assert rss < 1e-15
+
+
+def test_nominal_fit_over_chunks_equals_full_least_squares(monkeypatch):
+    # a record longer than several chunks: the segment's play outputs (built chunk by chunk,
+    # states carried) and the nominal fit (accumulated chunk by chunk) equal the plain ones
+    monkeypatch.setattr(chunks, "__defaults__", (257,))
+    truth = random_truth(["creep"], 3)
+    t, v = excitation("train", seed=4)
+    rec = truth.record(t, v, 4)
+    radii = np.linspace(0.0, np.ptp(rec.v) / 2, 12)
+    seg = make_segment(rec.t, rec.v, rec.y, radii)
+    Z = PIOperator(np.ones(radii.size), radii).play_outputs(rec.v)
+    assert np.array_equal(seg.Z, Z)
+    A = np.column_stack((Z, np.ones(Z.shape[0])))
+    ref = np.linalg.lstsq(A, rec.y, rcond=None)[0]
+    model = fit_nominal([seg])
+    assert np.max(np.abs(A @ model.coef - A @ ref)) < 1e-9 * np.ptp(rec.y)
+    assert np.max(np.abs(model.predict(seg) - A @ ref)) < 1e-9 * np.ptp(rec.y)
+
+
+def test_chunks_reject_bad_sizes():
+    with pytest.raises(ValueError, match="size"):
+        list(chunks(10, 0))
+    with pytest.raises(ValueError, match="X"):
+        NormalEquations(2).add(np.zeros((3, 4)), np.zeros(4))
+    with pytest.raises(ValueError, match="y"):
+        ChunkedQR(2).add(np.zeros((2, 4)), np.zeros(5))
+
+
+LIMIT_GB = 4.0  # address space of the child (virtual: libraries and thread stacks count); 2 x 1M
+# samples reached 15.5 GB resident before issue 31
+
+_CHILD = textwrap.dedent("""
+    import resource, sys
+    import numpy as np
+    sys.path.insert(0, {bench!r})
+    from bench_diagnosis import records
+    tr, va = records(1_000_000)
+    limit = int({limit} * 2**30)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    from pimodel.diagnosis import diagnose
+    rep = diagnose([tr], [va])
+    print("effects", rep.verdict["effects"])
+""")
+
+
+@pytest.mark.slow
+def test_million_sample_diagnosis_stays_under_memory_limit(tmp_path):
+    from pathlib import Path
+
+    bench = str(Path(__file__).resolve().parents[1] / "benchmarks")
+    code = _CHILD.format(bench=bench, limit=LIMIT_GB)
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
+                            "MKL_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"})
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert "dynamics" in p.stdout
+
+
+class _Stream:
+    def __init__(self, tty: bool):
+        self.tty, self.text = tty, ""
+
+    def isatty(self) -> bool:
+        return self.tty
+
+    def write(self, s: str) -> None:
+        self.text += s
+
+    def flush(self) -> None:
+        pass
+
+
+def test_progress_reports_the_stages_and_shows_only_on_a_terminal():
+    from pimodel.cli.diagnose import progress_line
+    from pimodel.diagnosis import diagnose
+
+    assert progress_line(False, _Stream(False)) is None
+    assert progress_line(True, _Stream(True)) is None
+    stream = _Stream(True)
+    show = progress_line(False, stream)
+    truth = random_truth(["creep"], 0)
+    tt, vt = excitation("train", seed=1)
+    tv, vv = excitation("validate", seed=2)
+    messages = []
+    diagnose([truth.record(tt, vt, 1)], [truth.record(tv, vv, 2)],
+             progress=lambda m: (messages.append(m), show(m)))
+    assert messages[0].startswith("nominal")
+    assert [m for m in messages if m.startswith("candidate")][-1] == "candidate rate (6/6)"
+    assert stream.text.count("\r") == len(messages)
+    assert "candidate creep (1/6)" in stream.text
