@@ -11,7 +11,8 @@ down, or none yet): :func:`play_sensitivity`.
 - :func:`polish_radii`: Gauss-Newton on ``sum_k (y[k] - yhat[k](r))^2`` over the samples
   ``k >= (1 - tail) N``, with the switching pattern of the current iterate, projected onto
   ``0 <= r_1 <= ... <= r_n`` and halved until the cost does not grow; it stops when the
-  step is below ``1e-12`` of the range of v, the pattern repeats, or after ``iterations``.
+  step is below ``1e-12`` of the range of v, the cost falls by less than ``1e-9`` of itself,
+  no step of 8 halvings lowers it, or after ``iterations``.
   Noise-free, once the pattern is the true one, one step lands on the truth.
 - :func:`radius_bound`: the Cramer-Rao bound for the radii from output samples with white
   Gaussian noise of standard deviation ``sigma`` (the covariance of least squares with the true
@@ -216,7 +217,7 @@ def polish_radii(v, y, weights, radii, *, tail: float = 1.0, iterations: int = 3
         step = np.zeros(p.size)
         step[free] = np.linalg.lstsq(Jf, res, rcond=None)[0]
         improved = False
-        for _ in range(30):
+        for _ in range(8):
             r_new = _project(r + step, linear_play)
             res_new, J_new = residual(r_new)
             c_new = float(res_new @ res_new)
@@ -227,8 +228,9 @@ def polish_radii(v, y, weights, radii, *, tail: float = 1.0, iterations: int = 3
         if not improved:
             break
         moved = float(np.max(np.abs(r_new - r)))
+        gain = cost - c_new
         r, res, J, cost = r_new, res_new, J_new, c_new
-        if moved <= tol:
+        if moved <= tol or gain <= 1e-9 * cost:
             break
     return r
 
@@ -237,9 +239,9 @@ def refine_radii(v, y, weights, online, *, linear_play: bool = False,
                  initial_state: float = 0.0) -> np.ndarray:
     """The batch refinement :func:`pimodel.estimate_radii` applies by default.
 
-    Gauss-Newton (:func:`polish_radii`, whole record) from whichever of ``online`` (the online
-    estimate) and :func:`profile_radii` fits the record better (smaller sum of squared output
-    errors).
+    Gauss-Newton (:func:`polish_radii`, whole record) from ``online`` (the online estimate)
+    and from :func:`profile_radii`; the end that fits the record better (smaller sum of
+    squared output errors) is returned.
 
     Examples
     --------
@@ -255,10 +257,11 @@ def refine_radii(v, y, weights, online, *, linear_play: bool = False,
     p = check_weights(weights)
     starts = [_project(as_vector(online, "online", length=p.size), linear_play),
               _project(profile_radii(x, m, p), linear_play)]
+    ends = [polish_radii(x, m, p, r, linear_play=linear_play, initial_state=initial_state)
+            for r in starts]
     sse = [float(np.sum((m - play_sensitivity(x, r, initial_state=initial_state)[0] @ p) ** 2))
-           for r in starts]
-    return polish_radii(x, m, p, starts[int(np.argmin(sse))], linear_play=linear_play,
-                        initial_state=initial_state)
+           for r in ends]
+    return ends[int(np.argmin(sse))]
 
 
 class RadiusBound:
