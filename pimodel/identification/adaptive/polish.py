@@ -32,6 +32,7 @@ from .settings import check_weights
 __all__ = ["play_sensitivity", "polish_radii", "profile_radii", "refine_radii", "radius_bound", "RadiusBound"]
 
 PROFILE_BINS = 512  # bins of input travel in :func:`profile_radii`
+REFINE_BINS = (512, 128, 32)  # profile starts of :func:`refine_radii` (coarse ones: noise)
 
 
 def play_sensitivity(v, radii, *, initial_state: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -240,7 +241,8 @@ def refine_radii(v, y, weights, online, *, linear_play: bool = False,
     """The batch refinement :func:`pimodel.estimate_radii` applies by default.
 
     Gauss-Newton (:func:`polish_radii`, whole record) from ``online`` (the online estimate)
-    and from :func:`profile_radii`; the end that fits the record better (smaller sum of
+    and from :func:`profile_radii` with 512, 128 and 32 bins (the coarse profiles are less
+    noisy, the fine one more precise); the end that fits the record better (smaller sum of
     squared output errors) is returned.
 
     Examples
@@ -256,7 +258,7 @@ def refine_radii(v, y, weights, online, *, linear_play: bool = False,
     m = as_signal(y, "y", min_length=3)
     p = check_weights(weights)
     starts = [_project(as_vector(online, "online", length=p.size), linear_play),
-              _project(profile_radii(x, m, p), linear_play)]
+              *(_project(profile_radii(x, m, p, bins=b), linear_play) for b in REFINE_BINS)]
     ends = [polish_radii(x, m, p, r, linear_play=linear_play, initial_state=initial_state)
             for r in starts]
     sse = [float(np.sum((m - play_sensitivity(x, r, initial_state=initial_state)[0] @ p) ** 2))
