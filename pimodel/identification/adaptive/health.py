@@ -183,13 +183,13 @@ def estimator_health(v, weights, history, *, linear_play: bool = False, y=None, 
     return EstimatorHealth(ok, exc.ok, merged, pinned, moving, drift, fit_ok, fit_rms, msgs)
 
 
-def refined_health(v, y, weights, radii, online: EstimatorHealth, *, linear_play: bool = False,
+def refined_health(v, y, weights, radii, *, linear_play: bool = False,
                    initial_state: float = 0.0, warn: bool = False) -> EstimatorHealth:
     """Health of the batch-refined estimate ``radii`` (:func:`pimodel.estimate_radii`).
 
-    ``online`` (the online law's report) is kept for reference only. Excitation: Lemma 2 at
-    ``radii`` (:func:`pimodel.identification.identifiability.check_excitation`) and the persistent excitation of the radii,
-    ``J^T J`` nonsingular at ``radii``
+    Excitation: Lemma 2 at ``radii``
+    (:func:`pimodel.identification.identifiability.check_excitation`) and the persistent
+    excitation of the radii, ``J^T J`` nonsingular at ``radii``
     (:func:`pimodel.identification.adaptive.polish.radius_bound`, with ``sigma`` the noise
     level of y, or ``1e-12 range(y)`` on a clean record); merged and pinned from ``radii``;
     not still moving (a batch estimate); the fit over the last quarter with ``radii``.
@@ -200,8 +200,7 @@ def refined_health(v, y, weights, radii, online: EstimatorHealth, *, linear_play
     >>> from pimodel import PIOperator
     >>> v = np.sin(np.arange(0, 60, 0.01))
     >>> y = PIOperator([1.0, 1.0], [0.1, 0.4]).simulate(v)
-    >>> ok = EstimatorHealth(ok=True, excitation_ok=True)
-    >>> refined_health(v, y, [1.0, 1.0], [0.1, 0.4], ok).ok
+    >>> refined_health(v, y, [1.0, 1.0], [0.1, 0.4]).ok
     True
     """
     from .polish import play_sensitivity, radius_bound

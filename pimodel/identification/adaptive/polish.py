@@ -29,7 +29,14 @@ from ...checks import as_signal, as_vector
 from ...operators.pi import PIOperator
 from .settings import check_weights
 
-__all__ = ["play_sensitivity", "polish_radii", "profile_radii", "refine_radii", "radius_bound", "RadiusBound"]
+__all__ = [
+    "play_sensitivity",
+    "polish_radii",
+    "profile_radii",
+    "radius_bound",
+    "RadiusBound",
+    "refine_radii",
+]
 
 PROFILE_BINS = 512  # bins of input travel in :func:`profile_radii`
 REFINE_BINS = (512, 128, 32)  # profile starts of :func:`refine_radii` (coarse ones: noise)
@@ -70,7 +77,7 @@ def play_sensitivity(v, radii, *, initial_state: float = 0.0) -> tuple[np.ndarra
     zz = np.empty((x.size, r.size))
     zz[:, order] = z.play_outputs(x)
     dz = np.diff(zz, axis=0, prepend=np.full((1, r.size), float(initial_state)))
-    move = -np.sign(dz)
+    move = np.sign(-dz) + 0.0  # no -0.0
     k = np.where(move != 0, np.arange(x.size)[:, None], 0)
     last = np.maximum.accumulate(k, axis=0)
     s = np.take_along_axis(move, last, axis=0)
@@ -192,7 +199,7 @@ def polish_radii(v, y, weights, radii, *, tail: float = 1.0, iterations: int = 3
     >>> from pimodel import PIOperator
     >>> v = 3 * np.sin(np.linspace(0, 40, 4000)) + np.sin(np.linspace(0, 97, 4000))
     >>> y = PIOperator([1.0, 0.5, 0.5], [0.0, 0.5, 1.2]).simulate(v)
-    >>> polish_radii(v, y, [1.0, 0.5, 0.5], [0.3, 0.3, 0.3]).round(6)
+    >>> polish_radii(v, y, [1.0, 0.5, 0.5], [0.1, 0.4, 1.0]).round(6)   # a local method
     array([0. , 0.5, 1.2])
     """
     x = as_signal(v, "v", min_length=2)

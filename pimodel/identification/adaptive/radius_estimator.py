@@ -558,9 +558,8 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
         res.online_radii = res.radii if res.radii_mean is None else res.radii_mean
         res.radii = refine_radii(x, m, est.weights, res.online_radii, linear_play=linear_play,
                                  initial_state=initial_state)
-        res.health = refined_health(x, m, est.weights, res.radii, res.health,
-                                    linear_play=linear_play, initial_state=initial_state,
-                                    warn=warn)
+        res.health = refined_health(x, m, est.weights, res.radii, linear_play=linear_play,
+                                    initial_state=initial_state, warn=warn)
     return res
 
 
