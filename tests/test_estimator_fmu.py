@@ -192,3 +192,23 @@ def test_simulate_fmu_logger_receives_the_health_warning(fmus, fmi):
     assert len(warnings) == 1 and warnings[0][0] == "logStatusWarning", records
     assert f"(health = {bits})" in warnings[0][1] and "pinned at the projection bound" in \
         warnings[0][1]
+
+
+@pytest.mark.parametrize("fmi", ["2.0", "3.0"])
+def test_fmu_with_self_tuned_settings_equals_estimate_radii(fmus, fmi):
+    """Issue 27: estimate_radii's settings chosen from a noisy record (gain, guard, threshold,
+    slope window) reach the FMU through RadiusEstimate.fmu_start_values; the FMU then gives
+    the online iterate (polish=False) to 1e-12."""
+    t, v = sinusoid(30, 1, fs=1 / TS, duration=3)
+    rng = np.random.default_rng(27)
+    v = v + rng.normal(0, 0.05, v.size)  # input noise: a threshold above 0
+    y0 = PIOperator(P, R).simulate(v)
+    y = y0 + rng.normal(0, np.std(y0) / 10, v.size)
+    ref = estimate_radii(v, y, P, dt=TS, initial_radii=STARTS["zero"], polish=False)
+    start = ref.fmu_start_values()
+    assert start["threshold"] > 0 and start["guard"] > 0 and start["gain"] != 10.0
+    out, _ = run_fmu(fmus, fmi, STARTS["zero"], v, y,
+                     [f"r_hat[{i + 1}]" for i in range(P.size)], **start)
+    np.testing.assert_allclose(out, np.vstack((ref.history[1:], ref.radii)), rtol=0,
+                               atol=1e-12)
+    assert np.max(np.abs(ref.radii - ref.history[0])) > 0.05  # the estimate moved

@@ -188,6 +188,42 @@ class RadiusEstimate:
     settings: dict | None = None
     online_radii: np.ndarray | None = None
 
+    def fmu_start_values(self) -> dict:
+        """The RadiusEstimator FMU's start values for the settings this run used.
+
+        With them (and the same weights, initial radii, ``Ts`` and ``linear_play``) the FMU
+        gives :func:`estimate_radii`'s online iterate (``polish=False``) to 1e-12; this is how
+        the self-tuned settings of :func:`estimate_radii` reach the FMU.
+
+        Returns
+        -------
+        dict
+            ``gain``, ``guard``, ``threshold``, ``slope_window``, ``law`` (0 data, 1 paper).
+
+        Raises
+        ------
+        ValueError
+            When the run has no ``settings`` (it came from :meth:`RadiusEstimator.run`) or
+            per-play gains differ (the FMU has one gain).
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = np.sin(np.linspace(0, 20, 2000))          # 2 s at dt = 1 ms
+        >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+        >>> estimate_radii(v, y, [1.0, 1.0], dt=1e-3).fmu_start_values()["slope_window"]
+        8
+        """
+        if self.settings is None:
+            raise ValueError("settings: this result has none; use estimate_radii")
+        g = np.atleast_1d(np.asarray(self.settings["gains"], float))
+        if np.ptp(g) > 0:
+            raise ValueError(f"settings: the FMU has one gain, got per-play gains {g.tolist()}")
+        return {"gain": float(g[0]), "guard": float(self.settings["guard"]),
+                "threshold": float(self.settings["threshold"]),
+                "slope_window": int(self.settings["slope_window"]),
+                "law": LAWS[self.settings["law"]]}
+
     def mean_radii(self, last_seconds: float) -> np.ndarray:
         """Average of the estimate over the last ``last_seconds`` of the record.
 
