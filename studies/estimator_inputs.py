@@ -75,7 +75,8 @@ def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) ->
     for i in range(len(INPUT_KINDS)):
         for j in range(len(NOISE)):
             ax.text(j, i, f"{worst[i, j]:.2g}", ha="center", va="center", fontsize=7)
-    ax.set(xlabel="output noise", title="worst refined radius error [% of largest radius]")
+    ax.set(xlabel="output noise", ylabel="input",
+           title="worst refined radius error [% of largest radius]")
     res.figures.append(save_figure(fig, out / "estimator_inputs.png"))
     res.numbers = {"worst_by_noise": {_label(s): float(worst[:, j].max())
                                       for j, s in enumerate(NOISE)}, "cases": len(results)}
