@@ -40,7 +40,8 @@ def record():
 
 def core(record, start, law="data"):
     t, v, y = record
-    ref = estimate_radii(v, y, P, dt=TS, initial_radii=STARTS[start], law=law, **SETTINGS)
+    ref = estimate_radii(v, y, P, dt=TS, initial_radii=STARTS[start], law=law, polish=False,
+                         **SETTINGS)
     assert ref.used.sum() > 1000  # the law adapted (data law: profile fitted, regimes found)
     assert np.max(np.abs(ref.radii - ref.history[0])) > 0.05  # and moved the estimate
     return ref
@@ -146,7 +147,7 @@ def test_estimator_fmu_health_output_and_log_equal_python(fmus, case, fmi):
     law, r0, amplitude, duration, must = HEALTH_CASES[case]
     t, v = sinusoid(amplitude, 1, fs=1 / TS, duration=duration)
     y = PIOperator(P, R).simulate(v)
-    ref = estimate_radii(v, y, P, dt=TS, initial_radii=r0, law=law, **SETTINGS)
+    ref = estimate_radii(v, y, P, dt=TS, initial_radii=r0, law=law, polish=False, **SETTINGS)
     want = python_health_bits(ref.health)
     assert want & must == must and (want != 0) == (must != 0), (want, ref.health.messages)
     out, unit = run_fmu(fmus, fmi, r0, v, y, ["health"], law=LAWS[law])
