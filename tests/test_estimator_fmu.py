@@ -40,7 +40,8 @@ def record():
 
 def core(record, start, law="data"):
     t, v, y = record
-    ref = estimate_radii(v, y, P, dt=TS, initial_radii=STARTS[start], law=law, **SETTINGS)
+    ref = estimate_radii(v, y, P, dt=TS, initial_radii=STARTS[start], law=law, polish=False,
+                         **SETTINGS)
     assert ref.used.sum() > 1000  # the law adapted (data law: profile fitted, regimes found)
     assert np.max(np.abs(ref.radii - ref.history[0])) > 0.05  # and moved the estimate
     return ref
@@ -146,7 +147,7 @@ def test_estimator_fmu_health_output_and_log_equal_python(fmus, case, fmi):
     law, r0, amplitude, duration, must = HEALTH_CASES[case]
     t, v = sinusoid(amplitude, 1, fs=1 / TS, duration=duration)
     y = PIOperator(P, R).simulate(v)
-    ref = estimate_radii(v, y, P, dt=TS, initial_radii=r0, law=law, **SETTINGS)
+    ref = estimate_radii(v, y, P, dt=TS, initial_radii=r0, law=law, polish=False, **SETTINGS)
     want = python_health_bits(ref.health)
     assert want & must == must and (want != 0) == (must != 0), (want, ref.health.messages)
     out, unit = run_fmu(fmus, fmi, r0, v, y, ["health"], law=LAWS[law])
@@ -192,3 +193,23 @@ def test_simulate_fmu_logger_receives_the_health_warning(fmus, fmi):
     assert len(warnings) == 1 and warnings[0][0] == "logStatusWarning", records
     assert f"(health = {bits})" in warnings[0][1] and "pinned at the projection bound" in \
         warnings[0][1]
+
+
+@pytest.mark.parametrize("fmi", ["2.0", "3.0"])
+def test_fmu_with_self_tuned_settings_equals_estimate_radii(fmus, fmi):
+    """Issue 27: estimate_radii's settings chosen from a noisy record (gain, guard, threshold,
+    slope window) reach the FMU through RadiusEstimate.fmu_start_values; the FMU then gives
+    the online iterate (polish=False) to 1e-12."""
+    t, v = sinusoid(30, 1, fs=1 / TS, duration=3)
+    rng = np.random.default_rng(27)
+    v = v + rng.normal(0, 0.05, v.size)  # input noise: a threshold above 0
+    y0 = PIOperator(P, R).simulate(v)
+    y = y0 + rng.normal(0, np.std(y0) / 10, v.size)
+    ref = estimate_radii(v, y, P, dt=TS, initial_radii=STARTS["zero"], polish=False)
+    start = ref.fmu_start_values()
+    assert start["threshold"] > 0 and start["guard"] > 0 and start["gain"] != 10.0
+    out, _ = run_fmu(fmus, fmi, STARTS["zero"], v, y,
+                     [f"r_hat[{i + 1}]" for i in range(P.size)], **start)
+    np.testing.assert_allclose(out, np.vstack((ref.history[1:], ref.radii)), rtol=0,
+                               atol=1e-12)
+    assert np.max(np.abs(ref.radii - ref.history[0])) > 0.05  # the estimate moved

@@ -173,6 +173,9 @@ MODELS: dict[str, dict] = {
                  Var("guard", 6, "Real", "parameter", "0", "breakpoint guard band (input unit)"),
                  Var("slope_window", 7, "Integer", "parameter", "8",
                      "slope check window in samples (0: off; law = 1 only)"),
+                 Var("threshold", 16, "Real", "parameter", "0",
+                     "reversal threshold (input unit; estimate_radii's default: 3 x the "
+                     "input noise level)"),
                  Var("law", 14, "Integer", "parameter", "0",
                      "principal case: 0 data (from the measured branches, the default), "
                      "1 paper (from the estimate, the paper's rule)"),

@@ -40,6 +40,7 @@ from .settings import noise_level
 
 __all__ = [
     "estimator_health",
+    "refined_health",
     "EstimatorHealth",
 ]
 
@@ -68,6 +69,10 @@ class EstimatorHealth:
         RMS of ``e`` over the last quarter [output unit] (None when not checked).
     messages : list of str
         One sentence per failed check.
+    radii_sd : numpy.ndarray of float, optional
+        After the batch refinement (:func:`refined_health`): the Cramer-Rao standard
+        deviations of the radii at the estimate and the record's noise level (input unit);
+        infinite when the record does not excite them (``J^T J`` singular).
 
     Examples
     --------
@@ -84,6 +89,7 @@ class EstimatorHealth:
     fit_ok: bool = True
     fit_rms: float | None = None
     messages: list = field(default_factory=list)
+    radii_sd: list | None = None
 
     def to_json(self) -> dict:
         """Plain dict of the fields.
@@ -175,3 +181,60 @@ def estimator_health(v, weights, history, *, linear_play: bool = False, y=None, 
     if warn and not ok:
         warnings.warn("radius estimate health: " + "; ".join(msgs), UserWarning, stacklevel=2)
     return EstimatorHealth(ok, exc.ok, merged, pinned, moving, drift, fit_ok, fit_rms, msgs)
+
+
+def refined_health(v, y, weights, radii, *, linear_play: bool = False,
+                   initial_state: float = 0.0, warn: bool = False) -> EstimatorHealth:
+    """Health of the batch-refined estimate ``radii`` (:func:`pimodel.estimate_radii`).
+
+    Excitation: Lemma 2 at ``radii``
+    (:func:`pimodel.identification.identifiability.check_excitation`) and the persistent
+    excitation of the radii, ``J^T J`` nonsingular at ``radii``
+    (:func:`pimodel.identification.adaptive.polish.radius_bound`, with ``sigma`` the noise
+    level of y, or ``1e-12 range(y)`` on a clean record); merged and pinned from ``radii``;
+    not still moving (a batch estimate); the fit over the last quarter with ``radii``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pimodel import PIOperator
+    >>> v = np.sin(np.arange(0, 60, 0.01))
+    >>> y = PIOperator([1.0, 1.0], [0.1, 0.4]).simulate(v)
+    >>> refined_health(v, y, [1.0, 1.0], [0.1, 0.4]).ok
+    True
+    """
+    from .polish import play_sensitivity, radius_bound
+
+    x, m = np.asarray(v, float), np.asarray(y, float)
+    p, r = np.asarray(weights, float), np.asarray(radii, float)
+    sig = max(noise_level(m), 1e-12 * float(np.ptp(m)), 1e-300)
+    bound = radius_bound(x, p, r, sigma=sig, linear_play=linear_play,
+                         initial_state=initial_state)
+    lemma = check_excitation(x, p, r, warn=False)
+    msgs = list(lemma.messages) if not lemma.ok else []
+    exc = lemma.ok and bound.exciting
+    if not bound.exciting:
+        msgs.append("the record does not excite the radii: J^T J (the output's sensitivity "
+                    "to the radii) is singular, so some radii are not identifiable from it")
+    scale = float(r.max()) if r.size else 0.0
+    merged = [(j + 1, j + 2) for j in range(r.size - 1)
+              if r[j + 1] - r[j] <= 1e-6 * scale and not (linear_play and j == 0 and scale == 0)]
+    if merged:
+        msgs.append("plays merged (equal estimates): "
+                    + ", ".join(f"r_hat[{a}] = r_hat[{b}]" for a, b in merged))
+    pinned = [j + 1 for j in range(r.size) if r[j] == 0 and not (linear_play and j == 0)]
+    if pinned:
+        msgs.append("radius pinned at the bound 0: " + ", ".join(f"r_hat[{j}]" for j in pinned))
+    q = max(x.size // 4, 1)
+    e = play_sensitivity(x, r, initial_state=initial_state)[0][-q:] @ p - m[-q:]
+    fit_rms = float(np.sqrt(np.mean(e ** 2)))
+    limit = 1.1 * noise_level(m) + 1e-4 * float(np.ptp(m))
+    fit_ok = fit_rms <= limit
+    if not fit_ok:
+        msgs.append(f"the model does not fit the data: RMS error {fit_rms:.3g} over the last "
+                    f"quarter exceeds the noise bound {limit:.3g}")
+    ok = exc and not merged and not pinned and fit_ok
+    if warn and not ok:
+        warnings.warn("radius estimate health: " + "; ".join(msgs), UserWarning, stacklevel=2)
+    return EstimatorHealth(ok, exc, merged, pinned, False, 0.0, fit_ok, fit_rms, msgs,
+                           bound.sd.tolist())

@@ -69,7 +69,8 @@ from ...checks import (
     positive_scalar,
     scalar_or_vector,
 )
-from .health import EstimatorHealth, estimator_health
+from .health import EstimatorHealth, estimator_health, refined_health
+from .polish import refine_radii
 from .settings import check_gains, check_weights, default_settings
 
 __all__ = [
@@ -158,7 +159,12 @@ class RadiusEstimate:
         From :func:`estimate_radii`: whether the estimate can be trusted, see
         :mod:`pimodel.identification.adaptive.health`.
     settings : dict, optional
-        The settings :func:`estimate_radii` used (gains, threshold, guard, slope window, law).
+        The settings :func:`estimate_radii` used (gains, threshold, guard, slope window, law,
+        polish).
+    online_radii : numpy.ndarray of float, shape (n,), optional
+        From :func:`estimate_radii` with ``polish=True``: the online law's own estimate
+        (``radii_mean`` when there is one, else the final iterate), before the batch
+        refinement; ``radii`` is then the refined estimate. None otherwise.
 
     Examples
     --------
@@ -180,6 +186,43 @@ class RadiusEstimate:
     radii_mean: np.ndarray | None = None
     health: EstimatorHealth | None = None
     settings: dict | None = None
+    online_radii: np.ndarray | None = None
+
+    def fmu_start_values(self) -> dict:
+        """The RadiusEstimator FMU's start values for the settings this run used.
+
+        With them (and the same weights, initial radii, ``Ts`` and ``linear_play``) the FMU
+        gives :func:`estimate_radii`'s online iterate (``polish=False``) to 1e-12; this is how
+        the self-tuned settings of :func:`estimate_radii` reach the FMU.
+
+        Returns
+        -------
+        dict
+            ``gain``, ``guard``, ``threshold``, ``slope_window``, ``law`` (0 data, 1 paper).
+
+        Raises
+        ------
+        ValueError
+            When the run has no ``settings`` (it came from :meth:`RadiusEstimator.run`) or
+            per-play gains differ (the FMU has one gain).
+
+        Examples
+        --------
+        >>> from pimodel import PIOperator
+        >>> v = np.sin(np.linspace(0, 20, 2000))          # 2 s at dt = 1 ms
+        >>> y = PIOperator([1.0, 1.0], [0.0, 0.3]).simulate(v)
+        >>> estimate_radii(v, y, [1.0, 1.0], dt=1e-3).fmu_start_values()["slope_window"]
+        8
+        """
+        if self.settings is None:
+            raise ValueError("settings: this result has none; use estimate_radii")
+        g = np.atleast_1d(np.asarray(self.settings["gains"], float))
+        if np.ptp(g) > 0:
+            raise ValueError(f"settings: the FMU has one gain, got per-play gains {g.tolist()}")
+        return {"gain": float(g[0]), "guard": float(self.settings["guard"]),
+                "threshold": float(self.settings["threshold"]),
+                "slope_window": int(self.settings["slope_window"]),
+                "law": LAWS[self.settings["law"]]}
 
     def mean_radii(self, last_seconds: float) -> np.ndarray:
         """Average of the estimate over the last ``last_seconds`` of the record.
@@ -469,7 +512,8 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
                    max_step: float | None = None, anneal_time: float | None = None,
                    guard: float | None = None, slope_window: int | None = None,
                    slope_tol: float = 0.5, initial_state: float = 0.0, law: str = "data",
-                   warn: bool = False, known_linear_play: bool | None = None) -> RadiusEstimate:
+                   warn: bool = False, known_linear_play: bool | None = None,
+                   polish: bool = True) -> RadiusEstimate:
     """Estimate the play radii from a record ``(v[k], y[k])``, k = 0..N-1, sampled every ``dt``.
 
     Runs :class:`RadiusEstimator` over the arrays (the C batch loop); see the module docstring
@@ -495,11 +539,19 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
         Issue a ``UserWarning`` when the health report fails.
     known_linear_play : bool, optional
         Deprecated name of ``linear_play``.
+    polish : bool, optional
+        Default True: refine the online estimate in batch
+        (:func:`pimodel.identification.adaptive.polish.refine_radii`: Gauss-Newton least
+        squares over the whole record, from the online estimate or the branch profile,
+        whichever fits better); ``radii`` is then the refined estimate and ``online_radii`` the
+        online one. False: ``radii`` is the online law's final iterate, exactly what the
+        RadiusEstimator FMU gives with the same settings.
 
     Returns
     -------
     RadiusEstimate
-        With ``radii`` (final), ``radii_mean`` (mean over the last half), ``health`` and the
+        With ``radii`` (refined, or the final iterate with ``polish=False``), ``radii_mean``
+        (mean of the online iterate over the last half), ``online_radii``, ``health`` and the
         ``settings`` used.
 
     Raises
@@ -536,8 +588,14 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
                           initial_state=initial_state, law=law, **settings)
     res = est.run(x, m)
     res.health = estimator_health(x, est.weights, res.history, linear_play=linear_play,
-                                  y=m, error=res.error, warn=warn)
-    res.settings = {**settings, "law": law}
+                                  y=m, error=res.error, warn=warn and not polish)
+    res.settings = {**settings, "law": law, "polish": bool(polish)}
+    if polish and x.size >= 3:
+        res.online_radii = res.radii if res.radii_mean is None else res.radii_mean
+        res.radii = refine_radii(x, m, est.weights, res.online_radii, linear_play=linear_play,
+                                 initial_state=initial_state)
+        res.health = refined_health(x, m, est.weights, res.radii, linear_play=linear_play,
+                                    initial_state=initial_state, warn=warn)
     return res
 
 

@@ -22,8 +22,8 @@ static int unit_init_estimator(pim_unit *u, pim_estimator *est)
 {
     double g[PIM_NMAX];
     for (int i = 0; i < u->n; ++i) g[i] = u->gain;
-    const char *msg = pim_est_init(est, (size_t)u->n, u->p, g, u->r, u->Ts, u->z0, 0.0, 0.0, 0.0,
-                                   u->guard, u->linear_play);
+    const char *msg = pim_est_init(est, (size_t)u->n, u->p, g, u->r, u->Ts, u->z0, u->threshold,
+                                   0.0, 0.0, u->guard, u->linear_play);
     if (!msg) msg = pim_est_set_slope_check(est, u->slope_window, 0.5);
     if (!msg) msg = pim_est_set_law(est, u->law);
     return msg ? unit_error(u, "bad parameters: %s", msg) : 0;
@@ -105,6 +105,8 @@ static int model_check_parameters(pim_unit *u)
         return unit_error(u, "parameter gain = %g: must be finite and >= 0", u->gain);
     if (!(u->guard >= 0.0) || !isfinite(u->guard))
         return unit_error(u, "parameter guard = %g: must be finite and >= 0", u->guard);
+    if (!(u->threshold >= 0.0) || !isfinite(u->threshold))
+        return unit_error(u, "parameter threshold = %g: must be finite and >= 0", u->threshold);
     if (u->slope_window < 0 || u->slope_window >= PIM_EST_WIN)
         return unit_error(u, "parameter slope_window = %d out of range: 0 <= slope_window <= %d",
                           u->slope_window, PIM_EST_WIN - 1);
