@@ -90,9 +90,12 @@ def export_models(rep, out_dir, *, fmu: bool = True) -> list:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     aug, nom = rep.model(augmented=True), rep.model(augmented=False)
-    paths = [aug.save(out / "augmented.json"), nom.save(out / "nominal.json")]
+    made = {"method": "diagnose"}
+    paths = [save_model(aug, out / "augmented.json", source=made),
+             save_model(nom, out / "nominal.json", source=made)]
     try:
-        paths.append(save_model(nom.operator_form(), out / "nominal.model.json"))
+        paths.append(save_model(nom.operator_form(), out / "nominal.model.json", dt=nom.dt,
+                                source=made))
     except ValueError as err:
         print(f"no operator form of the nominal model: {err}")
     if fmu:
