@@ -297,9 +297,8 @@ def test_csv_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_pa
     t = np.arange(0, 12, dt)
     v = 2 * np.abs((t % 2) - 1) - 1  # a 0.5 Hz triangle, 2 V peak to peak
     y = stage.simulate(v) + offset + rng.normal(0, 1e-3, t.size)
-    lines = ["time_s,voltage_V,disp_um"] + [f"{a!r},{b!r},{c!r}" for a, b, c in zip(t, v, y,
-                                                                                strict=True)]
-    (tmp_path / "lab.csv").write_text("\n".join(lines) + "\n")
+    np.savetxt(tmp_path / "lab.csv", np.c_[t, v, y], delimiter=",", fmt="%.17g",
+               header="time_s,voltage_V,disp_um", comments="")
     model_json = tmp_path / "m.json"
     assert main(["identify", str(tmp_path / "lab.csv"), "--columns", "time_s,voltage_V,disp_um",
                  "--json", str(model_json), "--method", "conventional", "--plays", "3"]) == 0

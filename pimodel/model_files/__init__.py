@@ -11,6 +11,15 @@ A file: ``{"type": "PIOperator", "weights": [...], "radii": [...], "offset": 0.3
 "units": {"time": "s", "input": "V", "output": "um"}, "provenance": {"record": "lab.csv",
 "method": "adaptive", "date": "...", "pimodel_version": "..."}, "report": {...},
 "format_version": 2}`` (docs/model-files.md lists every type's keys).
+
+Examples
+--------
+>>> import os, tempfile
+>>> from pimodel import PIOperator
+>>> path = save_model(Model(PIOperator([1.0], [0.0]), offset=0.5),
+...                   os.path.join(tempfile.mkdtemp(), "m.json"))
+>>> load_model(path).simulate([1.0]).tolist()
+[1.5]
 """
 
 from __future__ import annotations

@@ -126,7 +126,8 @@ def save_model(model, path, *, offset: float | None = None, dt: float | None = N
     Parameters
     ----------
     model : object
-        A :class:`Model`, an operator, an inverse, a Cascade or a DiagnosedModel.
+        A :class:`Model`, an operator, an inverse, a Cascade, a DiagnosedModel or the result of
+        :func:`pimodel.identify` (its operator, offset, method and report).
     path : str or Path
         The JSON file to write (overwritten).
     offset, dt : float, optional
@@ -159,6 +160,10 @@ def save_model(model, path, *, offset: float | None = None, dt: float | None = N
     >>> d["type"], d["offset"], d["format_version"]
     ('CreepOperator', 0.5, 2)
     """
+    if not isinstance(model, Model) and callable(getattr(model, "to_json", None)) \
+            and hasattr(model, "operator") and hasattr(model, "offset"):  # identify's result
+        model = Model(model.operator, offset=model.offset, report=model.to_json(),
+                      provenance={"method": str(getattr(model, "method", ""))})
     m = model if isinstance(model, Model) else Model(model)
     m = Model(m.operator, offset=m.offset if offset is None else offset,
               dt=m.dt if dt is None else dt, units={**m.units, **(units or {})},

@@ -103,6 +103,12 @@ class Model:
         Returns
         -------
         dict
+
+        Examples
+        --------
+        >>> d = Model(PIOperator([2.0], [0.0]), offset=1.0, dt=1e-3).as_file_dict()
+        >>> d["type"], d["offset"], d["dt"], d["format_version"]
+        ('PIOperator', 1.0, 0.001, 2)
         """
         d = model_to_dict(self.operator)
         d.setdefault("offset", self.offset)
@@ -135,6 +141,11 @@ class Model:
         -------
         numpy.ndarray
             ``y[k]`` [output unit].
+
+        Examples
+        --------
+        >>> Model(PIOperator([2.0], [0.0]), offset=1.0).simulate([0.0, 0.5]).tolist()
+        [1.0, 2.0]
         """
         return np.asarray(self.operator.simulate(v, *args, **kwargs)) + self.added_offset
 
@@ -150,11 +161,23 @@ class Model:
         -------
         float
             ``y[k]``.
+
+        Examples
+        --------
+        >>> Model(PIOperator([2.0], [0.0]), offset=1.0).step(0.5)
+        2.0
         """
         return float(self.operator.step(v)) + self.added_offset
 
     def reset(self) -> None:
-        """Back to the operator's initial state."""
+        """Back to the operator's initial state.
+
+        Examples
+        --------
+        >>> m = Model(PIOperator([2.0], [0.0]), offset=1.0)
+        >>> m.step(0.5), m.reset(), m.step(0.0)
+        (2.0, None, 1.0)
+        """
         self.operator.reset()
 
     def inverse(self) -> ModelInverse:
@@ -163,6 +186,11 @@ class Model:
         Returns
         -------
         ModelInverse
+
+        Examples
+        --------
+        >>> Model(PIOperator([2.0], [0.0]), offset=1.0).inverse().simulate([1.0, 2.0]).tolist()
+        [0.0, 0.5]
         """
         return ModelInverse(self.operator.inverse(), self.added_offset)
 
@@ -177,6 +205,11 @@ class Model:
         Returns
         -------
         object
+
+        Examples
+        --------
+        >>> Model(PIOperator([2.0], [0.0]), offset=1.0).as_operator().output_envelope
+        Envelope('poly2', [1.0, 1.0, 0.0])
         """
         op, c = self.operator, self.added_offset
         if c == 0.0:
@@ -232,6 +265,11 @@ class ModelInverse:
         -------
         numpy.ndarray
             ``v[k]`` [input unit].
+
+        Examples
+        --------
+        >>> Model(PIOperator([2.0], [0.0]), offset=1.0).inverse().simulate([3.0]).tolist()
+        [1.0]
         """
         return np.asarray(self.operator.simulate(np.asarray(y_d, float) - self.offset,
                                                  *args, **kwargs))
@@ -248,11 +286,23 @@ class ModelInverse:
         -------
         float
             ``v[k]``.
+
+        Examples
+        --------
+        >>> Model(PIOperator([2.0], [0.0]), offset=1.0).inverse().step(3.0)
+        1.0
         """
         return float(self.operator.step(y_d - self.offset))
 
     def reset(self) -> None:
-        """Back to the inverse's initial state."""
+        """Back to the inverse's initial state.
+
+        Examples
+        --------
+        >>> inv = Model(PIOperator([2.0], [0.0]), offset=1.0).inverse()
+        >>> inv.step(3.0), inv.reset(), inv.step(1.0)
+        (1.0, None, 0.0)
+        """
         self.operator.reset()
 
     def __getattr__(self, name: str):
