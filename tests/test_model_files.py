@@ -288,7 +288,7 @@ def test_property_random_model_edits_load_and_simulate_finite_or_name_the_key(ca
 def test_csv_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_path):
     if shutil.which("cc") is None and shutil.which("gcc") is None:
         pytest.skip("no C compiler on PATH")
-    from pimodel.fmu.model_fmu import cosimulate_chain
+    from pimodel.fmu.model_fmu import build_model_fmus, cosimulate_chain
 
     rng = np.random.default_rng(32)
     stage = PIOperator(rng.uniform(0.3, 1.0, 3), [0.0, 0.15, 0.4])
@@ -310,7 +310,13 @@ def test_csv_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_pa
     fwd = [p for p in fwd if "Inverse" not in p.name]
     assert len(fwd) == 1, fwd
     vv = v[:400]
-    np.testing.assert_allclose(cosimulate_chain(fwd, vv, dt), m.simulate(vv), rtol=0, atol=1e-9)
+    yy = cosimulate_chain(fwd, vv, dt)
+    np.testing.assert_allclose(yy, m.simulate(vv), rtol=0, atol=1e-9)
+    # the feedforward with the offset: one FMU chain, y_d in, v out
+    inv = build_model_fmus(m.inverse().as_operator(), tmp_path / "inv", stem="inv")
+    np.testing.assert_allclose(cosimulate_chain(inv, yy, dt), m.inverse().simulate(yy), rtol=0,
+                               atol=1e-9)
+    np.testing.assert_allclose(cosimulate_chain(inv, yy, dt), vv, rtol=0, atol=1e-6)
 
 
 @pytest.mark.skip(reason="the .mat chain needs load_record on .mat files (issue 30's records "
@@ -318,3 +324,21 @@ def test_csv_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_pa
 def test_mat_chain_identify_fmu_build_equals_the_python_model_with_offset():
     """Place for the .mat variant: scipy.io.savemat the record of the CSV chain, then the same
     steps with ``pimodel identify lab.mat``."""
+
+
+def test_identify_result_saves_as_a_model_file_and_its_blocks_take_the_offset(tmp_path):
+    from pimodel import identify
+
+    rng = np.random.default_rng(7)
+    stage = PIOperator([1.0, 0.5], [0.0, 0.4])
+    offset = float(rng.uniform(1, 3))
+    v = 2 * np.sin(np.linspace(0, 6 * np.pi, 600))
+    idn = identify(v, stage.simulate(v) + offset, dt=1e-3, n_plays=2, passes=2)
+    m = load_model(save_model(idn, tmp_path / "idn.json", dt=1e-3))
+    assert m.offset == idn.offset and m.provenance["method"] == idn.method
+    assert m.report["n_plays"] == 2
+    y_d = m.simulate(v)
+    t = np.arange(v.size) * 1e-3
+    for ff in (inverse_pi_block(idn, 1e-3), inverse_pi_block(m)):
+        res = control.input_output_response(ff, t, y_d, initial_state=initial_state(ff))
+        np.testing.assert_allclose(res.outputs, v, rtol=0, atol=1e-9)

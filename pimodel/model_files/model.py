@@ -294,6 +294,26 @@ class ModelInverse:
         """
         return float(self.operator.step(y_d - self.offset))
 
+    def as_operator(self):
+        """One operator equal to :meth:`simulate`, for the FMU builders: the inverse itself, or
+        a Cascade of an offset stage (``y_d - offset``) and the inverse.
+
+        Returns
+        -------
+        object
+
+        Examples
+        --------
+        >>> inv = Model(PIOperator([2.0], [0.0]), offset=1.0).inverse().as_operator()
+        >>> inv.simulate([3.0]).tolist()
+        [1.0]
+        """
+        if self.offset == 0.0:
+            return self.operator
+        shift = GeneralizedPI([1.0], [0.0], output_envelope=Envelope.affine(1.0, -self.offset))
+        stages = self.operator.stages if isinstance(self.operator, Cascade) else (self.operator,)
+        return Cascade(shift, *stages)
+
     def reset(self) -> None:
         """Back to the inverse's initial state.
 
