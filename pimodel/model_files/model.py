@@ -192,7 +192,7 @@ class Model:
         >>> Model(PIOperator([2.0], [0.0]), offset=1.0).inverse().simulate([1.0, 2.0]).tolist()
         [0.0, 0.5]
         """
-        return ModelInverse(self.operator.inverse(), self.added_offset)
+        return ModelInverse(self.operator.inverse(), self.added_offset, self.operator)
 
     def as_operator(self):
         """One operator equal to :meth:`simulate`, for the FMU builders.
@@ -239,6 +239,8 @@ class ModelInverse:
         The operator's inverse.
     offset : float
         The model's added offset, subtracted from ``y_d`` first.
+    forward : object, optional
+        The forward operator (for :meth:`as_operator`).
 
     Examples
     --------
@@ -247,9 +249,10 @@ class ModelInverse:
     [0.0, 1.0]
     """
 
-    def __init__(self, inverse, offset: float) -> None:
+    def __init__(self, inverse, offset: float, forward=None) -> None:
         self.operator = inverse
         self.offset = float(offset)
+        self.forward = forward
 
     def simulate(self, y_d, *args, **kwargs) -> np.ndarray:
         """``v[k]`` for the desired outputs ``y_d[k]``.
@@ -295,8 +298,9 @@ class ModelInverse:
         return float(self.operator.step(y_d - self.offset))
 
     def as_operator(self):
-        """One operator equal to :meth:`simulate`, for the FMU builders: the inverse itself, or
-        a Cascade of an offset stage (``y_d - offset``) and the inverse.
+        """One operator equal to :meth:`simulate`, for the FMU builders: the inverse itself (no
+        offset); a PI operator's with an offset, the inverse of :meth:`Model.as_operator`
+        (a GeneralizedPI's exact inverse); another after an offset stage (a Cascade).
 
         Returns
         -------
@@ -308,8 +312,11 @@ class ModelInverse:
         >>> inv.simulate([3.0]).tolist()
         [1.0]
         """
+        op = self.operator
+        if type(self.forward) is PIOperator and self.offset != 0.0:
+            return Model(self.forward, offset=self.offset).as_operator().inverse()
         if self.offset == 0.0:
-            return self.operator
+            return op
         shift = GeneralizedPI([1.0], [0.0], output_envelope=Envelope.affine(1.0, -self.offset))
         stages = self.operator.stages if isinstance(self.operator, Cascade) else (self.operator,)
         return Cascade(shift, *stages)
@@ -326,6 +333,6 @@ class ModelInverse:
         self.operator.reset()
 
     def __getattr__(self, name: str):
-        if name.startswith("__") or name == "operator":
+        if name.startswith("__") or name in ("operator", "forward"):
             raise AttributeError(name)
         return getattr(self.operator, name)
