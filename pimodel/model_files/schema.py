@@ -64,6 +64,9 @@ EFFECT_PARAMS = {"creep": {"creep_lag_gains": "nums", "creep_time_constants_s": 
                                "center": "num", "half_range": "num+"},
                  "delay": {"delay_samples": "num0"},
                  "drift": {"drift_clock": "str", "drift_per_s": "num"}}
+# a DiagnosedModel's params that record what the diagnosis tried (not used to simulate): not
+# held to the finiteness check
+TRACE_PARAMS = ("dynamics_structures_tried", "dynamics_positions_tried")
 _EXPECT = {"num": "a finite number", "num+": "a finite number > 0", "num0": "a finite number >= 0",
            "nums": "a non-empty list of finite numbers",
            "nums0": "a non-empty list of finite numbers >= 0",
@@ -171,7 +174,7 @@ def _finite_leaves(value, where: str) -> None:
 
 def _diagnosed_params(d: dict, where: str) -> None:
     params = d["params"]
-    _finite_leaves(params, f"{where}.params")
+    _finite_leaves({k: v for k, v in params.items() if k not in TRACE_PARAMS}, f"{where}.params")
     for effect in d["effects"]:
         for key, kind in EFFECT_PARAMS.get(effect, {}).items():
             if key not in params:
