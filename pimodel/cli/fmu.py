@@ -60,7 +60,7 @@ def run_build(args: argparse.Namespace) -> int:
 
             stem = "".join(ch if ch.isalnum() else "_" for ch in Path(args.model).stem)
             stem = stem if stem[:1].isalpha() else f"m_{stem}"
-            from ..model_files.limits import check_fmu_limits
+            from ..model_files.fmu_limits import check_fmu_limits
 
             loaded = load_model(args.model)
             check_fmu_limits(loaded, args.model)

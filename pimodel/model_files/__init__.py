@@ -2,10 +2,11 @@
 
 Modules:
 
-schema  -- check_model_dict: types, ranges, finiteness, required and unknown keys, lengths
-codec   -- model_to_dict / model_from_dict: an operator's JSON form
-model   -- Model (operator + offset, sample time, units, provenance) and ModelInverse
-files   -- load_model / save_model / provenance
+schema      -- check_model_dict: types, ranges, finiteness, required and unknown keys, lengths
+codec       -- model_to_dict / model_from_dict: an operator's JSON form
+file_model  -- Model (operator + offset, sample time, units, provenance) and ModelInverse
+files       -- load_model / save_model / provenance
+fmu_limits  -- check_fmu_limits: the FMU's play limits ("at most N plays")
 
 A file: ``{"type": "PIOperator", "weights": [...], "radii": [...], "offset": 0.3, "dt": 0.005,
 "units": {"time": "s", "input": "V", "output": "um"}, "provenance": {"record": "lab.csv",
@@ -25,8 +26,8 @@ Examples
 from __future__ import annotations
 
 from .codec import model_from_dict, model_to_dict
+from .file_model import Model, ModelInverse
 from .files import load_model, provenance, save_model
-from .model import Model, ModelInverse
 from .schema import FORMAT_VERSION, check_model_dict
 
 __all__ = ["FORMAT_VERSION", "Model", "ModelInverse", "check_model_dict", "load_model",

@@ -130,7 +130,7 @@ def model_to_dict(model) -> dict:
     model : object
         A GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, PIOperator, one of
         their inverses, a Cascade of these, a DiagnosedModel or a
-        :class:`~pimodel.model_files.model.Model` (then with its offset and metadata).
+        :class:`~pimodel.model_files.file_model.Model` (then with its offset and metadata).
 
     Returns
     -------

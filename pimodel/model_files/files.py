@@ -15,7 +15,7 @@ import json
 import warnings
 from pathlib import Path
 
-from .model import Model
+from .file_model import Model
 
 __all__ = ["LEGACY_IDENTIFY_KEYS", "load_model", "provenance", "save_model"]
 

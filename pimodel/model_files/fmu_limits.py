@@ -53,7 +53,7 @@ def check_fmu_limits(model, path=None) -> None:
     Parameters
     ----------
     model : object
-        A :class:`~pimodel.model_files.model.Model` or an operator.
+        A :class:`~pimodel.model_files.file_model.Model` or an operator.
     path : str or Path, optional
         The model file, for the message.
 
