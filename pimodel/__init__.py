@@ -70,29 +70,6 @@ import sys as _sys
 import types as _types
 
 from ._deprecated import install as _install_deprecated_paths
-from .identification.adaptive.joint import (
-    JointEstimate,
-    JointEstimator,
-    estimate_jointly,
-    stream_jointly,
-)
-from .identification.adaptive.radius_estimator import (
-    RadiusEstimate,
-    RadiusEstimator,
-    estimate_radii,
-)
-from .identification.chain import Identification, identify
-from .identification.conventional import fit_conventional
-from .identification.identifiability import check_excitation
-from .identification.slopes import identify_slopes
-from .operators.asymmetric import AsymmetricPI
-from .operators.cascade import Cascade
-from .operators.creep import CreepOperator
-from .operators.generalized import GeneralizedPI
-from .operators.pi import PIOperator, TimeDependentPI
-from .operators.rate_dependent import RateDependentPI
-from .records import Record, load_record, save_record
-from .reference.operators import pi_reference, play_reference
 
 __all__ = [
     "AsymmetricPI",
@@ -126,9 +103,33 @@ __all__ = [
 ]
 __version__ = "0.1.0"
 
-# Heavy or higher-layer names, imported on first use (``import pimodel`` stays light, so that
-# ``pimodel --help`` is quick): name -> module.
+# Every public name is imported on first use (``import pimodel`` loads no NumPy, so that
+# ``pimodel --help`` and ``--version`` are quick): name -> module.
 _LAZY = {
+    "JointEstimate": "pimodel.identification.adaptive.joint",
+    "JointEstimator": "pimodel.identification.adaptive.joint",
+    "estimate_jointly": "pimodel.identification.adaptive.joint",
+    "stream_jointly": "pimodel.identification.adaptive.joint",
+    "RadiusEstimate": "pimodel.identification.adaptive.radius_estimator",
+    "RadiusEstimator": "pimodel.identification.adaptive.radius_estimator",
+    "estimate_radii": "pimodel.identification.adaptive.radius_estimator",
+    "Identification": "pimodel.identification.chain",
+    "identify": "pimodel.identification.chain",
+    "fit_conventional": "pimodel.identification.conventional",
+    "check_excitation": "pimodel.identification.identifiability",
+    "identify_slopes": "pimodel.identification.slopes",
+    "AsymmetricPI": "pimodel.operators.asymmetric",
+    "Cascade": "pimodel.operators.cascade",
+    "CreepOperator": "pimodel.operators.creep",
+    "GeneralizedPI": "pimodel.operators.generalized",
+    "PIOperator": "pimodel.operators.pi",
+    "TimeDependentPI": "pimodel.operators.pi",
+    "RateDependentPI": "pimodel.operators.rate_dependent",
+    "Record": "pimodel.records",
+    "load_record": "pimodel.records",
+    "save_record": "pimodel.records",
+    "pi_reference": "pimodel.reference.operators",
+    "play_reference": "pimodel.reference.operators",
     "diagnose": "pimodel.diagnosis.diagnose",
     "DiagnosisReport": "pimodel.diagnosis.diagnose",
     "load_model": "pimodel.model_files",

@@ -356,7 +356,8 @@ class DiagParams(ctypes.Structure):
                 ("rate_tau", c_double), ("order", c_size),
                 ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
                 ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
-                ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP)]
+                ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP),
+                ("plays_start", c_int)]
 
 
 _check_layout(DiagParams, "pim_diag")

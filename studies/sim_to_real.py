@@ -1,11 +1,18 @@
-"""Study: sim-to-real gap diagnosis with withheld effects on two generators (confusion tables)
-and on the shared real piezo record.
+"""Study: sim-to-real gap diagnosis with withheld effects on three generators (confusion
+tables) and on the shared real piezo record.
 
-Generators: ``pimodel.stages.pi_stage`` (PI hysteresis, the same model family as the candidates) and
-the independently written ``pimodel.stages.preisach_stage`` (Preisach hysteresis, log-law creep, two
-modes, exponential static map, coloured noise; also effects outside the vocabulary that must come
-back "unexplained"). The diagnosis never sees the effect's name. Full size: 10 seeds per case;
-``--quick``: 1 seed, single effects only.
+Generators: ``pimodel.stages.pi_stage`` (PI hysteresis, the same model family as the
+candidates), the independently written ``pimodel.stages.preisach_stage`` (Preisach hysteresis,
+log-law creep, two modes, exponential static map, coloured noise; also effects outside the
+vocabulary that must come back "unexplained") and, at full size only, the third, independent
+``pimodel.stages.density_stage`` (2 kHz; a smooth PI density of many plays; random-phase
+multisines, log chirps, ramps to held levels, band-limited random input; creep with lags up to
+100 s, thermal settling on the shared clock, a mode plus a real pole, radii growing with a
+low-passed rate, a quadratic output map; outside the vocabulary: output clipping, an unmeasured
+second input, a sensor gain differing between records). Its clean stage is run on every input
+kind (``kind``: ``mixed`` or one of ``INPUT_KINDS``). The diagnosis never sees the effect's
+name. Full size: 10 seeds per case; ``--quick``: 1 seed, single effects only, no
+``density`` cases.
 
 A case ``offset`` adds a level of its own to each record (a sensor zeroed anew between
 records; train at 0, validate at +-0.05 to 0.2 um, seeded) to an otherwise clean stage: the
@@ -37,6 +44,10 @@ PAIRS = ((("rate", "creep"), "record"), (("delay", "drift"), "record"),
          (("asymmetry", "drift"), "absolute"))
 OUTSIDE = ("dead_zone", "second_input", "bouc_wen")  # truth_alt only: expect "unexplained"
 OFFSET = (("offset",), "record")  # a level per record (module docstring), found as "drift"
+DENSITY_PAIRS = (("creep", "delay"), ("dynamics", "asymmetry"), ("rate", "drift"),
+                 ("creep", "dynamics", "delay"))
+DENSITY_OUTSIDE = ("clipping", "second_input", "sensor_gain")  # density only: "unexplained"
+DENSITY_KINDS = ("mixed", "multisine", "chirp", "ramps", "random")  # clean stage on each
 
 
 def cases(quick: bool) -> list[dict]:
@@ -52,7 +63,22 @@ def cases(quick: bool) -> list[dict]:
             for seed in seeds:
                 out.append({"generator": gen, "effects": list(effects), "drift_clock": clock,
                             "seed": seed})
-    return out
+    return out + ([] if quick else density_cases(quick))
+
+
+def density_cases(quick: bool, seeds=None) -> list[dict]:
+    """The cases of the ``density`` generator: a clean stage on every input kind, each single
+    effect, ``DENSITY_PAIRS`` and ``DENSITY_OUTSIDE`` (``quick``: one seed, the clean stage on
+    the mixed input and the single effects; :func:`cases` adds them at full size only).
+    ``seeds`` overrides the seeds."""
+    seeds = range(1 if quick else 10) if seeds is None else seeds
+    groups = [((), k) for k in (DENSITY_KINDS[:1] if quick else DENSITY_KINDS)]
+    groups += [((e,), "mixed") for e in SINGLE]
+    if not quick:
+        groups += [(p, "mixed") for p in DENSITY_PAIRS]
+        groups += [((e,), "mixed") for e in DENSITY_OUTSIDE]
+    return [{"generator": "density", "effects": list(effects), "drift_clock": "absolute",
+             "kind": kind, "seed": seed} for effects, kind in groups for seed in seeds]
 
 
 def _records(case: dict):
@@ -67,6 +93,11 @@ def _records(case: dict):
 
 def _stage_records(case: dict):
     seed, effects, clock = case["seed"], case["effects"], case["drift_clock"]
+    if case["generator"] == "density":
+        from pimodel.stages.density_stage import density_records
+
+        train, validate = density_records(effects, seed, case["kind"])
+        return [train], [validate], "rest"
     if case["generator"] == "truth":
         from pimodel.stages.pi_stage import excitation, random_truth
 
@@ -88,7 +119,7 @@ def _stage_records(case: dict):
 def expected(case: dict) -> list[str]:
     """The right verdict: the withheld effects, "unexplained" for effects outside the
     vocabulary, "none" for a clean stage, "drift" for levels that differ by record."""
-    if set(case["effects"]) & set(OUTSIDE):
+    if set(case["effects"]) & (set(OUTSIDE) | set(DENSITY_OUTSIDE)):
         return ["unexplained"]
     return sorted({"drift" if e == "offset" else e for e in case["effects"]}) or ["none"]
 
@@ -109,8 +140,10 @@ def run_case(case: dict) -> dict:
 def group_name(row: dict) -> str:
     """Name of a case group: the withheld effects (and the drift's clock)."""
     key = "+".join(row["effects"]).replace("offset", "record offsets") or "none (clean)"
-    if "drift" in row["effects"]:
+    if "drift" in row["effects"] and row["generator"] != "density":
         key += f" [{row['drift_clock']} clock]"
+    if row["generator"] == "density" and not row["effects"]:
+        key += f" [{row['kind']} input]"
     return key
 
 
@@ -161,7 +194,10 @@ def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) ->
     (out / "cases.json").write_text(json.dumps(rows, indent=1, default=float))
     for gen, title in (("truth", "pimodel.stages.pi_stage (PI family)"),
                        ("truth_alt", "pimodel.stages.preisach_stage (independent: Preisach, "
-                                     "log creep, two modes, coloured noise)")):
+                                     "log creep, two modes, coloured noise)"),
+                       ("density", "pimodel.stages.density_stage (independent: 2 kHz, smooth PI "
+                                   "density, multisine/chirp/ramps/random input, thermal "
+                                   "settling, mode + pole)")):
         res.tables.append(Table(f"Withheld effects, {title}: right verdicts / cases, "
                                 "validate-gap shrink, verdicts",
                                 ["truth", "right", "min shrink", "median shrink", "verdicts"],

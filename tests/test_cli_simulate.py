@@ -48,7 +48,7 @@ def test_simulate_errors_are_clear(tmp_path, capsys):
     code = main(["simulate", str(tmp_path / "bad.csv"), "--weights", "1", "--radii", "0",
                  "--out", str(tmp_path / "o.csv")])
     assert code == 2
-    assert "row 2, column 'v'" in capsys.readouterr().err
+    assert "line 3 (data row 2), column 'v'" in capsys.readouterr().err
     code = main(["simulate", str(tmp_path / "bad.csv"), "--weights", "1,2", "--radii", "0",
                  "--out", str(tmp_path / "o.csv")])
     assert code == 2

@@ -38,10 +38,10 @@ def test_selectable_column_names(tmp_path):
 @pytest.mark.parametrize(
     ("text", "match"),
     [
-        ("t,v,y\n0,1,2\n0.1,abc,3\n", r"row 2, column 'v': 'abc' is not a number"),
-        ("t,v,y\n0,1,2\n0.1,2\n", "row 2 has 2 fields, expected 3"),
-        ("t,v,y\n0,1,2\n0.1,nan,3\n", r"row 2, column 'v': value nan is not a finite number"),
-        ("t,v,y\n0,1,2\n0,2,3\n", r"row 2, column 't': time 0.0 does not increase strictly"),
+        ("t,v,y\n0,1,2\n0.1,abc,3\n", r"line 3 \(data row 2\), column 'v': 'abc' is not a number"),
+        ("t,v,y\n0,1,2\n0.1,2\n", r"line 3 \(data row 2\) has 2 fields, expected 3"),
+        ("t,v,y\n0,1,2\n0.1,nan,3\n", r"line 3 \(data row 2\), column 'v': value nan is not"),
+        ("t,v,y\n0,1,2\n0,2,3\n", r"line 3 \(data row 2\), column 't': time 0.0 does not increase"),
         ("t,v,y\n0,1,2\n", "at least two samples are needed, got 1"),
         ("t,v,y\n", "at least two samples are needed, got 0"),
         ("", "empty file, expected a header line"),
@@ -59,7 +59,7 @@ def test_malformed_csv(tmp_path, text, match):
 def test_user_column_names_in_errors(tmp_path):
     path = tmp_path / "bad.csv"
     path.write_text("time,U,x\n0,1,2\n0.1,inf,3\n")
-    with pytest.raises(DataError, match="row 2, column 'U'"):
+    with pytest.raises(DataError, match=r"line 3 \(data row 2\), column 'U'"):
         load_record(path, columns=("time", "U", "x"))
 
 

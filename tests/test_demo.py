@@ -36,3 +36,28 @@ def test_demo_chain(tmp_path, capsys):
     assert res["fmu"]["max_abs_difference_um"] < 1e-9
     assert res["diagnose"]["effects"] == ["creep"]
     assert res["diagnose"]["shrink"] >= 0.5
+    _readme_table_matches(res)
+
+
+def _readme_table_matches(res: dict) -> None:
+    """The README's demo table shows this run's figures (to their printed rounding, plus a
+    margin for floating-point differences between machines)."""
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    row = re.search(r"\| diagnose \(stage with unmodelled creep\) \| verdict `(\w+)`, validate "
+                    r"RMS ([\d.]+) -> ([\d.]+) um \(shrink (\d+) %\) \|", readme)
+    assert row is not None, "README: the demo table's diagnose row is missing"
+    diag = res["diagnose"]
+    assert [row[1]] == diag["effects"]
+    assert abs(float(row[2]) - diag["gap_before"]) <= 0.0015
+    assert abs(float(row[3]) - diag["gap_after"]) <= 0.0015
+    assert abs(int(row[4]) - 100 * diag["shrink"]) <= 3  # percentage points
+    ident = re.search(r"adaptive n = 4: held-out RMS ([\d.]+) % / max ([\d.]+) % of range; "
+                      r"conventional n = 10: ([\d.]+) % / ([\d.]+) %", readme)
+    assert ident is not None, "README: the demo table's identify row is missing"
+    ada, conv = res["identify"]["adaptive (slopes + radii)"], res["identify"]["conventional n=10"]
+    values = (ada["heldout_rms_percent"], ada["heldout_max_percent"],
+              conv["heldout_rms_percent"], conv["heldout_max_percent"])
+    for text, value in zip(ident.groups(), values, strict=True):
+        assert abs(float(text) - value) <= 0.2 * value + 1e-4, (text, value)

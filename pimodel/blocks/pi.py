@@ -38,6 +38,7 @@ from ..identification.adaptive.radius_estimator import (
     EST_WINDOW,
     RadiusEstimator,
 )
+from ..operators.base import check_finite
 from ..operators.pi import PIOperator
 from .framework import (
     Block,
@@ -126,6 +127,8 @@ class _Stepper:
             raise ValueError(f"v: input sample is {v!r}; expected a finite number")
         self._z[:] = x
         y = _raw_pi_step(self.n, self._p, self._r, self._zp, v)
+        if not math.isfinite(y):  # the numerical-range rule (pimodel.operators.base)
+            check_finite(np.array([y]), np.array([v]), "v", state=self._z)
         return y, self._z.copy()
 
 

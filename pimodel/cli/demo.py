@@ -5,15 +5,18 @@ from __future__ import annotations
 import argparse
 
 __all__ = [
+    "HELP",
     "register",
     "run",
 ]
+
+HELP = "run the headline chain on the embedded piezo-like stage"
 
 
 def register(sub) -> None:
     p = sub.add_parser(
         "demo",
-        help="run the headline chain on the embedded piezo-like stage",
+        help=HELP,
         description="Run the headline chain on the embedded piezo-like stage and write a "
         "one-page Markdown report with figures; prints the report's path.",
     )

@@ -6,14 +6,16 @@ import argparse
 import json
 from pathlib import Path
 
-from ..records import load_record
-from .common import add_columns_option, refuse_overwrite
+from .common import add_columns_option, load_inputs, refuse_overwrite
 
 __all__ = [
+    "HELP",
     "export_models",
     "register",
     "run",
 ]
+
+HELP = "diagnose the gap between a PI model and measured records"
 
 EXPORT_FILES = ("augmented.json", "nominal.json", "nominal.model.json",
                 "augmented_1_DiagnosedModel.fmu", "nominal_1_DiagnosedModel.fmu",
@@ -23,7 +25,7 @@ EXPORT_FILES = ("augmented.json", "nominal.json", "nominal.model.json",
 def register(sub) -> None:
     p = sub.add_parser(
         "diagnose",
-        help="diagnose the gap between a PI model and measured records",
+        help=HELP,
         description="Fit a PI model on the --train records, measure the residual on the "
         "--validate records (never used for fitting), rank where it concentrates, test the "
         "candidate effects (creep, dynamics, delay, asymmetry, drift, rate) and report how far "
@@ -50,6 +52,9 @@ def register(sub) -> None:
                    "nominal.model.json is the nominal model as an operator (GeneralizedPI)")
     p.add_argument("--no-fmu", action="store_true",
                    help="with --export: write the JSON files only (no C compiler needed)")
+    p.add_argument("--report", default=None, metavar="DIR",
+                   help="write report.md (the summary in words, the figures, the numbers, "
+                   "each effect alone, where the gap lies, hints) and its figures here")
     add_columns_option(p)
     p.set_defaults(func=run)
 
@@ -62,8 +67,13 @@ def run(args: argparse.Namespace) -> int:
     refuse_overwrite({"--train": args.train, "--validate": args.validate},
                      {"--json": args.json, **exported}, {"--plots": args.plots,
                                                          "--export": args.export})
-    train = [load_record(f, columns=args.columns) for f in args.train]
-    validate = [load_record(f, columns=args.columns) for f in args.validate]
+    if args.report:
+        refuse_overwrite({"--train": args.train, "--validate": args.validate},
+                         {"--report report.md": str(Path(args.report) / "report.md")},
+                         {"--report": args.report})
+    inputs = args.train + args.validate
+    train = load_inputs(args, args.train, inputs)
+    validate = load_inputs(args, args.validate, inputs)
     rep = diagnose(train, validate, initial_state=args.initial_state)
     rep.save_json(args.json)
     if args.plots:
@@ -75,6 +85,11 @@ def run(args: argparse.Namespace) -> int:
     print(json.dumps({k: v[k] for k in ("effects", "gap_before", "gap_after", "shrink",
                                         "noise_floor", "noise_floor_method")}, indent=1))
     print(f"wrote {args.json}")
+    from ..diagnosis.summary import summarize, write_report
+
+    print(summarize(rep))
+    if args.report:
+        print(f"wrote {write_report(rep, args.report)}")
     if args.export:
         for path in export_models(rep, args.export, fmu=not args.no_fmu):
             print(f"wrote {path}")
@@ -84,11 +99,41 @@ def run(args: argparse.Namespace) -> int:
 def export_models(rep, out_dir, *, fmu: bool = True) -> list:
     """Write ``augmented.json``, ``nominal.json``, ``nominal.model.json`` (operator JSON) and,
     with ``fmu``, both models' FMUs (unit DiagnosedModel) and their feedforwards' (unit
-    DiagnosedInverse) into ``out_dir``; returns the paths written."""
-    from ..model_files import save_model
+    DiagnosedInverse) into ``out_dir``; returns the paths written.
+
+    The files are made in a temporary folder beside ``out_dir`` and moved in at the end, so an
+    interrupted export leaves ``out_dir`` as it was; the files of an earlier export that this
+    one does not write (e.g. FMUs, with ``fmu=False``) are removed, so the folder never mixes
+    two runs. While the files move, ``out_dir/EXPORT_INCOMPLETE`` marks the folder.
+    """
+    import shutil
+    import tempfile
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+    try:
+        made = _write_exports(rep, tmp, fmu)
+        marker = out / "EXPORT_INCOMPLETE"
+        marker.write_text("an export into this folder was interrupted; rerun pimodel diagnose "
+                          "--export\n")
+        for name in EXPORT_FILES:
+            if not (tmp / name).exists():
+                (out / name).unlink(missing_ok=True)
+        paths = []
+        for path in made:
+            target = out / Path(path).name
+            Path(path).replace(target)
+            paths.append(target)
+        marker.unlink()
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return paths
+
+
+def _write_exports(rep, out: Path, fmu: bool) -> list:
+    from ..model_files import save_model
+
     aug, nom = rep.model(augmented=True), rep.model(augmented=False)
     made = {"method": "diagnose"}
     paths = [save_model(aug, out / "augmented.json", source=made),

@@ -5,13 +5,16 @@ from __future__ import annotations
 import argparse
 
 __all__ = [
+    "HELP",
     "register",
     "run_build",
 ]
 
+HELP = "build the FMI 2.0 / 3.0 co-simulation FMUs"
+
 
 def register(sub) -> None:
-    p = sub.add_parser("fmu", help="build the FMI 2.0 / 3.0 co-simulation FMUs",
+    p = sub.add_parser("fmu", help=HELP,
                        description="FMU tools: 'pimodel fmu build --out DIR'.")
     fsub = p.add_subparsers(dest="fmu_command", metavar="ACTION")
     fsub.required = True

@@ -4,25 +4,26 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 
-from ..records import load_record
-from .common import add_columns_option, float_list, refuse_overwrite
+from .common import add_columns_option, float_list, load_inputs, refuse_overwrite
 
 __all__ = [
+    "HELP",
     "register",
     "run",
 ]
+
+HELP = "identify a PI model from a measured record"
 
 
 def register(sub) -> None:
     p = sub.add_parser(
         "identify",
-        help="identify a PI model from a measured record",
+        help=HELP,
         description="Identify y = PI[v] + offset from DATA: number and weights of plays from "
         "the loop slopes, radii from the adaptive estimator (or the conventional baseline).",
     )
-    p.add_argument("data", help="record (CSV with header, or NPZ)")
+    p.add_argument("data", help="record (CSV with header, NPZ or MATLAB .mat)")
     p.add_argument("--json", required=True,
                    help="output model file (pimodel.model_files: the PI operator, its offset, "
                    "sample time, units, provenance and the fit report)")
@@ -50,13 +51,14 @@ def _save_model_file(idn, rec, args: argparse.Namespace) -> None:
     from pathlib import Path
 
     from ..model_files import Model, save_model
+    from .common import columns_for
 
-    tcol, vcol, ycol = args.columns
+    tcol, vcol, ycol = columns_for(args, args.data)
     units = {k: u for k, u in (("time", _unit(tcol) or "s"), ("input", _unit(vcol)),
                                ("output", _unit(ycol))) if u}
     Path(args.json).parent.mkdir(parents=True, exist_ok=True)
     save_model(Model(idn.operator, offset=idn.offset, dt=rec.dt, units=units), args.json,
-               source={"record": str(args.data), "columns": list(args.columns),
+               source={"record": str(args.data), "columns": [tcol, vcol, ycol],
                        "method": idn.method}, report=idn.to_json())
 
 
@@ -64,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     from ..identification.chain import identify
 
     refuse_overwrite({"DATA": [args.data]}, {"--json": args.json}, {"--plots": args.plots})
-    rec = load_record(args.data, columns=args.columns)
+    (rec,) = load_inputs(args, [args.data])
     gains = None
     if args.gains is not None:
         gains = args.gains[0] if len(args.gains) == 1 else args.gains
@@ -78,8 +80,6 @@ def run(args: argparse.Namespace) -> int:
             print(f"figure: {path}")
     print(json.dumps({k: idn.to_json()[k] for k in ("method", "weights", "radii", "fit")},
                      indent=1))
-    if idn.health is not None and not idn.health.ok:
-        for msg in idn.health.messages:
-            print(f"warning: radius estimate: {msg}", file=sys.stderr)
+    # a failed health check is identify()'s UserWarning, printed once by the CLI
     print(f"wrote {args.json}")
     return 0

@@ -4,26 +4,27 @@ from __future__ import annotations
 
 import argparse
 
-from ..operators.pi import PIOperator
-from ..records import Record, load_record, save_record
-from .common import add_columns_option, float_list, refuse_overwrite, unique_name
+from .common import add_columns_option, float_list, load_inputs, refuse_overwrite, unique_name
 
 __all__ = [
+    "HELP",
     "register",
     "run",
 ]
+
+HELP = "run a PI operator on a record's input"
 
 
 def register(sub) -> None:
     p = sub.add_parser(
         "simulate",
-        help="run a PI operator on a record's input",
+        help=HELP,
         description="Run y = PI[v] on the input column of DATA (CSV or NPZ) and write a record "
         "t,v,y (y = model output; the measured output, if any, is kept as 'y_measured'; a "
         "new column whose name the input already uses gets a suffix _1, _2, ... with a "
         "warning). The output file must not be the input file.",
     )
-    p.add_argument("data", help="input record (CSV with header, or NPZ)")
+    p.add_argument("data", help="input record (CSV with header, NPZ or MATLAB .mat)")
     p.add_argument("--model", default=None, metavar="MODEL.json",
                    help="a model file (pimodel identify --json, save_model): its operator and "
                    "offset, instead of --weights and --radii")
@@ -39,12 +40,15 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..operators.pi import PIOperator
+    from ..records import Record, save_record
+
     if (args.model is None) == (args.weights is None or args.radii is None) or \
             (args.model is not None and (args.weights or args.radii)):
         raise ValueError("give either --model or both --weights and --radii")
     refuse_overwrite({"DATA": [args.data], "--model": [args.model] if args.model else []},
                      {"--out": args.out})
-    rec = load_record(args.data, columns=args.columns, output_required=False)
+    (rec,) = load_inputs(args, [args.data], output_required=False)
     if args.model is not None:
         from ..model_files import load_model
 
@@ -60,6 +64,6 @@ def run(args: argparse.Namespace) -> int:
     if rec.has_output:
         extra = {unique_name("y_measured", taken + names): rec.y, **extra}
     out = Record(rec.t, rec.v, y, extra, source=args.out)
-    save_record(out, args.out, columns=tuple(names))
-    print(f"wrote {len(out)} samples to {args.out}")
+    written = save_record(out, args.out, columns=tuple(names))  # exactly args.out
+    print(f"wrote {len(out)} samples to {written}")
     return 0

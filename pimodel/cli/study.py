@@ -8,9 +8,12 @@ import time
 from pathlib import Path
 
 __all__ = [
+    "HELP",
     "register",
     "run",
 ]
+
+HELP = "run a study (figures and results tables into an output folder)"
 
 
 def register(sub) -> None:
@@ -19,7 +22,7 @@ def register(sub) -> None:
     names = ", ".join(available_studies()) or "none found"
     p = sub.add_parser(
         "study",
-        help="run a study (figures and results tables into an output folder)",
+        help=HELP,
         description=f"Run a study from studies/ and write its figures (PNG) and results "
         f"(Markdown and JSON) to an output folder. A sweep study maps its cases on Dask "
         f"(--workers, --scheduler) and keeps each finished case in OUT/cases, so a rerun "
@@ -36,7 +39,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..experiments.studies import available_studies, run_study
-    from ..experiments.sweeps import CaseFailed
+    from ..experiments.sweeps import CaseFailed, Interrupted
 
     if args.list or not args.name:
         for name in available_studies():
@@ -48,14 +51,20 @@ def run(args: argparse.Namespace) -> int:
         if args.out:
             out = Path(args.out) / name if args.name == "all" else Path(args.out)
         t0 = time.perf_counter()
+        counts: dict = {}
         try:
             result = run_study(name, out, quick=args.quick, workers=args.workers,
                                scheduler=args.scheduler, fresh=args.fresh,
-                               memory_limit=args.memory_limit)
+                               memory_limit=args.memory_limit, counts=counts)
         except CaseFailed as exc:
             print(f"pimodel study: error in study {name}: {exc}", file=sys.stderr)
             return 1
+        except Interrupted as exc:
+            print(f"pimodel study {name}: {exc}", file=sys.stderr)
+            return 130
         print(result.to_markdown())
+        cases = (f"{counts['reused']} cases reused, {counts['computed']} computed; "
+                 if counts else "")
         print(f"study {name}: results in {Path(out or Path('out') / 'studies' / name).resolve()}"
-              f" ({time.perf_counter() - t0:.1f} s)")
+              f" ({cases}{time.perf_counter() - t0:.1f} s)")
     return 0

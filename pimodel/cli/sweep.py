@@ -9,11 +9,16 @@ import sys
 import time
 from pathlib import Path
 
+from .common import check_outputs
+
 __all__ = [
+    "HELP",
     "build_cases",
     "register",
     "run",
 ]
+
+HELP = "sweep the truth simulator and diagnosis/identification settings (tidy table)"
 
 
 def _value(text: str):
@@ -57,7 +62,7 @@ def register(sub) -> None:
 
     p = sub.add_parser(
         "sweep",
-        help="sweep the truth simulator and diagnosis/identification settings (tidy table)",
+        help=HELP,
         description="Run the diagnosis or the identification on records of the truth simulator "
         "over a grid (--grid) or a random sample (--random) of parameters, on a local Dask "
         "cluster or a given scheduler, and write OUT/table.csv (one row per case; "
@@ -112,18 +117,25 @@ def build_cases(args: argparse.Namespace) -> list[dict]:
 
 def run(args: argparse.Namespace) -> int:
     from ..experiments.stage_sweeps import truth_sweep
-    from ..experiments.sweeps import DEFAULT_MEMORY_LIMIT, CaseFailed
+    from ..experiments.sweeps import DEFAULT_MEMORY_LIMIT, CaseFailed, Interrupted
 
     cases = build_cases(args)
     out = Path(args.out or Path("out") / "sweeps" / args.target)
+    check_outputs({"--table": str(out / args.table)}, {"--out": str(out)})
     t0 = time.perf_counter()
+    counts: dict = {}
     try:
         rows = truth_sweep(cases, target=args.target, out=out, table=args.table,
                            workers=args.workers, scheduler=args.scheduler, fresh=args.fresh,
-                           memory_limit=args.memory_limit or DEFAULT_MEMORY_LIMIT)
+                           memory_limit=args.memory_limit or DEFAULT_MEMORY_LIMIT,
+                           counts=counts)
     except CaseFailed as exc:
         print(f"pimodel sweep: error: {exc}", file=sys.stderr)
         return 1
-    print(f"sweep {args.target}: {len(rows)} cases in {time.perf_counter() - t0:.1f} s; "
-          f"table {(out / args.table).resolve()}")
+    except Interrupted as exc:
+        print(f"pimodel sweep: {exc}", file=sys.stderr)
+        return 130
+    print(f"sweep {args.target}: {len(rows)} cases ({counts['reused']} reused from "
+          f"{out / 'cases'}, {counts['computed']} computed) in "
+          f"{time.perf_counter() - t0:.1f} s; table {(out / args.table).resolve()}")
     return 0

@@ -23,6 +23,7 @@ Modules
     noise               the measurement-noise floor of the records
     where               regions, bands and correlations of the residual
     plots               the figures of a report
+    summary             the report in words (verdict, how sure, where, next step) and report.md
     model               DiagnosedModel and DiagnosedInverse: the chosen model, batch forms
     monotone            the nearest monotone PI weights (what the inverse solves)
     native_model        the model streamed on the C core: its block, runner and FMU values

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..operators.pi import PIOperator
+from .creep import creep_time_constants
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 from .filters import lag, mode, mode_coefficients, mode_rows, shift
 from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
@@ -36,7 +37,6 @@ __all__ = [
     "shift",
 ]
 
-CREEP_TAUS = (0.003, 0.03, 0.3, 3.0)  # s, one lag per decade
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
 MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
@@ -134,8 +134,14 @@ class Segment:
         return rows[:n if ncols is None else min(ncols, n)]
 
 
-def make_segment(t, v, y, radii, mask=None) -> Segment:
-    """Segment of one record with the play outputs of ``radii`` (play states start at 0).
+def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
+    """Segment of one record with the play outputs of ``radii``, the plays at rest at ``v[0]``.
+
+    The play states before the first sample are ``z_i[-1] = v[0]`` (the diagnosis' ``"rest"``
+    convention): a record that starts away from 0 starts with every play in its interior, not
+    with the large plays held at 0 until the input has travelled past their radius. With
+    ``at_rest=False`` they are 0 (the memory of a record cut from periodic motion near an
+    extreme, where the plays sit near ``v[0] -+ r``).
 
     Parameters
     ----------
@@ -149,6 +155,8 @@ def make_segment(t, v, y, radii, mask=None) -> Segment:
         Play radii of the grid [input units], ``n`` of them.
     mask : numpy.ndarray or None
         Samples fitted and scored (see :class:`Segment`); None: all.
+    at_rest : bool
+        Plays at rest at ``v[0]`` (default); False: at 0.
 
     Returns
     -------
@@ -162,7 +170,9 @@ def make_segment(t, v, y, radii, mask=None) -> Segment:
     >>> seg.Z.tolist()
     [[0.0, 0.0], [1.0, 0.5], [0.5, 0.5], [0.0, 0.5]]
     """
-    Z = PIOperator(np.ones(len(radii)), radii).play_outputs(v)
+    v = np.asarray(v, float)
+    z0 = float(v[0]) if at_rest else 0.0
+    Z = PIOperator(np.ones(len(radii)), radii, initial_state=z0).play_outputs(v)
     return Segment(t, v, y, Z, mask)
 
 
@@ -339,8 +349,9 @@ def fit_nominal(train) -> Model:
     -------
     Model
         Named ``"nominal"``, ``k = 0``; ``params`` holds the ``center`` and ``half_range`` of
-        its output, ``slope_sum`` (sum of the play weights) and ``rate_scale`` (95th
-        percentile of the moving input rate [input units / s]).
+        its output, ``slope_sum`` (sum of the play weights), ``rate_scale`` (95th
+        percentile of the moving input rate [input units / s]) and ``creep_taus`` (the creep
+        candidate's lags for these records, :func:`.creep.creep_time_constants`).
 
     Examples
     --------
@@ -359,7 +370,9 @@ def fit_nominal(train) -> Model:
     moving = rate[rate > 1e-9 * (float(np.ptp(rate)) or 1.0)]
     model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
                     "slope_sum": float(np.sum(model.coef[:-1])),
-                    "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0}
+                    "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0,
+                    "creep_taus": creep_time_constants(
+                        train[0].dt, max(float(s.t[-1] - s.t[0]) for s in train))}
     return model
 
 
@@ -395,8 +408,8 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
     >>> v = np.sin(np.linspace(0.0, 6 * np.pi, 300))
     >>> seg = make_segment(np.arange(300) * 1e-3, v, 2.0 * v, [0.0, 0.3])
     >>> m = fit_effect("creep", [seg])
-    >>> m.name, m.k, len(m.params["creep_lag_gains"])
-    ('creep', 4, 4)
+    >>> m.name, m.k, m.params["creep_time_constants_s"]  # lags for 0.3 s at 1 kHz
+    ('creep', 2, [0.03, 0.3])
     """
     return _fit_combo((*combo, name), train, dict(fixed or {}), nominal or fit_nominal(train))
 
@@ -431,7 +444,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
     the grid optimum, then refitted with every play column."""
     name = "+".join(effects)
-    k = _combo_k(effects) + (drift_k(fixed) - 1 if "drift" in effects else 0)  # + levels
+    k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
     static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
@@ -550,7 +563,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     p = best[0].params  # the grid optimum, refitted with every play column
     k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too
     if p.get("wiener"):  # a filter's parameters instead of the base mode's two
-        k_all += wiener_k(p["wiener"]) - _combo_k(("dynamics",))
+        k_all += wiener_k(p["wiener"]) - _combo_k(("dynamics",), nominal)
     model, rss = _fit(name, k_all, _combo_features(effects, p, nominal, static), train, p)
     if effects == ("dynamics",) and not dyn_fixed and all(s.wiener_basis is not None
                                                           for s in train):
@@ -606,9 +619,9 @@ def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
     return ref
 
 
-def _combo_k(effects) -> int:
-    return sum({"creep": len(CREEP_TAUS), "dynamics": 2, "delay": 1, "asymmetry": 2,
-                "drift": 1, "rate": RATE_BANDS + 2}[e] for e in effects)
+def _combo_k(effects, nominal: Model) -> int:
+    return sum({"creep": len(nominal.params["creep_taus"]), "dynamics": 2, "delay": 1,
+                "asymmetry": 2, "drift": 1, "rate": RATE_BANDS + 2}[e] for e in effects)
 
 
 def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
@@ -624,7 +637,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             out = [np.ones(s.t.size)]
             h0 = nominal.predict(s)
             if "creep" in effects:
-                out += [lag(h0, tau, s.dt) - h0 for tau in CREEP_TAUS]
+                out += [lag(h0, tau, s.dt) - h0 for tau in nominal.params["creep_taus"]]
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 out += [u**2, u**3]
@@ -686,9 +699,10 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
     i = 0
     for e in (e for e in ("creep", "asymmetry", "rate") if e in effects):  # column order
         if e == "creep":
-            out["creep_lag_gains"] = extra[i:i + len(CREEP_TAUS)].tolist()
-            out["creep_time_constants_s"] = list(CREEP_TAUS)
-            i += len(CREEP_TAUS)
+            taus = nominal.params["creep_taus"]
+            out["creep_lag_gains"] = extra[i:i + len(taus)].tolist()
+            out["creep_time_constants_s"] = list(taus)
+            i += len(taus)
         elif e == "asymmetry":
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2

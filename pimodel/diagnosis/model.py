@@ -2,9 +2,10 @@
 inverse (:meth:`pimodel.diagnosis.DiagnosisReport.model`).
 
 The diagnosis fits every candidate *jointly* with the hysteresis weights, in a parallel form
-(:mod:`.effects`): with ``Z`` the play outputs of the radius grid (plays at rest at 0, then
-``z_i[k] = Gamma_{r_i}[v][k]``) and ``h0 = Z w0 + c0`` the reference hysteresis output the
-effect columns are built from,
+(:mod:`.effects`): with ``Z`` the play outputs of the radius grid (plays at rest at
+``z_i[-1] = z_s``, then ``z_i[k] = Gamma_{r_i}[v][k]``; ``z_s = v[0]`` when
+``plays_start == "v0"``, as the diagnosis' nominal since issue 33, else 0) and
+``h0 = Z w0 + c0`` the reference hysteresis output the effect columns are built from,
 
     y[k] = (D Z)[k] w + c                                    hysteresis (weights w, offset c)
          + sum_i g_i (L_i[h0][k] - h0[k])                     creep: lags L_i, tau_i (s)
@@ -30,9 +31,11 @@ and the rate memory of sample k - 1 fixed, ``F_k`` is a polynomial of degree at 
 ``v[k]`` between the play breakpoints ``z_i[k-1] -+ r_i`` (and ``v[k-1]``), so the root is
 exact to rounding. Exact (round trip to 1e-9) for the nominal model and
 for creep and asymmetry, alone or together, while ``F_k`` is monotone near the input. The
-plays start at rest at 0, or, when the diagnosis took the stage's initial memory as unknown
-(``initial_state="unknown"``), from the memory of one reversal that puts ``y_d[0]`` on the
-model's output at the input 0 (:meth:`DiagnosedInverse.initial_memory`).
+plays start at rest at 0 (``plays_start == "v0"``: at rest at the ``v[0]`` that puts the
+first sample on ``y_d[0]``, :meth:`DiagnosedInverse.first_input`), or, when the diagnosis
+took the stage's initial memory as unknown (``initial_state="unknown"``), from the memory of
+one reversal that puts ``y_d[0]`` on the model's output at the input 0
+(:meth:`DiagnosedInverse.initial_memory`).
 A model without creep, asymmetry or rate whose hysteresis weights fold (a partial sum
 ``w_1 + ... + w_m <= 0``, as signed
 fine-grid least squares can give: its branches turn back, and the root the inverse follows
@@ -90,6 +93,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.optimize import brentq
 
+from .._native import LIMITS
+from ..operators.base import check_finite
 from ..operators.pi import PIOperator
 from .checks import checked_signal
 from .drift import drift_term
@@ -109,6 +114,7 @@ __all__ = ["DiagnosedInverse", "DiagnosedModel", "load_diagnosed_model"]
 
 KIND = "DiagnosedModel"
 INITIAL_STATES = ("rest", "unknown")  # as diagnose(initial_state=...)
+PLAYS_STARTS = ("zero", "v0")  # plays at rest at 0, or at the first input v[0]
 
 
 @dataclass(frozen=True)
@@ -142,6 +148,13 @@ class DiagnosedModel:
         (``"unknown"``: the inverse starts from the memory that puts ``y_d[0]`` on the model's
         output at rest, :meth:`DiagnosedInverse.initial_memory`). :meth:`simulate` starts at
         rest either way (it has no output to match).
+    plays_start : {"zero", "v0"}
+        Where the plays rest before the first sample: at 0 (``z_i[-1] = 0``, the default and
+        the form of models saved before issue 33) or at the record's first input
+        (``z_i[-1] = v[0]``; a Wiener model's plays of the filtered input at its first sample),
+        as the diagnosis' nominal fitted them (``report.nominal["model"]["plays_start"]``).
+        :meth:`simulate`, the C stream, the block and the DiagnosedModel FMU
+        (``plays_start = 1``) all follow it.
 
     Examples
     --------
@@ -160,6 +173,7 @@ class DiagnosedModel:
     reference_offset: float = 0.0
     params: dict = field(default_factory=dict)
     initial_state: str = "rest"
+    plays_start: str = "zero"
 
     def __post_init__(self):
         r = np.asarray(self.radii, float)
@@ -168,6 +182,7 @@ class DiagnosedModel:
             raise ValueError(f"weights: expected {r.size} values like radii, got {w.shape}")
         if np.any(r < 0) or np.any(np.diff(r) < 0):
             raise ValueError("radii: expected non-negative, ascending values")
+        _check_limits(r.size, self.params)
         if not self.dt > 0:
             raise ValueError(f"dt: expected > 0, got {self.dt!r}")
         bad = set(self.effects) - {"creep", "asymmetry", "rate", "drift", "dynamics", "delay"}
@@ -186,6 +201,9 @@ class DiagnosedModel:
         if self.initial_state not in INITIAL_STATES:
             raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got "
                              f"{self.initial_state!r}")
+        if self.plays_start not in PLAYS_STARTS:
+            raise ValueError(f"plays_start: expected one of {PLAYS_STARTS}, got "
+                             f"{self.plays_start!r}")
 
     # -- construction -------------------------------------------------------------------
     @classmethod
@@ -201,7 +219,8 @@ class DiagnosedModel:
             nom = fitted["nominal"]
             return cls(radii, nom.coef[:n], float(nom.coef[n]), fitted["dt"], (),
                        params={"rate_scale": nom.params["rate_scale"]},
-                       initial_state=fitted.get("initial_state", "rest"))
+                       initial_state=fitted.get("initial_state", "rest"),
+                       plays_start=fitted.get("plays_start", "zero"))
         model, ref = fitted["model"], fitted["reference"]
         q = n if V is None else V.shape[1]
         params = dict(model.params)
@@ -210,7 +229,8 @@ class DiagnosedModel:
             params["mode_hz"], params["mode_damping"] = model.grid["fn"], model.grid["zeta"]
         return cls(radii, play_weights(model.coef, q), float(model.coef[q]), fitted["dt"],
                    tuple(fitted["chosen"]), play_weights(ref.coef, q), float(ref.coef[q]),
-                   params, fitted.get("initial_state", "rest"))
+                   params, fitted.get("initial_state", "rest"),
+                   fitted.get("plays_start", "zero"))
 
     # -- forward ------------------------------------------------------------------------
     def _clock(self, v: np.ndarray, t) -> np.ndarray:
@@ -223,7 +243,8 @@ class DiagnosedModel:
 
     def simulate(self, v, t=None, *, input_range: float | None = None,
                  measured=None) -> np.ndarray:
-        """Output ``y[k]`` for the input ``v[k]`` (plays at rest at 0 before ``v[0]``).
+        """Output ``y[k]`` for the input ``v[k]`` (plays at rest before ``v[0]``: at 0, or at
+        ``v[0]`` itself when :attr:`plays_start` is ``"v0"``).
 
         Parameters
         ----------
@@ -247,7 +268,8 @@ class DiagnosedModel:
         Raises
         ------
         ValueError
-            ``v`` not a finite 1-D signal, ``t`` of another length.
+            ``v`` not a finite 1-D signal, ``t`` of another length, or an output float64
+            cannot hold (the sample is named; docs/reliability.md).
 
         Examples
         --------
@@ -258,11 +280,10 @@ class DiagnosedModel:
         v = checked_signal(v, "v")
         tk = self._clock(v, t)
         p, e = self.params, self.effects
-        Z = PIOperator(np.ones(self.radii.size), self.radii).play_outputs(v)
+        Z = self._plays(v)
         Zp = Z
         if self.dynamics_before:  # the plays of the filtered input (module wiener)
-            Zp = PIOperator(np.ones(self.radii.size), self.radii).play_outputs(
-                prefilter(v, p["wiener_elements"], self.dt))
+            Zp = self._plays(prefilter(v, p["wiener_elements"], self.dt))
         elif "dynamics" in e:
             Zp = mode(Zp, p["mode_hz"], p["mode_damping"], self.dt)
         if "delay" in e:
@@ -292,7 +313,13 @@ class DiagnosedModel:
                 raise ValueError(f"measured: expected {v.size} samples like v, got "
                                  f"{y_meas.shape}")
             y = y + drift_term(p, tk, y, y_meas)
-        return y
+        return check_finite(y, v, "v")
+
+    def _plays(self, x: np.ndarray) -> np.ndarray:
+        """Play outputs of ``x`` on the grid, at rest at ``x[0]`` or 0 (:attr:`plays_start`)."""
+        z0 = float(x[0]) if self.plays_start == "v0" else 0.0
+        return PIOperator(np.ones(self.radii.size), self.radii,
+                          initial_state=z0).play_outputs(x)
 
     def inverse(self) -> DiagnosedInverse:
         """The causal feedforward inverse (module docstring: exact or approximate per effect).
@@ -380,8 +407,8 @@ class DiagnosedModel:
         -------
         dict
             ``type``, ``radii``, ``weights``, ``offset``, ``dt``, ``effects``,
-            ``reference_weights``, ``reference_offset``, ``initial_state``, ``params``
-            (plain JSON values).
+            ``reference_weights``, ``reference_offset``, ``initial_state``,
+            ``plays_start``, ``params`` (plain JSON values).
 
         Examples
         --------
@@ -396,18 +423,20 @@ class DiagnosedModel:
                 "offset": self.offset, "dt": self.dt, "effects": list(self.effects),
                 "reference_weights": self.reference_weights.tolist(),
                 "reference_offset": self.reference_offset, "initial_state": self.initial_state,
+                "plays_start": self.plays_start,
                 "params": {k: (list(v) if isinstance(v, tuple) else v)
                            for k, v in self.params.items()}}
 
     @classmethod
     def from_dict(cls, d: dict) -> DiagnosedModel:
-        """Rebuild from :meth:`to_dict` (ValueError naming a missing key)."""
+        """Rebuild from :meth:`to_dict` (ValueError naming a missing key; a model saved without
+        ``plays_start``, before issue 33, starts its plays at 0 as it was fitted)."""
         if not isinstance(d, dict) or d.get("type") != KIND:
             raise ValueError(f"model: expected a JSON object with type {KIND!r}")
         try:
             return cls(d["radii"], d["weights"], d["offset"], d["dt"], tuple(d["effects"]),
                        d["reference_weights"], d["reference_offset"], dict(d["params"]),
-                       d.get("initial_state", "rest"))
+                       d.get("initial_state", "rest"), d.get("plays_start", "zero"))
         except KeyError as err:
             raise ValueError(f"model: missing key {err.args[0]!r}") from None
 
@@ -454,7 +483,8 @@ class DiagnosedModel:
         Raises
         ------
         ValueError
-            A model with effects (named), or weights the PI operator refuses.
+            A model with effects (named), plays that start at ``v[0]``
+            (:attr:`DiagnosedModel.plays_start`), or weights the PI operator refuses.
 
         Examples
         --------
@@ -467,6 +497,11 @@ class DiagnosedModel:
         from ..operators.envelopes import Envelope
         from ..operators.generalized import GeneralizedPI
 
+        if self.plays_start == "v0":
+            raise ValueError("model: its plays start at rest at each record's first input "
+                             "v[0] (plays_start 'v0'), which an operator's fixed initial state "
+                             "cannot express; the DiagnosedModel FMU unit runs it (plays_start "
+                             "= 1)")
         if self.effects:
             raise ValueError(f"model: the effects {list(self.effects)} are fitted in parallel "
                              "to the hysteresis; no operator chain reproduces them (the "
@@ -621,19 +656,12 @@ class DiagnosedInverse:
         """
         m = monotone_model(self.model.static_part())  # the model the solver inverts
         r = m.radii
-        p = m.params
 
         def memory(u: float) -> np.ndarray:
             return np.clip(np.clip(0.0, u - r, u + r), -r, r)
 
         def output(u: float) -> float:
-            z = memory(u)
-            y = float(z @ m.weights) + m.offset
-            if "asymmetry" in m.effects:
-                x = (float(z @ m.reference_weights) + m.reference_offset - p["center"]) / \
-                    p["half_range"]
-                y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
-            return y - float(y_0)
+            return _first_output(m, memory(u)) - float(y_0)
 
         f0 = output(0.0)
         if f0 == 0.0:
@@ -652,6 +680,47 @@ class DiagnosedInverse:
         return memory(brentq(output, min(u[i], u[i + 1]), max(u[i], u[i + 1]),
                              xtol=1e-15 * (1.0 + float(r[-1]))))
 
+    def first_input(self, y_0: float) -> float:
+        """The first input ``v[0]`` of a model whose plays start at rest at ``v[0]``
+        (:attr:`DiagnosedModel.plays_start` ``"v0"``): every play then outputs ``v[0]`` on the
+        first sample, so the static part's output there, ``(sum w) v[0] + c`` plus the
+        asymmetry of ``h0``, is solved for ``y_0`` (creep and rate act from the next sample).
+
+        Parameters
+        ----------
+        y_0 : float
+            Output to reach on the first sample (the reference after :meth:`prefilter`).
+
+        Returns
+        -------
+        float
+            ``v[0]`` [input units]; the input nearest the linear guess ``(y_0 - c) / sum w``
+            that reaches ``y_0`` (the guess itself when none does within 1e6 of it).
+
+        Examples
+        --------
+        >>> m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.1, dt=1e-3, plays_start="v0")
+        >>> round(m.inverse().first_input(1.6), 12)
+        1.0
+        """
+        m = monotone_model(self.model.static_part())
+        ones = np.ones(m.radii.size)
+
+        def f(u: float) -> float:
+            return _first_output(m, u * ones) - float(y_0)
+
+        total = float(np.sum(m.weights))
+        u0 = (float(y_0) - m.offset) / total if total != 0 else 0.0
+        if f(u0) == 0.0 or "asymmetry" not in m.effects:
+            return u0
+        step = 1e-3 * (1.0 + abs(u0) + float(m.radii[-1]))
+        while step < 1e6:
+            for lo, hi in ((u0 - step, u0), (u0, u0 + step)):
+                if f(lo) * f(hi) <= 0:
+                    return brentq(f, lo, hi, xtol=1e-15 * (1.0 + abs(u0)))
+            step *= 2.0
+        return u0
+
     def simulate(self, y_d, t=None, *, input_range: float | None = None,
                  initial_state: str | None = None) -> np.ndarray:
         """Input ``v[k]`` that makes the model's output follow ``y_d[k]``.
@@ -668,7 +737,9 @@ class DiagnosedInverse:
         initial_state : {"rest", "unknown"}, optional
             The stage's memory before the first sample; default the model's
             :attr:`~DiagnosedModel.initial_state` (the diagnosis' assumption). ``"rest"``: the
-            plays at rest at 0 (the exact inverse of :meth:`DiagnosedModel.simulate`).
+            plays at rest as the model's (:attr:`~DiagnosedModel.plays_start`: at 0, or at the
+            ``v[0]`` of :meth:`first_input`), the exact inverse of
+            :meth:`DiagnosedModel.simulate`.
             ``"unknown"``: the plays start from :meth:`initial_memory` of the first
             (prefiltered) reference sample, so the stage is taken to sit at ``y_d[0]`` with
             the input 0 instead of being driven there from rest. On a stage whose memory
@@ -685,7 +756,8 @@ class DiagnosedInverse:
         Raises
         ------
         ValueError
-            ``y_d`` not a finite 1-D signal, an unknown ``initial_state``.
+            ``y_d`` not a finite 1-D signal, an unknown ``initial_state``, or an input float64
+            cannot hold (the sample is named).
 
         Examples
         --------
@@ -704,11 +776,14 @@ class DiagnosedInverse:
             raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got {state!r}")
         rng = 2 * self.model.radii[-1] if input_range is None else float(input_range)
         x = self.prefilter(yd)
+        _check_headroom(x, self.model)
         z0 = self.initial_memory(x[0]) if state == "unknown" else None
+        if state == "rest" and self.model.plays_start == "v0":
+            z0 = np.full(self.model.radii.size, self.first_input(x[0]))
         x = _solve_static(self.model.static_part(), x, rng, z0)
         if self.model.dynamics_before:  # the filter's output -> its input (approximate)
-            return inverse_prefilter(x, self.model.params["wiener_elements"], self.model.dt)
-        return x
+            x = inverse_prefilter(x, self.model.params["wiener_elements"], self.model.dt)
+        return check_finite(x, yd, "y_d")
 
     def block(self, dt: float | None = None, *, name: str = "inverse", input: str = "y_d",
               output: str = "v", input_range: float | None = None,
@@ -766,6 +841,49 @@ class DiagnosedInverse:
         """
         return inverse_block(self, dt, name=name, input=input, output=output,
                              input_range=input_range, reference_range=reference_range)
+
+
+def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
+    """The static part's output on a first sample whose play outputs are ``z`` (hysteresis,
+    offset and the asymmetry of ``h0``; creep and rate are 0 there)."""
+    y = float(z @ m.weights) + m.offset
+    if "asymmetry" in m.effects:
+        p = m.params
+        x = (float(z @ m.reference_weights) + m.reference_offset - p["center"]) / p["half_range"]
+        y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
+    return y
+
+
+def _check_limits(n_plays: int, params: dict) -> None:
+    """ValueError above the C core's limits, the FMUs' too (``LIMITS``): at most
+    ``PIM_DIAG_MAX_PLAYS`` plays and ``PIM_DIAG_MAX_LAGS`` creep lags, so a model that loads
+    also exports and each sample costs a bounded time (issue 32, docs/reliability.md)."""
+    most = LIMITS["PIM_DIAG_MAX_PLAYS"]
+    if n_plays > most:
+        raise ValueError(f"radii: {n_plays} plays; a diagnosed model (and its FMU) takes at "
+                         f"most {most}")
+    lags = params.get("creep_lag_gains", ()) if isinstance(params, dict) else ()
+    most = LIMITS["PIM_DIAG_MAX_LAGS"]
+    if hasattr(lags, "__len__") and len(lags) > most:
+        raise ValueError(f"params: creep_lag_gains: {len(lags)} creep lags; a diagnosed model "
+                         f"(and its FMU) takes at most {most}")
+
+
+def _check_headroom(x: np.ndarray, model: DiagnosedModel) -> None:
+    """ValueError naming the ``y_d`` sample when the static inverse's root bracket, the
+    breakpoints plus 10 input spans (``pim_diag_inverse.c``), would overflow float64: the
+    input scale ``(max |x| + ptp x) / |sum w| + 2 r_n`` must stay below ``float max / 32``.
+    Beyond it the C solve returned a finite, wrong input (issue 32)."""
+    wsum = max(abs(float(model.weights.sum())), 1e-12)
+    with np.errstate(over="ignore"):
+        scale = (np.max(np.abs(x)) + np.ptp(x)) / wsum + 2 * float(model.radii[-1])
+    bound = np.finfo(float).max / 32
+    if not scale < bound:
+        k = int(np.argmax(np.abs(x)))
+        raise ValueError(
+            f"y_d: sample {k} ({float(x[k]):.6g}) is out of the inverse's range: the input it "
+            f"asks for, about {scale:.3g}, leaves no float64 headroom for the root bracket "
+            f"(expected below {bound:.3g}); scale the reference down")
 
 
 def _solve_static(static: DiagnosedModel, x: np.ndarray, input_range: float, z0) -> np.ndarray:

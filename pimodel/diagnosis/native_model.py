@@ -6,7 +6,8 @@ runner (:func:`stream_simulate`) and the values of the DiagnosedModel FMU unit
 ``tests/test_diagnosed_block_fmu.py`` holds the two equal to 1e-12 for every effect.
 
 Discrete-time semantics (those of ``simulate``, written per sample): with the play states
-``z_i[k-1]`` (at rest at 0 before the first sample) and the input ``v[k]``,
+``z_i[k-1]`` (at rest before the first sample: at 0, or at ``v[0]`` when the model's
+``plays_start`` is ``"v0"``, set by the C step on the first sample) and the input ``v[k]``,
 ``y[k]`` depends on ``v[0..k]`` and ``t[k]`` only; the LTI part (the dynamics) and the delay act
 on the hysteresis term ``sum_i w_i z_i[k]`` and start at rest around its first value; the creep
 lags start at rest around ``h0[0]``; the rate effect (:mod:`.rate`) low-passes the normalised
@@ -35,10 +36,11 @@ hysteresis term before the delay, as :func:`~pimodel.diagnosis.lti.lti_columns` 
 A Wiener model (``params["dynamics_position"] == "before"``, :mod:`.wiener`) has its filter
 ``F`` before the hysteresis instead: the elements of ``params["wiener_elements"]`` run as
 sections in series on ``v`` (:func:`prefilter_sections`), each started at rest around its own
-first input (``x_f[0] = v[0]``), and a second set of plays, at rest at 0 like the first,
-follows ``x_f[k]``; the hysteresis term is ``sum_i w_i zf_i[k]`` of these plays (then the
-delay, as above), while ``h0`` and the creep, asymmetry and rate terms keep the plays of ``v``
-itself, as :meth:`DiagnosedModel.simulate`. No LTI part after the plays applies in this form.
+first input (``x_f[0] = v[0]``), and a second set of plays, at rest at 0 like the first
+(or at ``x_f[0]``), follows ``x_f[k]``; the hysteresis term is ``sum_i w_i zf_i[k]`` of
+these plays (then the delay, as above), while ``h0`` and the creep, asymmetry and rate terms
+keep the plays of ``v`` itself, as :meth:`DiagnosedModel.simulate`. No LTI part after the
+plays applies in this form.
 """
 
 from __future__ import annotations
@@ -264,6 +266,7 @@ class NativeModel:
         keep = {"w": model.weights, "r": r, "w0": model.reference_weights}
         d = _native.DiagParams()
         d.n, d.c, d.c0, d.dt = n, model.offset, model.reference_offset, model.dt
+        d.plays_start = int(model.plays_start == "v0")  # 1: the C step sets z = v[0]
         if "creep" in e:
             taus = np.asarray(p["creep_time_constants_s"], float)
             keep["lag_a"] = np.exp(-model.dt / taus)  # as effects.lag
@@ -321,7 +324,8 @@ class NativeModel:
 
     def initial_state(self) -> np.ndarray:
         """The state before the first sample: not started, plays (and a Wiener model's plays of
-        the filtered input) at rest at 0 (``pim_diag_initial_state``).
+        the filtered input) at rest at 0 (``pim_diag_initial_state``); a model whose plays
+        start at ``v[0]`` has them set on the first sample.
 
         Returns
         -------
@@ -601,7 +605,8 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
         """Plays 1..64 in NAME[i], 65..128 in NAME_hi[i] (other arrays: up to 64)."""
         return labelled_values(name, values, split=NMAX)
 
-    out = {"Ts": model.dt, "n": n, "z0": 0.0, **arr("p", model.weights), **arr("r", model.radii),
+    out = {"Ts": model.dt, "n": n, "z0": 0.0, "plays_start": int(d.plays_start),
+           **arr("p", model.weights), **arr("r", model.radii),
            **arr("w0", model.reference_weights), "offset": d.c,
            "reference_offset": model.reference_offset, "input_range": nm.input_range}
     if d.m:

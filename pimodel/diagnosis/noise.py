@@ -34,6 +34,7 @@ __all__ = [
 ARX_NA, ARX_NB, ARX_LEAD = 6, 24, 4  # linear model of the residual on the model output
 SG_WINDOW = 9  # Savitzky-Golay window [samples] and polynomial order
 SG_ORDER = 3
+FEEDBACK_CORR = 0.1  # |corr| of h's fast part one sample ahead with r's fast part: feedback
 MIN_REPEATED = 400  # samples of repeated input needed for the "repeated periods" method
 MAX_PERIODS_TRIED = 6
 
@@ -117,13 +118,38 @@ def _repeated_differences(v: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
     return out
 
 
+def _fast(x: np.ndarray) -> np.ndarray:
+    return x - savgol_filter(x, SG_WINDOW, SG_ORDER)
+
+
+def _corr(a: np.ndarray, b: np.ndarray) -> float:
+    sa, sb = float(np.std(a)), float(np.std(b))
+    return 0.0 if sa == 0 or sb == 0 else float(np.mean((a - a.mean()) * (b - b.mean())) / sa / sb)
+
+
+def _feedback(h: np.ndarray, r: np.ndarray) -> bool:
+    """Whether the record was taken in closed loop: the fast part of the model output one sample
+    ahead, ``h[k + 1]``, follows the fast part of the residual ``r[k]`` (the controller fed the
+    measured noise back into the input), and far more than ``h[k - 1]`` does (an open-loop
+    effect, a delay at a step, is about symmetric). Under feedback the ARX's leads would
+    predict the noise from the next input and the floor would come out low (3x on clean
+    closed-loop records, ``docs/diagnosis.md``)."""
+    hf, rf = _fast(h), _fast(r)
+    ahead = abs(_corr(hf[1:], rf[:-1]))
+    behind = abs(_corr(hf[:-1], rf[1:]))
+    return ahead > FEEDBACK_CORR and ahead > 2.0 * behind
+
+
 def _local_model_residual(h: np.ndarray, r: np.ndarray) -> np.ndarray:
     """What neither a linear model of the model output ``h`` nor a smoothing fit explains.
 
     The linear model is ``B(q) / A(q)`` from ``h`` (``ARX_LEAD`` samples ahead, so it may also
-    lead) to ``r``: first fitted in equation-error (ARX) form by least squares, then simulated
-    in output-error form (stable poles only; else the ARX residual itself is kept)."""
+    lead; no lead on a record taken in closed loop, :func:`_feedback`) to ``r``: first fitted
+    in equation-error (ARX) form by least squares, then simulated in output-error form (stable
+    poles only; else the ARX residual itself is kept)."""
     n, na, nb, m = r.size, ARX_NA, ARX_NB, ARX_LEAD
+    if n > 10 * (na + nb) + SG_WINDOW and _feedback(h, r):
+        m = 0  # the leads would explain the noise the loop fed back into the input
     if n <= 10 * (na + nb) + SG_WINDOW:
         return r - savgol_filter(r, SG_WINDOW, SG_ORDER)
     u = np.concatenate((h[m:], np.full(m, h[-1]))) - h.mean()

@@ -168,6 +168,9 @@ class WienerBasis:
         ``V``, shape (n, q): the record's columns are ``Z V``; None: the plays themselves.
     dt : float
         Sample time [s].
+    at_rest : bool
+        The plays at rest at the filtered input's first sample (default), else at 0, as the
+        nominal's plays (:func:`.effects.make_segment`).
 
     Examples
     --------
@@ -176,8 +179,10 @@ class WienerBasis:
     [[0.0, 0.0], [0.0, 0.0], [0.6321, 0.1321]]
     """
 
-    def __init__(self, v: np.ndarray, radii, projection: np.ndarray | None, dt: float):
+    def __init__(self, v: np.ndarray, radii, projection: np.ndarray | None, dt: float, *,
+                 at_rest: bool = True):
         self.v, self.dt = np.asarray(v, float), float(dt)
+        self.at_rest = at_rest
         self.radii = np.asarray(radii, float)
         self.projection = projection
         self._cache: dict = {}
@@ -195,12 +200,15 @@ class WienerBasis:
         Returns
         -------
         numpy.ndarray
-            Shape (N, q) or (N, ncols): ``Gamma[F[v]] V`` (plays at rest at 0).
+            Shape (N, q) or (N, ncols): ``Gamma[F[v]] V`` (plays at rest at ``F[v][0]`` or at
+            0, as the plays of ``v`` in :func:`.effects.make_segment`).
         """
         key = (tuple(tuple(e) for e in elements), ncols)
         if key not in self._cache:
             x = prefilter(self.v, elements, self.dt)
-            Z = PIOperator(np.ones(self.radii.size), self.radii).play_outputs(x)
+            z0 = float(x[0]) if self.at_rest else 0.0
+            Z = PIOperator(np.ones(self.radii.size), self.radii,
+                           initial_state=z0).play_outputs(x)
             if self.projection is not None:
                 Z = Z @ (self.projection if ncols is None else self.projection[:, :ncols])
             elif ncols is not None:

@@ -112,7 +112,7 @@ def truth_sweep(cases: Sequence[dict], *, target: str = "diagnose", out="out/swe
                 table: str = "table.csv", workers: int | None = None,
                 scheduler: str | None = None, fresh: bool = False,
                 memory_limit: str | None = DEFAULT_MEMORY_LIMIT,
-                progress: bool = True) -> list[dict]:
+                progress: bool = True, counts: dict | None = None) -> list[dict]:
     """Run :func:`truth_case` over ``cases`` and write the tidy table ``out/table``.
 
     Parameters
@@ -126,8 +126,9 @@ def truth_sweep(cases: Sequence[dict], *, target: str = "diagnose", out="out/swe
         Output folder: the table, and ``cases/`` with the finished cases (for resuming).
     table : str
         File name of the table in ``out``: ``.csv``, or ``.parquet`` (needs pyarrow).
-    workers, scheduler, fresh, memory_limit, progress
-        Where and how the cases run, as in :func:`pimodel.experiments.sweeps.run_cases`.
+    workers, scheduler, fresh, memory_limit, progress, counts
+        Where and how the cases run, and the reused/computed counts, as in
+        :func:`pimodel.experiments.sweeps.run_cases`.
 
     Returns
     -------
@@ -140,6 +141,8 @@ def truth_sweep(cases: Sequence[dict], *, target: str = "diagnose", out="out/swe
         Unknown target or parameter, a case without a seed, a bad table name.
     pimodel.experiments.sweeps.CaseFailed
         A case raised (finished cases stay in ``out/cases``).
+    pimodel.experiments.sweeps.Interrupted
+        Ctrl-C: the workers stopped, finished cases stay in ``out/cases``.
 
     Examples
     --------
@@ -161,7 +164,7 @@ def truth_sweep(cases: Sequence[dict], *, target: str = "diagnose", out="out/swe
     out = Path(out)
     results = run_cases(truth_case, cases, workers=workers, scheduler=scheduler,
                         cache_dir=out / "cases", fresh=fresh, memory_limit=memory_limit,
-                        progress=progress, desc=f"sweep ({target})")
+                        progress=progress, desc=f"sweep ({target})", counts=counts)
     rows = tidy_rows(cases, results)
     write_table(rows, out / table)
     return rows

@@ -255,7 +255,7 @@ def is_sweep(module: ModuleType) -> bool:
 
 def run_study(name: str, out_dir=None, *, quick: bool = False, workers: int | None = 0,
               scheduler: str | None = None, fresh: bool = False,
-              memory_limit: str | None = None) -> StudyResult:
+              memory_limit: str | None = None, counts: dict | None = None) -> StudyResult:
     """Run study ``name``; writes results.md/json and figures to ``out_dir``.
 
     Parameters
@@ -274,6 +274,9 @@ def run_study(name: str, out_dir=None, *, quick: bool = False, workers: int | No
         ``None`` means :data:`pimodel.experiments.sweeps.DEFAULT_MEMORY_LIMIT`.
     fresh : bool
         Recompute every case instead of reusing the finished ones in ``out_dir/cases``.
+    counts : dict, optional
+        For a sweep: filled with the reused and computed case counts
+        (:func:`pimodel.experiments.sweeps.run_cases`).
 
     Returns
     -------
@@ -302,7 +305,8 @@ def run_study(name: str, out_dir=None, *, quick: bool = False, workers: int | No
         results = run_cases(module.run_case, cases, scheduler=scheduler,
                             workers=None if scheduler is not None else workers,
                             cache_dir=out / "cases", fresh=fresh,
-                            memory_limit=memory_limit or DEFAULT_MEMORY_LIMIT, desc=name)
+                            memory_limit=memory_limit or DEFAULT_MEMORY_LIMIT, desc=name,
+                            counts=counts)
         result: StudyResult = module.aggregate(out, quick, cases, results)
     else:
         result = module.run(out, quick=quick)

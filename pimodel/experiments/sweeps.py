@@ -15,8 +15,11 @@ while the estimator and diagnosis spend much of their time in Python and NumPy g
 
 With ``cache_dir`` each finished case is written to ``cache_dir/<key>.json`` (``key`` a hash of
 its params) as soon as it finishes; a rerun loads those and computes only the missing cases,
-so a sweep killed halfway resumes. Results are JSON round-tripped whether computed or loaded, so
-both give identical values, and they come back in case order.
+so a sweep killed halfway resumes; a file that is unreadable or not the case's is computed
+again, never trusted. Ctrl-C (SIGINT) stops the workers (they ignore SIGINT themselves, so they
+print nothing) and raises :class:`Interrupted`, which says how many cases are kept. Results
+are JSON round-tripped whether computed or loaded, so both give identical values, and they come
+back in case order.
 """
 
 from __future__ import annotations
@@ -59,6 +62,7 @@ __all__ = [
     "DEFAULT_MEMORY_LIMIT",
     "WORKER_ENV",
     "CaseFailed",
+    "Interrupted",
     "available_cores",
     "case_key",
     "grid",
@@ -100,6 +104,31 @@ class CaseFailed(RuntimeError):
         super().__init__(message)
         self.index = index
         self.params = params
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a sweep; ``str()`` is one line with the cases kept and how to resume.
+
+    Parameters
+    ----------
+    kept : int
+        Cases finished (computed or reused) and kept in ``folder``.
+    total : int
+        Cases of the sweep.
+    folder : path or None
+        The cache folder (None: nothing kept).
+
+    Examples
+    --------
+    >>> print(Interrupted(5, 12, "out/cases"))
+    interrupted: 5 of 12 cases kept in out/cases; rerun the same command to resume
+    """
+
+    def __init__(self, kept: int, total: int, folder):
+        self.kept, self.total, self.folder = kept, total, folder
+        where = (f"kept in {folder}; rerun the same command to resume" if folder is not None
+                 else "finished, none kept (no cache folder)")
+        super().__init__(f"interrupted: {kept} of {total} cases {where}")
 
 
 def plain(x):
@@ -247,7 +276,7 @@ def _progress(total: int, initial: int, desc: str, show: bool):
 def run_cases(func: Callable[[dict], object], cases: Sequence[dict], *,
               workers: int | None = None, scheduler: str | None = None, cache_dir=None,
               fresh: bool = False, memory_limit: str | None = DEFAULT_MEMORY_LIMIT,
-              progress: bool = True, desc: str = "cases") -> list:
+              progress: bool = True, desc: str = "cases", counts: dict | None = None) -> list:
     """Compute ``func(params)`` for every case; results in case order.
 
     Parameters
@@ -276,6 +305,9 @@ def run_cases(func: Callable[[dict], object], cases: Sequence[dict], *,
         Show a progress bar over the cases (on a terminal).
     desc : str
         Label of the progress bar.
+    counts : dict, optional
+        Filled with ``"reused"`` (loaded from ``cache_dir``) and ``"computed"`` (run now)
+        case counts, also when the sweep fails or is interrupted.
 
     Returns
     -------
@@ -289,6 +321,8 @@ def run_cases(func: Callable[[dict], object], cases: Sequence[dict], *,
     CaseFailed
         A case raised; the message names it and its params. Finished cases stay in
         ``cache_dir``; the remaining ones are cancelled.
+    Interrupted
+        Ctrl-C (a ``KeyboardInterrupt``): the workers are stopped, finished cases kept.
 
     Examples
     --------
@@ -316,14 +350,21 @@ def run_cases(func: Callable[[dict], object], cases: Sequence[dict], *,
             todo.append(i)
         else:
             results[i] = hit[0]
-    bar = _progress(len(cases), len(cases) - len(todo), desc, progress)
+    reused = len(cases) - len(todo)
+    counts = {} if counts is None else counts
+    counts.update(reused=reused, computed=0)
+    bar = _progress(len(cases), reused, desc, progress)
     try:
         if not todo:
             pass
         elif workers == 0:
-            _run_serial(func, cases, todo, results, cache, bar)
+            _run_serial(func, cases, todo, results, cache, bar, counts)
         else:
-            _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory_limit)
+            _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory_limit,
+                      counts)
+    except KeyboardInterrupt:
+        bar.close()
+        raise Interrupted(reused + counts["computed"], len(cases), cache.folder) from None
     finally:
         bar.close()
     return results
@@ -348,7 +389,7 @@ def available_cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def _run_serial(func, cases, todo, results, cache, bar) -> None:
+def _run_serial(func, cases, todo, results, cache, bar, counts) -> None:
     for done, i in enumerate(todo):
         try:
             results[i] = _call_case(func, cases[i])
@@ -356,33 +397,73 @@ def _run_serial(func, cases, todo, results, cache, bar) -> None:
             raise _failure(i, cases[i], len(cases), exc, cache, len(cases) - len(todo) + done) \
                 from exc
         cache.store(cases[i], results[i])
+        counts["computed"] += 1
         bar.update()
 
 
-def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory_limit) -> None:
+def _start_local_cluster(workers: int, memory_limit):
+    """A LocalCluster of single-threaded worker processes that ignore SIGINT (Ctrl-C stops
+    them through this process, without their tracebacks)."""
     import logging
+    import signal
+    import threading
 
     import dask
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import LocalCluster
 
-    cluster = None
-    if scheduler is None:
-        # processes, one thread each: the Python glue of a case holds the GIL
-        spawn_env = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), **WORKER_ENV}
-        saved = {k: os.environ.get(k) for k in WORKER_ENV}
-        os.environ.update(WORKER_ENV)
-        try:
-            with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn_env}):
-                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                       memory_limit=memory_limit, dashboard_address=None,
-                                       silence_logs=logging.ERROR)
-        finally:
-            for k, old in saved.items():
-                if old is None:
-                    os.environ.pop(k, None)
-                else:
-                    os.environ[k] = old
+    # processes, one thread each: the Python glue of a case holds the GIL
+    spawn_env = {**dask.config.get("distributed.nanny.pre-spawn-environ", {}), **WORKER_ENV}
+    saved = {k: os.environ.get(k) for k in WORKER_ENV}
+    os.environ.update(WORKER_ENV)
+    main = threading.current_thread() is threading.main_thread()
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:  # the nannies and workers inherit the ignored SIGINT
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn_env}):
+            return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                memory_limit=memory_limit, dashboard_address=None,
+                                silence_logs=logging.ERROR)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, handler)
+        for k, old in saved.items():
+            if old is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = old
+
+
+def _quiet_close(client, cluster, interrupted: bool) -> None:
+    """Close the client and the local cluster; after Ctrl-C without Dask's log lines and
+    without a second Ctrl-C cutting the shutdown short."""
+    import contextlib
+    import logging
+    import signal
+    import threading
+
+    main = interrupted and threading.current_thread() is threading.main_thread()
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    log = logging.getLogger("distributed")
+    level = log.level
+    if interrupted:
+        log.setLevel(logging.CRITICAL + 1)
+    try:
+        with contextlib.suppress(Exception) if interrupted else contextlib.nullcontext():
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    finally:
+        log.setLevel(level)
+        if main:
+            signal.signal(signal.SIGINT, handler)
+
+
+def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory_limit,
+              counts) -> None:
+    from dask.distributed import Client, as_completed
+
+    cluster = _start_local_cluster(workers, memory_limit) if scheduler is None else None
     client = Client(cluster if cluster is not None else scheduler)
+    interrupted = False
     try:
         run = partial(_call_case, func)
         keys = [f"case-{i}-{case_key(cases[i])}" for i in todo]
@@ -397,12 +478,14 @@ def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory
                 client.cancel(futures)
                 raise _failure(i, cases[i], len(cases), exc, cache, done) from exc
             cache.store(cases[i], results[i])
+            counts["computed"] += 1
             done += 1
             bar.update()
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        _quiet_close(client, cluster, interrupted)
 
 
 def grid(**axes: Sequence) -> list[dict]:

@@ -253,7 +253,7 @@ MODELS: dict[str, dict] = {
                        "with further elements on h0 or a filter before the plays (Wiener), "
                        "and a delay "
                        "(pimodel.diagnosis.model.DiagnosedModel, dt = Ts)",
-        "vars": [*_common(z0="initial play state (input unit; a diagnosis starts at 0)",
+        "vars": [*_common(z0="initial play state (input unit; used when plays_start = 0)",
                           weights=("p", "1", "weight w (any sign), play"),
                           n_max=2 * NMAX),
                  *_arrays("r", 200, "parameter", "0", "radius r (>= 0, sorted), play"),
@@ -313,6 +313,9 @@ MODELS: dict[str, dict] = {
                  Var("n_wiener_elements", 66, "Integer", "parameter", "0",
                      f"sections F_j of a Wiener model's filter before the plays, in series on "
                      f"v, 0 <= n_wiener_elements <= {MAX_LTI_ELEMENTS} (0: none)"),
+                 Var("plays_start", 72, "Integer", "parameter", "0",
+                     "plays before the first sample: 0 at z0, 1 at rest at the first input "
+                     "v[0] (the diagnosis' nominal, DiagnosedModel.plays_start)"),
                  *_arrays("wiener_element_b", 1700, "parameter", "0",
                           "filter before the plays: second-order sections, 3 numerator "
                           "coefficients each (z^0, z^-1, z^-2): F_j in 3j-2..3j, element"),

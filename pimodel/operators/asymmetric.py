@@ -35,6 +35,7 @@ from ..checks import as_signal, as_vector, positive_scalar, scalar_or_vector
 from .base import (
     InverseStreaming,
     Streaming,
+    check_finite,
     freeze,
     operator_repr,
     read_only,
@@ -44,6 +45,8 @@ from .base import (
 from .envelopes import Envelope
 
 __all__ = ["AsymmetricPI", "AsymmetricPIInverse"]
+
+_MAX_PLAYS = _native.LIMITS["PIM_MAX_PLAYS"]
 
 
 class AsymmetricPI(Streaming):
@@ -137,16 +140,17 @@ class AsymmetricPI(Streaming):
         """
         self._restart()
 
-    def _run(self, x: np.ndarray, z: np.ndarray, *, inverse: bool, name: str) -> np.ndarray:
+    def _run(self, x: np.ndarray, z: np.ndarray, *, inverse: bool, name: str = "v") -> np.ndarray:
         out, bad = _native.asym_run(self._c, self._p, self._r, z, x, inverse=inverse)
-        if bad > x.size:
-            raise ValueError(f"weights: the inverse handles at most 64 plays, got {self.n}")
+        if bad > x.size:  # AsymmetricPIInverse checks first; kept for a direct _run
+            raise ValueError(f"weights: the inverse handles at most {_MAX_PLAYS} plays, got "
+                             f"{self.n}")
         if bad:
             k = bad - 1
             what = ("has no input: it lies beyond the range of the shape function"
                     if inverse else "lies outside the domain of the shape function")
             raise ValueError(f"{name}: sample {k} ({float(x[k])!r}) {what} {self.shape!r}")
-        return out
+        return check_finite(out, x, name, state=z)
 
     def simulate(self, v, *, state=None, return_state: bool = False):
         """Output ``y[k]`` for ``v[k]`` from ``state`` (default the initial state).
@@ -205,7 +209,7 @@ class AsymmetricPI(Streaming):
         >>> op.step(1.0), op.state
         (1.4, array([0.8]))
         """
-        return self._advance(self._run, as_signal(v, "v"), inverse=False, name="v")
+        return self._advance(self._run, as_signal(v, "v"), "v", inverse=False)
 
     def to_dict(self) -> dict:
         """JSON-ready parameters.
@@ -262,6 +266,9 @@ class AsymmetricPIInverse(InverseStreaming):
     """
 
     def __init__(self, forward: AsymmetricPI):
+        if forward.n > _MAX_PLAYS:  # the C solve sorts its kinks in a fixed-size array
+            raise ValueError(f"forward: {forward.n} plays; the inverse (and the FMU) takes at "
+                             f"most {_MAX_PLAYS}")
         self.forward = forward
         self.reset()
 
@@ -338,5 +345,4 @@ class AsymmetricPIInverse(InverseStreaming):
         >>> round(inv.step(1.5), 12), inv.state
         (1.066666666667, array([0.86666667]))
         """
-        return self._advance(self.forward._run, as_signal(y_d, "y_d"), inverse=True,
-                             name="y_d")
+        return self._advance(self.forward._run, as_signal(y_d, "y_d"), "y_d", inverse=True)

@@ -14,9 +14,14 @@ leaves alone:
 - :func:`operator_repr` writes ``Name(args, key=value)`` with the arrays rounded to 6 digits;
 - :class:`Streaming` holds the streaming-state bookkeeping: the start state of ``simulate``,
   ``reset`` and one ``step`` on a copy of the state (the state changes only when the step
-  succeeds; ``PIOperator.step`` updates it in place through the C core's step instead);
+  succeeds, and only when the outputs and the new state are finite);
   :func:`streaming_state` makes the ``state`` property with the class's docstring;
   :class:`InverseStreaming` is the same for an inverse that runs its forward operator's state.
+
+The numerical-range rule, the same for every operator and model (docs/reliability.md): a result
+that float64 cannot represent raises a ValueError naming the argument and the sample
+(:func:`check_finite`); no operator returns inf or NaN from finite input, and a step that raises
+leaves the state as it was.
 
 A class using :class:`Streaming` defines ``_check_state(value)`` (the state's form and its
 error message) and, when its initial state is not ``self.initial_state``, ``_fresh_state()``.
@@ -29,6 +34,7 @@ from collections.abc import Callable
 import numpy as np
 
 __all__ = [
+    "check_finite",
     "freeze",
     "InverseStreaming",
     "operator_repr",
@@ -37,6 +43,27 @@ __all__ = [
     "Streaming",
     "streaming_state",
 ]
+
+
+def check_finite(out: np.ndarray, x: np.ndarray, name: str, *, state=None,
+                 what: str = "output") -> np.ndarray:
+    """``out`` when it and ``state`` are finite; else ValueError naming ``name``'s first sample
+    whose result overflowed float64 (the numerical-range rule of the module docstring).
+
+    ``x`` is the (finite) input the operator ran on, ``out`` its output, one sample each;
+    ``state`` the operator's state after the last sample (checked too, since an overflowed
+    state would spoil the next sample).
+    """
+    bad = ~np.isfinite(out)
+    if state is not None and not np.all(np.isfinite(state)):
+        bad[-1] = True
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"{name}: sample {k} ({float(x[k]):.6g}) makes the {what} or the state overflow "
+            f"float64 (got {float(out[k])!r}); expected inputs and parameters whose results stay "
+            f"below {np.finfo(float).max:.3g}: scale the signal or the parameters down")
+    return out
 
 
 def read_only(attribute: str, doc: str) -> property:
@@ -102,12 +129,14 @@ class Streaming:
         """Return the streaming state to the initial state (the body of ``reset``)."""
         self._z = self._fresh_state()
 
-    def _advance(self, run: Callable[..., np.ndarray], x: np.ndarray, **options) -> float:
+    def _advance(self, run: Callable[..., np.ndarray], x: np.ndarray, name: str = "v",
+                 **options) -> float:
         """One ``step``: ``run(x, z, **options)`` on a copy ``z`` of the streaming state, which
-        it advances in place; the copy becomes the state once ``run`` returned. Returns the
-        first output sample."""
+        it advances in place; the copy becomes the state once ``run`` returned and both its
+        output and ``z`` are finite (:func:`check_finite`, else ValueError and the state is
+        unchanged). Returns the first output sample."""
         z = self._z.copy()
-        out = run(x, z, **options)
+        out = check_finite(run(x, z, **options), x, name, state=z)
         self._z = z
         return float(out[0])
 

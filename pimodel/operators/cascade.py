@@ -98,15 +98,28 @@ class Cascade:
         float
             Output ``y[k]`` of the last stage.
 
+        Raises
+        ------
+        ValueError
+            When a stage refuses the sample (e.g. float64 overflow); every stage then keeps
+            the state it had before this step.
+
         Examples
         --------
         >>> from pimodel import PIOperator
         >>> Cascade(PIOperator([1.0], [0.0]), PIOperator([2.0], [0.0])).step(0.5)
         1.0
         """
+        kept = [s for s in self.stages if hasattr(s, "state")]
+        saved = [s.state for s in kept]
         x = float(v)
-        for s in self.stages:
-            x = s.step(x)
+        try:
+            for s in self.stages:
+                x = s.step(x)
+        except ValueError:   # a stage refused: every stage keeps its state (base.py's rule)
+            for s, z in zip(kept, saved, strict=True):
+                s.state = z
+            raise
         return x
 
     def reset(self) -> None:

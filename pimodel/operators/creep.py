@@ -29,7 +29,15 @@ import numpy as np
 
 from .. import _native
 from ..checks import as_signal, as_vector, positive_scalar, scalar_or_vector
-from .base import Streaming, freeze, operator_repr, read_only, size_of, streaming_state
+from .base import (
+    Streaming,
+    check_finite,
+    freeze,
+    operator_repr,
+    read_only,
+    size_of,
+    streaming_state,
+)
 
 __all__ = ["CreepOperator"]
 
@@ -223,7 +231,8 @@ class CreepOperator(Streaming):
         return (out, s) if return_state else out
 
     def _run(self, x: np.ndarray, s: np.ndarray) -> np.ndarray:
-        return _native.creep_run(self._a, self._c, s, x, inverse=self.inverted)
+        return check_finite(_native.creep_run(self._a, self._c, s, x, inverse=self.inverted), x,
+                            "u", state=s)
 
     def _check_state(self, value) -> np.ndarray:
         return scalar_or_vector(value, "state", self.m)
@@ -267,7 +276,7 @@ class CreepOperator(Streaming):
         >>> cr.step(1.0), round(cr.step(1.0), 8)
         (1.0, 1.31606028)
         """
-        return self._advance(self._run, as_signal(u, "u"))
+        return self._advance(self._run, as_signal(u, "u"), "u")
 
     def inverse(self) -> CreepOperator:
         """The exact causal inverse ``u = G^-1[y]`` (same lags and state; module docstring).

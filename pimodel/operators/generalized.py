@@ -37,7 +37,7 @@ import numpy as np
 
 from .. import _native
 from ..checks import as_signal, scalar_or_vector
-from .base import Streaming, operator_repr, read_only, size_of, streaming_state
+from .base import Streaming, check_finite, operator_repr, read_only, size_of, streaming_state
 from .envelopes import Envelope
 from .pi import PIOperator
 
@@ -123,7 +123,7 @@ class GeneralizedPI(Streaming):
             raise ValueError(f"v: sample {k} ({float(x[k])!r}) leaves the domain of the input "
                              f"envelope {self.input_envelope!r} or, through the play sum, of the "
                              f"output envelope {self.output_envelope!r}")
-        return y
+        return check_finite(y, x, "v", state=z)
 
     def _check_state(self, value) -> np.ndarray:
         return scalar_or_vector(value, "initial_state", self.n, one_per="play")

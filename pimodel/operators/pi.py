@@ -13,6 +13,7 @@ no role, only the sequence of input values. Units: ``v`` and the radii share the
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 
@@ -20,7 +21,15 @@ import numpy as np
 
 from .. import _native
 from ..checks import as_signal, as_vector, scalar_or_vector
-from .base import Streaming, freeze, operator_repr, read_only, size_of, streaming_state
+from .base import (
+    Streaming,
+    check_finite,
+    freeze,
+    operator_repr,
+    read_only,
+    size_of,
+    streaming_state,
+)
 from .describing_function import PIDescribingFunction
 
 __all__ = [
@@ -30,16 +39,11 @@ __all__ = [
 
 INVERSE_CONDITION_WARN = 1e6    # max/min branch slope above which inverse() warns
 INVERSE_CONDITION_ERROR = 1e12  # ... and above which it raises (rounding dominates)
-
-
-def _check_output(y: np.ndarray, v: np.ndarray) -> None:
-    """ValueError when a finite input gave a non-finite output (float64 overflow)."""
-    if not np.all(np.isfinite(y)):
-        k = int(np.flatnonzero(~np.isfinite(y))[0])
-        raise ValueError(
-            f"v: sample {k} ({float(v[k]):.6g}) makes the output overflow to {float(y[k])!r}; "
-            f"expected |v| * sum |p_i| below {np.finfo(float).max:.3g}: scale the input"
-        )
+# The inverse's weights -p_i / (P_i P_(i-1)) need the product of two partial sums P_i = p_1 +
+# ... + p_i to be a normal float64: P_i in [sqrt(tiny), sqrt(max)] = [1.49e-154, 1.34e154].
+# Outside it the product overflows (weights -0.0) or loses digits (subnormal), silently.
+INVERSE_WEIGHT_MIN = float(np.sqrt(np.finfo(float).tiny))
+INVERSE_WEIGHT_MAX = float(np.sqrt(np.finfo(float).max))
 
 
 def _check_parameters(weights, radii, *, signed_weights: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -168,7 +172,7 @@ class PIOperator(Streaming):
         x = as_signal(v, "v")
         z = self._start_state(state)
         y, _ = _native.pi_run(self._p, self._r, z, x)
-        _check_output(y, x)
+        check_finite(y, x, "v", state=z)
         return (y, z) if return_state else y
 
     def play_outputs(self, v, *, state=None) -> np.ndarray:
@@ -239,7 +243,7 @@ class PIOperator(Streaming):
         Raises
         ------
         ValueError
-            If ``v`` is not finite or the output overflows.
+            If ``v`` is not finite or the output overflows; the state is then unchanged.
 
         Examples
         --------
@@ -250,8 +254,11 @@ class PIOperator(Streaming):
         vk = float(v)
         if not np.isfinite(vk):
             raise ValueError(f"v: input sample is {v!r}; expected a finite number")
-        y = _native.pi_step(self._p, self._r, self._z, vk)
-        _check_output(np.array([y]), np.array([vk]))
+        z = self._z.copy()   # the state moves only when the step succeeds (base.py's rule)
+        y = _native.pi_step(self._p, self._r, z, vk)
+        if not math.isfinite(y):   # a non-finite play state makes y non-finite too
+            check_finite(np.array([y]), np.array([vk]), "v", state=z)
+        self._z = z
         return y
 
     def output(self, state=None) -> float:
@@ -339,7 +346,9 @@ class PIOperator(Streaming):
         Raises
         ------
         ValueError
-            If ``r_1 > 0``, a partial sum of weights is not positive, the branch slopes range
+            If ``r_1 > 0``, a partial sum of weights is not positive or lies outside
+            ``[INVERSE_WEIGHT_MIN, INVERSE_WEIGHT_MAX]`` (about 1.5e-154 to 1.3e154, where
+            the products ``P_i P_(i-1)`` stay normal float64 numbers), the branch slopes range
             over more than ``INVERSE_CONDITION_ERROR`` (a RuntimeWarning above
             ``INVERSE_CONDITION_WARN``), or the inverse's parameters overflow float64.
 
@@ -365,6 +374,13 @@ class PIOperator(Streaming):
                 "PIOperator.inverse: not invertible, a partial sum of weights is not positive"
             )
         P = np.cumsum(self._p)
+        if P.max() > INVERSE_WEIGHT_MAX or P.min() < INVERSE_WEIGHT_MIN:
+            raise ValueError(
+                "PIOperator.inverse: not representable in float64, the partial sums P_i = "
+                f"p_1 + ... + p_i run from {float(P.min()):.3g} to {float(P.max()):.3g}; the "
+                "inverse's weights -p_i / (P_i P_(i-1)) are representable only for P_i within "
+                f"[{INVERSE_WEIGHT_MIN:.3g}, {INVERSE_WEIGHT_MAX:.3g}] (float64): rescale the "
+                "output units")
         cond = float(P.max() / P.min())
         if cond > INVERSE_CONDITION_ERROR:
             raise ValueError(

@@ -52,6 +52,7 @@ from ..checks import as_signal, positive_scalar
 from .base import (
     InverseStreaming,
     Streaming,
+    check_finite,
     operator_repr,
     read_only,
     size_of,
@@ -185,10 +186,26 @@ class RateDependentPI(Streaming):
         self._restart()
 
     # -- simulation ---------------------------------------------------------------------
+    def _check_rates(self, x: np.ndarray, s: np.ndarray) -> None:
+        """ValueError naming the first sample whose rate ``|v[k] - v[k-1]| / dt`` or radius
+        ``alpha_n (1 + beta rate)`` float64 cannot hold (checked before the C core runs)."""
+        with np.errstate(over="ignore"):
+            rate = np.abs(np.diff(np.concatenate(([s[self.n]], x)))) / self.dt
+            radius = self._r[-1] * (1.0 + self.rate_gain * np.maximum(rate, s[-1]))
+            bad = ~np.isfinite(rate) | ~np.isfinite(radius) | ~np.isfinite(np.abs(x) + radius)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"v: sample {k} ({float(x[k]):.6g}) moves at a rate |v[k] - v[k-1]| / dt = "
+                f"{float(rate[k]):.3g} whose play radius alpha_n (1 + rate_gain rate) overflows "
+                "float64; expected a smaller step, a longer dt or a smaller rate_gain")
+
     def _run(self, x: np.ndarray, s: np.ndarray) -> np.ndarray:
+        self._check_rates(x, s)
         z, hist = s[:self.n].copy(), s[self.n:].copy()
         y = _native.rdpi_run(self.weights, self.base_radii, self.rate_gain, self.rate_decay,
                              self.dt, z, hist, x)
+        check_finite(y, x, "v", state=np.concatenate((z, hist)))
         s[:self.n], s[self.n:] = z, hist
         return y
 
@@ -344,6 +361,7 @@ class RateDependentPIInverse(InverseStreaming):
         z, hist = s[:f.n].copy(), s[f.n:].copy()
         v = _native.rdpi_inverse_run(f.weights, f.base_radii, f.rate_gain, f.rate_decay, f.dt,
                                      z, hist, yd)
+        check_finite(v, yd, "y_d", state=np.concatenate((z, hist)))
         s[:f.n], s[f.n:] = z, hist
         return v
 
@@ -404,4 +422,4 @@ class RateDependentPIInverse(InverseStreaming):
         >>> round(op.inverse().step(1.5), 12)
         1.066666666667
         """
-        return self._advance(self._run, as_signal(y_d, "y_d"))
+        return self._advance(self._run, as_signal(y_d, "y_d"), "y_d")

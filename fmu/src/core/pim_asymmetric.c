@@ -57,8 +57,21 @@ static double asym_slope(const pim_asym *a, size_t n, const double *p, const dou
     return d;
 }
 
+/* One correction x + (y - f(x)) / d: f is linear with slope d on the segment that holds x and
+ * the root, so the residual taken at x (near the root) keeps the digits a distant kink loses
+ * (envelopes with near-equal slopes cross at |s| ~ 1e15, where f(kink) has ~1 absolute
+ * rounding; issue 32). */
+static double asym_refine(const pim_asym *a, size_t n, const double *p, const double *r,
+                          const double *z, double y, double x, double d, double lo, double hi)
+{
+    x += (y - asym_sum(a, n, p, r, z, x)) / d;
+    x = x > lo ? x : lo;
+    return x < hi ? x : hi;
+}
+
 /* s with asym_sum(s) = y: f is continuous, strictly increasing, linear between the kinks;
- * the root is taken from the left kink with the segment's own slope (no long chords). */
+ * the root is taken from the left kink with the segment's own slope (no long chords), then
+ * corrected once from that first estimate (asym_refine). */
 double pim_asym_solve(const pim_asym *a, size_t n, const double *p, const double *r,
                          const double *z, double y)
 {
@@ -80,18 +93,20 @@ double pim_asym_solve(const pim_asym *a, size_t n, const double *p, const double
     }
     double f_lo = asym_sum(a, n, p, r, z, b[0]);
     if (y <= f_lo) { /* linear left of every kink */
-        return b[0] - (f_lo - y) / asym_slope(a, n, p, r, z, b[0] - 1.0);
+        const double d = asym_slope(a, n, p, r, z, b[0] - 1.0);
+        return asym_refine(a, n, p, r, z, y, b[0] - (f_lo - y) / d, d, -INFINITY, b[0]);
     }
     for (size_t j = 1; j < m; ++j) {
         const double f_hi = asym_sum(a, n, p, r, z, b[j]);
         if (y <= f_hi) {
-            const double x = b[j - 1] + (y - f_lo) /
-                             asym_slope(a, n, p, r, z, 0.5 * (b[j - 1] + b[j]));
-            return x < b[j] ? x : b[j];
+            const double d = asym_slope(a, n, p, r, z, 0.5 * (b[j - 1] + b[j]));
+            const double x = b[j - 1] + (y - f_lo) / d;
+            return asym_refine(a, n, p, r, z, y, x < b[j] ? x : b[j], d, b[j - 1], b[j]);
         }
         f_lo = f_hi;
     }
-    return b[m - 1] + (y - f_lo) / asym_slope(a, n, p, r, z, b[m - 1] + 1.0);
+    const double d = asym_slope(a, n, p, r, z, b[m - 1] + 1.0);
+    return asym_refine(a, n, p, r, z, y, b[m - 1] + (y - f_lo) / d, d, b[m - 1], INFINITY);
 }
 
 size_t pim_asym_inverse_run(const pim_asym *a, size_t N, size_t n, const double *p,

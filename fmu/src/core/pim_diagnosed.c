@@ -148,6 +148,7 @@ const char *pim_diag_check(const pim_diag *d)
     if (!(isfinite(d->delay) && d->delay >= 0.0 && d->delay <= PIM_DIAG_MAX_DELAY - 2))
         return "the delay must be finite, >= 0 and <= 4094 samples";
     if (d->drift_clock < 0 || d->drift_clock > 2) return "drift_clock must be 0, 1 or 2";
+    if (d->plays_start != 0 && d->plays_start != 1) return "plays_start must be 0 or 1";
     if (!isfinite(d->drift)) return "the drift is not finite";
     return NULL;
 }
@@ -164,6 +165,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     if (first) {
         x[1] = v;
         x[2] = t;
+        for (size_t i = 0; d->plays_start && i < n; ++i) z[i] = v; /* at rest at v[0] */
     }
     /* the filtered rate rho_f[k] (rate.input_rate) */
     double rho_f = 0.0;
@@ -203,6 +205,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         double xf = v;
         for (size_t j = 0; j < d->nw; ++j)
             xf = lti_step(d->wf_b + m * j, d->wf_a + m * j, o, fs + o * j, xf, first);
+        for (size_t i = 0; first && d->plays_start && i < n; ++i) zf[i] = xf; /* at x_f[0] */
         h = 0.0;
         for (size_t i = 0; i < n; ++i) {
             zf[i] = diag_clamp(zf[i], xf - d->r[i], xf + d->r[i]);

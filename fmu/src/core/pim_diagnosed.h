@@ -6,7 +6,7 @@
  * FMU unit (pim_unit.h, unit 8).
  *
  * Discrete-time semantics, sample k at time t[k], input v[k], plays at rest at z_i[-1] (the
- * state, normally 0):
+ * state, normally 0; with plays_start = 1, v[0], set on the first sample):
  *
  *     z_i[k] = max(v[k] - r_i, min(v[k] + r_i, z_i[k-1]))              plays (pim_core.h)
  *     h[k]   = sum_i w_i z_i[k],   h0[k] = sum_i w0_i z_i[k] + c0
@@ -96,6 +96,9 @@ typedef struct {
     size_t nw;             /* prefilter sections F_j before the plays (0: none, a Wiener model
                               has <= PIM_DIAG_MAX_ELEMENTS) */
     const double *wf_b, *wf_a; /* nw sections of PIM_DIAG_SECTION coefficients, a[0] = 1 */
+    int plays_start;       /* 0: the plays start at the initial state's z (and zf); 1: at rest
+                              at the first input, z_i[-1] = v[0] (zf_i[-1] = x_f[0]), as the
+                              diagnosis' nominal (pimodel.diagnosis.effects.make_segment) */
 } pim_diag;
 
 /* Length of the flat state of d (the layout above). */
@@ -122,9 +125,10 @@ PIM_API size_t pim_diag_delay_length(double delay);
  * (the FMU adds the value).
  */
 PIM_API const char *pim_diag_check(const pim_diag *d);
+/* (plays_start must be 0 or 1.) */
 
 /* The state before the first sample into x (pim_diag_state_size(d) values): all zero, the plays
- * z (and zf) at z0. */
+ * z (and zf) at z0 (replaced by v[0] on the first sample when plays_start = 1). */
 PIM_API void pim_diag_initial_state(const pim_diag *d, double *x, double z0);
 
 /* One sample: y[k] for v[k] at time t[k]; the state x advances to after sample k. */

@@ -48,6 +48,10 @@ from ...checks import as_signal, as_vector, integer_in, positive_scalar
 from ..branches import ReversalScanner
 from ..piecewise_linear import fit_hinges, fit_segmented
 from ..slopes import plays_from_slopes
+from .settings import noise_level
+
+FIT_NOISE_FACTOR = 2.0   # estimate_jointly warns when its branch fit RMS exceeds
+FIT_RANGE_SHARE = 1e-3   # FIT_NOISE_FACTOR sigma_y + FIT_RANGE_SHARE ptp(y)
 
 __all__ = [
     "branch_shape",
@@ -490,6 +494,12 @@ def estimate_jointly(v, y, n_plays: int, **options) -> JointEstimate:
     ValueError
         Bad samples or options (named).
 
+    Warns
+    -----
+    RuntimeWarning
+        When the branch fit RMS exceeds ``FIT_NOISE_FACTOR sigma_y + FIT_RANGE_SHARE ptp(y)``
+        (a fit far outside the noise, e.g. a local optimum of the radii).
+
     Examples
     --------
     >>> from pimodel import PIOperator
@@ -501,7 +511,26 @@ def estimate_jointly(v, y, n_plays: int, **options) -> JointEstimate:
     """
     est = JointEstimator(n_plays, **options)
     est.run(v, y)
-    return est.finish()
+    res = est.finish()
+    _warn_if_poor_fit(res, est.linear_play, as_signal(y, "y"))
+    return res
+
+
+def _warn_if_poor_fit(res: JointEstimate, linear_play: bool, y: np.ndarray) -> None:
+    """RuntimeWarning when the branch fit RMS is far outside the noise of ``y``: above
+    ``FIT_NOISE_FACTOR sigma_y + FIT_RANGE_SHARE ptp(y)`` (``sigma_y`` from
+    :func:`.settings.noise_level`), as ``identify`` warns through its health check."""
+    if y.size < 3 or not np.isfinite(res.fit_rms):
+        return
+    bound = FIT_NOISE_FACTOR * noise_level(y) + FIT_RANGE_SHARE * float(np.ptp(y))
+    if res.fit_rms > bound:
+        hint = ("" if linear_play else "; if the stage has a linear play (r_1 = 0), pass "
+                "linear_play=True, or use identify(method='joint'), which takes r_1 from the "
+                "branch slopes")
+        warnings.warn(f"estimate_jointly: the model does not fit the data: branch fit RMS "
+                      f"{res.fit_rms:.3g} exceeds the noise bound {bound:.3g} (a local optimum "
+                      f"of the radii, or dynamics the PI model lacks){hint}",
+                      RuntimeWarning, stacklevel=3)
 
 
 def stream_jointly(estimator: JointEstimator, chunks: Iterable[tuple]) -> JointEstimate:

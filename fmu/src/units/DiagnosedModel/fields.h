@@ -6,7 +6,7 @@
 #include "diag_fields.h"
 double lti_b[PIM_NMAX], lti_a[PIM_NMAX];
 double drift_per_s, delay_samples;
-int lti_order, drift_clock, n_lti_elements, n_wiener_elements;
+int lti_order, drift_clock, n_lti_elements, n_wiener_elements, plays_start;
 double lti_gain[PIM_NMAX], lti_element_b[PIM_NMAX], lti_element_a[PIM_NMAX];
 double wiener_element_b[PIM_NMAX], wiener_element_a[PIM_NMAX];
 double dstate[PIM_DIAG_STATE_MAX]; /* pim_diag's state */

@@ -35,6 +35,7 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->nw = u->n_wiener_elements > 0 ? (size_t)u->n_wiener_elements : 0;
     d->wf_b = u->wiener_element_b;
     d->wf_a = u->wiener_element_a;
+    d->plays_start = u->plays_start;
 }
 
 /* The DiagnosedModel parameter rules, with the variable, index and value in the message. */
@@ -46,6 +47,9 @@ static int model_check_parameters(pim_unit *u)
     if (u->drift_clock < 0 || u->drift_clock > 2)
         return unit_error(u, "parameter drift_clock = %d out of range: 0 none, 1 record, "
                              "2 absolute", u->drift_clock);
+    if (u->plays_start < 0 || u->plays_start > 1)
+        return unit_error(u, "parameter plays_start = %d out of range: 0 at z0, 1 at rest at "
+                             "the first input v[0]", u->plays_start);
     if (u->lti_order < 0 || u->lti_order > PIM_DIAG_MAX_ORDER)
         return unit_error(u, "parameter lti_order = %d out of range: 0 <= lti_order <= %d",
                           u->lti_order, PIM_DIAG_MAX_ORDER);

@@ -1,0 +1,138 @@
+"""Issue 28: the diagnosis on records unlike its other tests' (a logarithmic chirp, ramps to
+held levels, band-limited random input, 500 Hz and 2 kHz), and creep reported as a law.
+
+Stages and inputs are drawn in the tests (fixed seeds): a clean stage must come out ``none``;
+a creep over tens of seconds must come out ``creep`` with its percent per decade.
+"""
+
+import numpy as np
+import pytest
+from scipy.signal import butter, lfilter
+
+from pimodel.diagnosis import diagnose
+from pimodel.diagnosis.creep import creep_law, creep_time_constants
+from pimodel.operators.creep import CreepOperator
+from pimodel.operators.pi import PIOperator
+from pimodel.records import Record
+
+NOISE = 0.005  # um
+
+
+def _stage(rng):
+    """4-8 plays, the first at radius 0, the others up to 3 (input units)."""
+    n = int(rng.integers(4, 9))
+    radii = np.sort(np.concatenate(([0.0], rng.uniform(0.2, 3.0, n - 1))))
+    return rng.uniform(0.1, 1.0, n), radii
+
+
+def _chirp(rng, fs, seconds=4.0):
+    """A logarithmic chirp from 0.5 Hz to min(40 Hz, fs / 20) around 2, random phase."""
+    t = np.arange(int(seconds * fs)) / fs
+    f0, f1 = 0.5, min(40.0, fs / 20)
+    phase = 2 * np.pi * f0 * t[-1] / np.log(f1 / f0) * ((f1 / f0) ** (t / t[-1]) - 1)
+    return t, 2.0 + 3.0 * np.sin(phase + rng.uniform(0, 2 * np.pi))
+
+
+def _held_ramps(rng, fs, seconds=4.0, levels=16):
+    """Ramps of 50 ms to random levels in [-3, 4], each held until the next (random times)."""
+    t = np.arange(int(seconds * fs)) / fs
+    starts = np.sort(rng.uniform(0, t[-1] - 0.1, levels))
+    lv = rng.uniform(-3, 4, levels)
+    tk, vk = [0.0], [lv[0]]
+    for k in range(1, levels):
+        tk += [starts[k], starts[k] + 0.05]
+        vk += [vk[-1], lv[k]]
+    return t, np.interp(t, tk + [t[-1]], vk + [vk[-1]])
+
+
+def _band_limited(rng, fs, seconds, cutoff):
+    """Gaussian noise low-passed (3rd-order Butterworth, ``cutoff`` Hz), unit variance."""
+    b, a = butter(3, cutoff / (fs / 2))
+    n = int(seconds * fs)
+    x = lfilter(b, a, rng.normal(0, 1, n + 3000))[3000:]
+    return np.arange(n) / fs, x / np.std(x)
+
+
+INPUTS = {"chirp": _chirp, "held_ramps": _held_ramps}
+
+
+@pytest.mark.parametrize("fs", [500.0, 2000.0])
+@pytest.mark.parametrize("kind", sorted(INPUTS))
+def test_clean_stage_is_none_on_other_inputs_and_rates(kind, fs):
+    """A clean stage (plays at rest at v[0], white noise) driven by a chirp or by ramps to held
+    levels, at 500 Hz or 2 kHz: the nominal reaches the noise (within 1.5x) and the verdict is
+    ``none``."""
+    rng = np.random.default_rng(11 if kind == "chirp" else 12)
+    p, r = _stage(rng)
+    recs = []
+    for i in range(2):
+        t, v = INPUTS[kind](rng, fs)
+        y = PIOperator(p, r, initial_state=v[0]).simulate(v) + rng.normal(0, NOISE, v.size)
+        recs.append(Record(t, v, y, source=f"{kind}{i}"))
+    rep = diagnose([recs[0]], [recs[1]])
+    assert rep.nominal["validate"]["rms"] <= 1.5 * NOISE, rep.nominal["validate"]
+    assert rep.verdict["effects"] == ["none"], rep.verdict["effects"]
+
+
+def test_creep_lags_follow_the_records():
+    """One lag per decade from at least 10 samples to at least half the longest record: the
+    grid of the existing generators' records (10 kHz over 3 s, 5 kHz over 1.7 s) is kept, a
+    slow record gets longer lags, a fast one shorter ones."""
+    assert creep_time_constants(1e-4, 3.0) == (0.003, 0.03, 0.3, 3.0)
+    assert creep_time_constants(2e-4, 1.65) == (0.003, 0.03, 0.3, 3.0)
+    for dt, duration in ((5e-3, 100.0), (2e-3, 40.0), (1e-5, 0.2), (1e-3, 600.0)):
+        taus = np.array(creep_time_constants(dt, duration))
+        assert taus[0] >= 10 * dt and taus[0] < 100 * dt
+        assert taus[-1] >= duration / 2 and taus[-1] < 5 * duration
+        assert np.allclose(np.diff(np.log10(taus)), 1.0)
+    with pytest.raises(ValueError, match="dt"):
+        creep_time_constants(0.0, 1.0)
+    with pytest.raises(ValueError, match="duration"):
+        creep_time_constants(1e-3, float("nan"))
+
+
+def test_creep_law_reads_a_log_law():
+    """Lags one per decade of equal gain give a law of that gain per decade (to 10 %), and its
+    total creep; gains that sum to 1 or more are refused."""
+    rng = np.random.default_rng(4)
+    for _ in range(5):
+        c = rng.uniform(0.005, 0.03)
+        taus = 0.01 * 10.0 ** np.arange(int(rng.integers(3, 6)))
+        g = np.full(taus.size, c) / (1 + c * taus.size)  # the diagnosis' form (module creep)
+        law = creep_law(g, taus)
+        assert law["percent_per_decade"] == pytest.approx(100 * c, rel=0.1)
+        assert law["total_percent"] == pytest.approx(100 * c * taus.size, rel=1e-9)
+        assert law["lag_percent"] == pytest.approx([100 * c] * taus.size, rel=1e-9)
+    with pytest.raises(ValueError, match="sum"):
+        creep_law([0.6, 0.5], [0.1, 1.0])
+    with pytest.raises(ValueError, match="one gain per time constant"):
+        creep_law([0.1], [0.1, 1.0])
+
+
+@pytest.mark.slow  # two 40 s records at 500 Hz (~15-30 s)
+def test_slow_creep_on_long_band_limited_records_is_read_as_a_law():
+    """Creep of 1-3 % per decade with lags of 0.2, 2 and 20 s under band-limited random motion
+    and held levels (two 40 s records at 500 Hz): creep is the first effect named, its lags
+    reach half the record and its percent per decade is the truth's within 25 %. (A second
+    effect, ``rate``, is still added here: issue 28's "second effect only when it is real" is
+    not met, docs/diagnosis.md.)"""
+    rng = np.random.default_rng(0)
+    fs, seconds = 500.0, 40.0
+    p, r = _stage(rng)
+    gamma = rng.uniform(0.01, 0.03)
+    taus = np.array([0.2, 2.0, 20.0])
+    recs = []
+    for i in range(2):
+        t, x = _band_limited(rng, fs, seconds, 1.5)
+        levels = np.repeat(rng.uniform(-3, 3, 20), t.size // 20 + 1)[:t.size]
+        v = 1.0 + 1.5 * x + np.convolve(levels, np.ones(50) / 50, mode="same")
+        h = PIOperator(p, r, initial_state=v[0]).simulate(v)
+        y = CreepOperator(np.full(3, gamma), taus, dt=1 / fs, initial_state=h[0]).simulate(h)
+        recs.append(Record(t, v, y + rng.normal(0, NOISE, t.size), source=f"creep{i}"))
+    rep = diagnose([recs[0]], [recs[1]])
+    assert rep.verdict["effects"][0] == "creep", rep.verdict["effects"]
+    law = rep.verdict["creep_law"]
+    assert law["time_constants_s"][-1] >= seconds / 2
+    assert law["time_constants_s"][0] >= 10 / fs
+    truth = creep_law(np.full(3, gamma) / (1 + 3 * gamma), taus)
+    assert law["percent_per_decade"] == pytest.approx(truth["percent_per_decade"], rel=0.25)

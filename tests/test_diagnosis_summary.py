@@ -1,0 +1,133 @@
+"""The diagnosis in words (``pimodel.diagnosis.summary``): the summary names the verdict, how
+sure it is, where the gap sits and a next step drawn from the report's own figures; the
+Markdown report holds them and its figures."""
+
+import numpy as np
+import pytest
+
+from pimodel.cli import main
+from pimodel.diagnosis.diagnose import DiagnosisReport
+from pimodel.diagnosis.summary import confidence, hints, next_step, summarize, write_report
+
+STARTUP = "start-up (until the input first spans 90 % of its range)"
+
+
+def _report(effects=("creep",), *, ratio=1.2, alternatives=(), startup=1.0, share=0.0,
+            initial_state="rest", seed=0):
+    rng = np.random.default_rng(seed)
+    noise = rng.uniform(0.005, 0.02)
+    before = noise * rng.uniform(5, 20)
+    after = ratio * noise
+    regions = sorted([{"region": "hold after a step (after 50 ms)", "concentration": 2.5,
+                       "energy_share": 0.5, "sample_share": 0.2},
+                      {"region": STARTUP, "concentration": startup,
+                       "energy_share": 0.1 * startup, "sample_share": 0.1},
+                      {"region": "ascending branches", "concentration": 0.8,
+                       "energy_share": 0.4, "sample_share": 0.5}],
+                     key=lambda r: -r["concentration"])
+    un = {"present": "unexplained" in effects, "share": share}
+    if un["present"]:
+        un.update(where=["input extremes (outer 20 % of range)"], band="1-10 Hz")
+    verdict = {"effects": list(effects), "gap_before": before, "gap_after": after,
+               "shrink": 1 - after / before, "noise_floor": noise,
+               "noise_floor_method": "repeated periods", "gap_after_over_noise": ratio,
+               "alternatives": list(alternatives), "unexplained": un, "model": {}}
+    where = {"regions": regions, "spectrum": [{"band": "< 1 Hz", "energy_share": 0.7},
+                                              {"band": "1-10 Hz", "energy_share": 0.3}]}
+    return DiagnosisReport({"initial_state": initial_state}, where, [], verdict, [], [], [])
+
+
+def test_summary_states_verdict_figures_and_region():
+    rep = _report(seed=3)
+    text = summarize(rep)
+    lines = text.splitlines()
+    assert len(lines) == 4 and [ln.split(":")[0] for ln in lines] == [
+        "Verdict", "How sure", "Where the gap sits (nominal model)", "Next"]
+    v = rep.verdict
+    assert "creep" in lines[0]
+    assert f"{v['gap_before']:.3g}" in lines[1] and f"{v['gap_after']:.3g}" in lines[1]
+    assert f"{100 * v['shrink']:.0f} %" in lines[1]
+    assert lines[1].startswith("How sure: sure")
+    assert "hold after a step (after 50 ms)" in lines[2] and "70 % of it at < 1 Hz" in lines[2]
+    assert "ascending" not in lines[2]  # a region below uniform concentration is not named
+    assert "--export" in lines[3]
+
+
+def test_startup_hint_only_when_started_at_rest():
+    rep = _report(startup=3.0)
+    assert "--initial-state unknown" in next_step(rep)
+    assert "--initial-state unknown" in summarize(rep).splitlines()[-1]
+    quiet = _report(startup=3.0, initial_state="unknown")
+    assert not any("--initial-state" in h for h in hints(quiet))
+    assert "start-up" in summarize(rep) and "start-up" not in summarize(quiet)
+    assert not any("--initial-state" in h for h in hints(_report(startup=1.2)))
+
+
+def test_alternatives_and_unexplained_lower_the_confidence():
+    alt = _report(("delay",), alternatives=("rate",))
+    level, why = confidence(alt)
+    assert level == "fairly sure" and "rate explains" in why
+    assert any("tell them apart" in h for h in hints(alt))
+    un = _report(("unexplained",), ratio=6.0, share=0.4)
+    level, why = confidence(un)
+    assert level == "unsure" and "40 %" in why
+    assert "clipping" in next_step(un) and "input extremes" in next_step(un)
+    assert confidence(_report(ratio=3.0))[0] == "fairly sure"  # named, but not at the noise
+
+
+def test_none_says_use_the_nominal_model():
+    rep = _report(("none",), ratio=1.1)
+    assert "nominal PI model explains" in summarize(rep).splitlines()[0]
+    assert next_step(rep).startswith("use the nominal PI model")
+
+
+def test_report_without_records_has_no_figures(tmp_path):
+    rep = _report(("unexplained",), ratio=6.0, share=0.4, startup=3.0)
+    text = write_report(rep, tmp_path / "r").read_text()
+    assert "## Summary" in text and "## Hints" in text and "![" not in text
+    assert text.count("\n- ") == len(hints(rep)) >= 2
+    assert STARTUP in text  # the regions table
+
+
+@pytest.mark.slow
+def test_cli_prints_the_summary_and_writes_the_report(tmp_path, capsys):
+    """``pimodel diagnose --report DIR`` on a simulated stage with creep: the printed summary
+    names creep, report.md links figures that exist."""
+    from pimodel import save_record
+    from pimodel.stages.pi_stage import Truth, excitation
+
+    truth = Truth(creep_percent_per_decade=1.5)
+    for name, role, seed in (("a.csv", "train", 1), ("b.csv", "validate", 2)):
+        t, v = excitation(role, fs=5000.0)
+        save_record(truth.record(t, v, seed=seed), tmp_path / name)
+    out = tmp_path / "rep"
+    assert main(["diagnose", "--train", str(tmp_path / "a.csv"), "--validate",
+                 str(tmp_path / "b.csv"), "--json", str(tmp_path / "r.json"),
+                 "--report", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "Verdict: creep" in printed and f"wrote {out / 'report.md'}" in printed
+    text = (out / "report.md").read_text()
+    figs = [ln[ln.index("(") + 1:-1] for ln in text.splitlines() if ln.startswith("![")]
+    assert len(figs) == 2 and all((out / f).exists() for f in figs)
+    assert "| creep |" in text  # the table of each effect alone
+
+
+def test_report_tables_escape_pipes_in_region_names(tmp_path):
+    rep = _report()
+    rep.where["regions"].insert(0, {"region": "fast input (top quarter of |dv/dt|)",
+                                    "concentration": 3.0, "energy_share": 0.6,
+                                    "sample_share": 0.2})
+    text = write_report(rep, tmp_path).read_text()
+    row = next(ln for ln in text.splitlines() if ln.startswith("| fast input"))
+    assert row.replace("\\|", "").count("|") == 5  # four cells
+
+
+def test_report_folder_that_is_an_input_is_refused(tmp_path, capsys):
+    from pimodel import Record, save_record
+
+    t = np.arange(200) * 1e-3
+    rec = save_record(Record(t, np.sin(20 * t), np.sin(20 * t)), tmp_path / "d.csv")
+    code = main(["diagnose", "--train", str(rec), "--validate", str(rec), "--json",
+                 str(tmp_path / "r.json"), "--report", str(rec)])
+    assert code == 2 and "--report" in capsys.readouterr().err
+    assert not (tmp_path / "r.json").exists()  # refused before any work
