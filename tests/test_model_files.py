@@ -151,11 +151,15 @@ def test_case14_too_many_plays_says_at_most(tmp_path, capsys, n):
 
 def test_case14_diagnosed_model_limit_is_twice_nmax(tmp_path, capsys):
     n = 2 * NMAX + 1
-    save_model(DiagnosedModel(np.linspace(0, 1, n), np.full(n, 0.1), 0.0, dt=1e-3),
-               tmp_path / "d.json")
+    d = diagnosed(())
+    d["radii"], d["weights"] = np.linspace(0, 1, n).tolist(), [0.1] * n
+    d["reference_weights"] = [0.1] * n
+    write(tmp_path, d, "d.json")
     assert main(["fmu", "build", "--model", str(tmp_path / "d.json"), "--out",
                  str(tmp_path / "fmus")]) == 2
-    assert f"at most {2 * NMAX} plays" in capsys.readouterr().err
+    err = capsys.readouterr().err  # the constructor's limit (Python = FMU) or the FMU check
+    assert "d.json" in err and f"{n} plays" in err and f"at most {2 * NMAX}" in err
+    assert len(err) < 300
 
 
 # --- case 17: list lengths ------------------------------------------------------------------------
@@ -285,7 +289,10 @@ def test_property_random_model_edits_load_and_simulate_finite_or_name_the_key(ca
 # --- the chain: CSV with its own column names -> identify --json -> fmu build --model -> fmpy
 
 @pytest.mark.slow
-def test_csv_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_path):
+@pytest.mark.parametrize("fmt", ["csv", "mat"])
+def test_lab_file_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_path, fmt):
+    """CSV or MATLAB .mat with its own column names -> identify --json -> fmu build --model on
+    that very file -> the FMU in fmpy equals the Python model with its offset."""
     if shutil.which("cc") is None and shutil.which("gcc") is None:
         pytest.skip("no C compiler on PATH")
     from pimodel.fmu.model_fmu import build_model_fmus, cosimulate_chain
@@ -297,14 +304,19 @@ def test_csv_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_pa
     t = np.arange(0, 12, dt)
     v = 2 * np.abs((t % 2) - 1) - 1  # a 0.5 Hz triangle, 2 V peak to peak
     y = stage.simulate(v) + offset + rng.normal(0, 1e-3, t.size)
-    np.savetxt(tmp_path / "lab.csv", np.c_[t, v, y], delimiter=",", fmt="%.17g",
-               header="time_s,voltage_V,disp_um", comments="")
+    lab = tmp_path / f"lab.{fmt}"
+    if fmt == "csv":
+        np.savetxt(lab, np.c_[t, v, y], delimiter=",", fmt="%.17g",
+                   header="time_s,voltage_V,disp_um", comments="")
+    else:
+        scipy_io = pytest.importorskip("scipy.io")
+        scipy_io.savemat(lab, {"time_s": t, "voltage_V": v, "disp_um": y})  # (1, N) arrays
     model_json = tmp_path / "m.json"
-    assert main(["identify", str(tmp_path / "lab.csv"), "--columns", "time_s,voltage_V,disp_um",
+    assert main(["identify", str(lab), "--columns", "time_s,voltage_V,disp_um",
                  "--json", str(model_json), "--method", "conventional", "--plays", "3"]) == 0
     m = load_model(model_json)
     assert m.units == {"time": "s", "input": "V", "output": "um"} and m.dt == pytest.approx(dt)
-    assert abs(m.offset - offset) < 0.2 and m.provenance["record"].endswith("lab.csv")
+    assert abs(m.offset - offset) < 0.2 and m.provenance["record"].endswith(lab.name)
     assert main(["fmu", "build", "--model", str(model_json), "--out", str(tmp_path / "fmus")]) == 0
     fwd = sorted((tmp_path / "fmus").glob("m_1_*.fmu"))
     fwd = [p for p in fwd if "Inverse" not in p.name]
@@ -317,28 +329,3 @@ def test_csv_chain_identify_fmu_build_equals_the_python_model_with_offset(tmp_pa
     np.testing.assert_allclose(cosimulate_chain(inv, yy, dt), m.inverse().simulate(yy), rtol=0,
                                atol=1e-9)
     np.testing.assert_allclose(cosimulate_chain(inv, yy, dt), vv, rtol=0, atol=1e-6)
-
-
-@pytest.mark.skip(reason="the .mat chain needs load_record on .mat files (issue 30's records "
-                  "part, another branch); the CSV chain above is the same from identify on")
-def test_mat_chain_identify_fmu_build_equals_the_python_model_with_offset():
-    """Place for the .mat variant: scipy.io.savemat the record of the CSV chain, then the same
-    steps with ``pimodel identify lab.mat``."""
-
-
-def test_identify_result_saves_as_a_model_file_and_its_blocks_take_the_offset(tmp_path):
-    from pimodel import identify
-
-    rng = np.random.default_rng(7)
-    stage = PIOperator([1.0, 0.5], [0.0, 0.4])
-    offset = float(rng.uniform(1, 3))
-    v = 2 * np.sin(np.linspace(0, 6 * np.pi, 600))
-    idn = identify(v, stage.simulate(v) + offset, dt=1e-3, n_plays=2, passes=2)
-    m = load_model(save_model(idn, tmp_path / "idn.json", dt=1e-3))
-    assert m.offset == idn.offset and m.provenance["method"] == idn.method
-    assert m.report["n_plays"] == 2
-    y_d = m.simulate(v)
-    t = np.arange(v.size) * 1e-3
-    for ff in (inverse_pi_block(idn, 1e-3), inverse_pi_block(m)):
-        res = control.input_output_response(ff, t, y_d, initial_state=initial_state(ff))
-        np.testing.assert_allclose(res.outputs, v, rtol=0, atol=1e-9)

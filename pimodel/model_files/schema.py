@@ -50,7 +50,8 @@ SPECS: dict[str, dict[str, tuple[str, bool]]] = {
     "DiagnosedModel": {"radii": ("nums0", True), "weights": ("nums", True),
                        "offset": ("num", True), "dt": ("num+", True), "effects": ("strs", True),
                        "reference_weights": ("nums", True), "reference_offset": ("num", True),
-                       "params": ("obj", True), "initial_state": ("str", False)},
+                       "params": ("obj", True), "initial_state": ("str", False),
+                       "plays_start": ("str", False)},
 }
 TYPES = tuple(SPECS)
 # lists that must have equal lengths, per type
