@@ -30,7 +30,7 @@ JointEstimate       the joint estimators' result
 Record              a sampled record t, v, y (validated)
 load_record         read a record from CSV (header) or NPZ
 save_record         write a record to CSV or NPZ
-load_model          read a model file (operator, cascade or diagnosed model)
+load_model          read a model file: a Model (operator, offset, dt, units, provenance)
 save_model          write a model file
 diagnose            where the sim-to-real gap lies and which effect causes it
 DiagnosisReport     diagnose's result

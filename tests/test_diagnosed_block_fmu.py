@@ -339,7 +339,7 @@ def test_cli_builds_a_model_fmu_that_validates_and_runs_in_the_masters(tmp_path,
 
     m = model("all")
     path = m.save(tmp_path / "twin.json")
-    assert isinstance(load_model(path), DiagnosedModel)
+    assert isinstance(load_model(path).operator, DiagnosedModel)
     out = tmp_path / "fmus"
     assert main(["fmu", "build", "--model", str(path), "--out", str(out),
                  "--fmi-version", fmi]) == 0

@@ -272,7 +272,7 @@ def test_json_round_trip_rebuilds_every_model(tmp_path):
     for model in models:
         path = save_model(model, tmp_path / "m.json")
         again = load_model(path)
-        assert type(again) is type(model)
+        assert type(again.operator) is type(model)
         np.testing.assert_array_equal(again.simulate(x), model.simulate(x))
         assert model_to_dict(again) == json.loads(path.read_text())
 
@@ -282,11 +282,12 @@ def test_bad_model_json_names_the_place(tmp_path):
         model_from_dict([1, 2])
     with pytest.raises(ValueError, match="model.type: unknown model type 'Foo'"):
         model_from_dict({"type": "Foo"})
-    with pytest.raises(ValueError, match=r"model.stages\[1\]: missing key 'time_constants'"):
+    with pytest.raises(ValueError, match=r"model.stages\[1\].time_constants: missing key"):
         model_from_dict({"type": "Cascade", "stages": [
             {"type": "CreepOperator", "gains": [0.1], "time_constants": [1.0], "dt": 1e-3},
             {"type": "CreepOperator", "gains": [0.1], "dt": 1e-3}]})
-    with pytest.raises(ValueError, match=r"model.stages\[0\] \(CreepOperator\): time_constants"):
+    with pytest.raises(ValueError,
+                       match=r"model.stages\[0\].time_constants\[0\]: expected a finite num"):
         model_from_dict({"type": "Cascade", "stages": [
             {"type": "CreepOperator", "gains": [0.1], "time_constants": [-1.0], "dt": 1e-3}]})
     bad = tmp_path / "bad.json"

@@ -135,20 +135,20 @@ def test_cli_identify_writes_json_and_plots(tmp_path):
     out = tmp_path / "id.json"
     assert main(["identify", str(tmp_path / "rec.csv"), "--json", str(out),
                  "--plots", str(tmp_path / "plots")]) == 0
-    data = json.loads(out.read_text())
-    assert data["method"] == "adaptive"
+    data = json.loads(out.read_text())  # a model file: the operator, offset, report
+    assert data["type"] == "PIOperator" and data["provenance"]["method"] == "adaptive"
     np.testing.assert_allclose(data["weights"], STAGE.weights, rtol=1e-3)
     np.testing.assert_allclose(data["radii"], STAGE.radii, atol=2e-3)
-    assert data["fit"]["rms_error_percent"] < 0.1
-    assert data["excitation"]["ok"] is True
+    assert data["report"]["fit"]["rms_error_percent"] < 0.1
+    assert data["report"]["excitation"]["ok"] is True
     assert (tmp_path / "plots" / "identify_adaptive.png").exists()
     assert main(["identify", str(tmp_path / "rec.csv"), "--json", str(out), "--method",
                  "conventional", "--plays", "7"]) == 0
-    assert json.loads(out.read_text())["n_plays"] <= 7
+    assert json.loads(out.read_text())["report"]["n_plays"] <= 7
     assert main(["identify", str(tmp_path / "rec.csv"), "--json", str(out), "--method",
                  "joint", "--plots", str(tmp_path / "plots")]) == 0
     data = json.loads(out.read_text())
-    assert data["method"] == "joint" and data["settings"]["updates"] >= 1
+    assert data["report"]["method"] == "joint" and data["report"]["settings"]["updates"] >= 1
     np.testing.assert_allclose(data["weights"], STAGE.weights, rtol=1e-3)
     np.testing.assert_allclose(data["radii"], STAGE.radii, atol=2e-3)
     assert (tmp_path / "plots" / "identify_joint.png").exists()

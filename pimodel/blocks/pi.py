@@ -60,8 +60,27 @@ __all__ = [
 
 
 
-def _operator_settings(op: PIOperator, name: str):
-    """Build function for a PI operator's params: weights, radii, initial play state."""
+def _pi_and_offset(op, dt) -> tuple[PIOperator, float, float]:
+    """``(operator, offset, dt)`` of a PIOperator, or of a model that holds one with its output
+    offset and sample time (``pimodel.load_model``'s Model, ``identify``'s result)."""
+    inner = getattr(op, "operator", None)
+    if isinstance(op, PIOperator):
+        pi, offset = op, 0.0
+    elif isinstance(inner, PIOperator):
+        pi, offset = inner, float(getattr(op, "offset", 0.0))
+    else:
+        raise TypeError(f"op: expected a PIOperator or a model holding one (load_model, "
+                        f"identify), got {type(op).__name__}")
+    if dt is None:
+        dt = getattr(op, "dt", None)
+        if dt is None:
+            raise ValueError("dt: expected the sample time [s]; the model has none")
+    return pi, offset, positive_scalar(dt, "dt")
+
+
+def _operator_settings(op: PIOperator, name: str, offset: float = 0.0):
+    """Build function for a PI operator's params: weights, radii, initial play state, output
+    offset."""
     n = op.n
 
     def build(s: dict) -> _Stepper:
@@ -73,10 +92,15 @@ def _operator_settings(op: PIOperator, name: str):
                          signed_weights=op.signed_weights)
         if not np.array_equal(new.radii, as_vector(s["radii"], "radii")):
             raise ValueError("radii: expected non-decreasing radii (they fix the state order)")
-        return _Stepper(new)
+        c = s["offset"]
+        if isinstance(c, bool) or not isinstance(c, (int, float, np.floating)) \
+                or not math.isfinite(c):
+            raise ValueError(f"offset: expected a finite number, got {c!r}")
+        return _Stepper(new, float(c))
 
     return BlockSettings(name, {"weights": op.weights.copy(), "radii": op.radii.copy(),
-                            "initial_state": op.initial_state.copy()}, build)
+                            "initial_state": op.initial_state.copy(), "offset": offset},
+                         build)
 
 
 # pim_pi_step on raw pointers: the blocks call it a few times per sample, and numpy's checked
@@ -87,8 +111,9 @@ _raw_pi_step = _native.raw_pi_step
 class _Stepper:
     """A PI operator ready for the C step: raw pointers to its (read-only, kept alive) arrays."""
 
-    def __init__(self, op: PIOperator):
+    def __init__(self, op: PIOperator, offset: float = 0.0):
         self.op = op
+        self.offset = offset
         self.n = op.n
         self.initial_state = op.initial_state
         self._p, self._r = _native.address(op.weights), _native.address(op.radii)
@@ -107,19 +132,22 @@ class _Stepper:
         return y, self._z.copy()
 
 
-def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
+def pi_block(op, dt: float | None = None, *, name: str = "pi", input: str = "v",
              output: str = "y") -> control.NonlinearIOSystem:
     """PI operator as a discrete python-control block (C core step).
 
-    ``y[k] = sum_i p_i z_i[k]`` with ``z_i[k] = clamp(z_i[k-1], v[k] - r_i, v[k] + r_i)``; the
-    state is ``x[k] = z[k-1]`` (direct feedthrough from ``v[k]``).
+    ``y[k] = sum_i p_i z_i[k] + offset`` with
+    ``z_i[k] = clamp(z_i[k-1], v[k] - r_i, v[k] + r_i)``; the state is ``x[k] = z[k-1]``
+    (direct feedthrough from ``v[k]``).
 
     Parameters
     ----------
-    op : PIOperator
-        Weights, radii and initial play state (signed weights allowed if ``op`` allows them).
-    dt : float
-        Sample time [s].
+    op : PIOperator or Model
+        Weights, radii and initial play state (signed weights allowed if ``op`` allows them);
+        a model that holds a PIOperator (``pimodel.load_model``, ``identify``) adds its
+        ``offset`` (0 for a bare operator).
+    dt : float, optional
+        Sample time [s] (default: the model's ``dt``).
     name : str
         Block name; prefix of its params and (in an interconnection) of its states.
     input, output : str
@@ -140,6 +168,8 @@ def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
         radii ``r_i`` (n values, non-decreasing, >= 0)
     ``"<name>.initial_state"``
         play states before the first sample ``z_i[-1]`` (scalar or n)
+    ``"<name>.offset"``
+        output offset added to ``y[k]``
 
     State layout (``sys.state_labels``):
 
@@ -160,10 +190,8 @@ def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
     >>> res.outputs.round(3).tolist()
     [0.0, 1.45, 0.8]
     """
-    if not isinstance(op, PIOperator):
-        raise TypeError(f"op: expected a PIOperator, got {type(op).__name__}")
-    dt = positive_scalar(dt, "dt")
-    settings = _operator_settings(op, name)
+    op, offset, dt = _pi_and_offset(op, dt)
+    settings = _operator_settings(op, name, offset)
 
     def upd(t, x, u, params):
         cur = settings.get(params)
@@ -172,7 +200,7 @@ def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
     def out(t, x, u, params):
         cur = settings.get(params)
         warn_if_zero_start(name, t, x, cur.initial_state)
-        return np.array([cur.step(x, u[0])[0]])
+        return np.array([cur.step(x, u[0])[0] + cur.offset])
 
     return Block(upd, out, own_state=lambda params: settings.get(params).initial_state,
                   aliases={f"{name}_z{i}": f"z[{i}]" for i in range(1, op.n + 1)},
@@ -180,19 +208,21 @@ def pi_block(op: PIOperator, dt: float, *, name: str = "pi", input: str = "v",
                   name=name, params=settings.params)
 
 
-def inverse_pi_block(op: PIOperator, dt: float, *, name: str = "pi_inv", input: str = "y_d",
+def inverse_pi_block(op, dt: float | None = None, *, name: str = "pi_inv", input: str = "y_d",
                      output: str = "v") -> control.NonlinearIOSystem:
     """Exact inverse of ``op`` as a feedforward compensator block.
 
-    Input the desired output ``y_d[k]``; output ``v[k] = PI^-1[y_d][k]``, the exact inverse
-    (itself a PI operator with signed weights, Krejci & Kuhnen) stepped by the C core.
+    Input the desired output ``y_d[k]``; output ``v[k] = PI^-1[y_d - offset][k]``, the exact
+    inverse (itself a PI operator with signed weights, Krejci & Kuhnen) stepped by the C core.
 
     Parameters
     ----------
-    op : PIOperator
+    op : PIOperator or Model
         The **forward** model to invert (``r_1 = 0``); its initial state gives the inverse's.
-    dt : float
-        Sample time [s].
+        A model that holds a PIOperator (``pimodel.load_model``, ``identify``) gives its
+        ``offset`` too (subtracted from ``y_d``; 0 for a bare operator): no second input.
+    dt : float, optional
+        Sample time [s] (default: the model's ``dt``).
     name, input, output : str
         Block name and signal names.
 
@@ -211,6 +241,8 @@ def inverse_pi_block(op: PIOperator, dt: float, *, name: str = "pi_inv", input: 
         forward radii ``r_i`` (non-decreasing, ``r_1 = 0``)
     ``"<name>.initial_state"``
         forward play states before the first sample
+    ``"<name>.offset"``
+        the forward model's output offset
 
     State layout: ``z_inv[i]``, the state of play i of the inverse operator after the previous
     sample. The own initial state is the inverse state consistent with the forward one, so
@@ -230,27 +262,25 @@ def inverse_pi_block(op: PIOperator, dt: float, *, name: str = "pi_inv", input: 
     >>> np.allclose(res.outputs, [0.3, 1.0, -0.4, 0.2])
     True
     """
-    if not isinstance(op, PIOperator):
-        raise TypeError(f"op: expected a PIOperator, got {type(op).__name__}")
-    dt = positive_scalar(dt, "dt")
+    op, offset, dt = _pi_and_offset(op, dt)
     op.inverse()  # ValueError now when op is not invertible
-    forward = _operator_settings(op, name)
+    forward = _operator_settings(op, name, offset)
     inverse_of = {}
 
     def inv(params) -> _Stepper:
         model = forward.get(params)
         if inverse_of.get("model") is not model:
-            inverse_of.update(model=model, inverse=_Stepper(model.op.inverse()))
+            inverse_of.update(model=model, inverse=_Stepper(model.op.inverse(), model.offset))
         return inverse_of["inverse"]
 
     def upd(t, x, u, params):
         cur = inv(params)
-        return cur.step(x, u[0])[1]
+        return cur.step(x, u[0] - cur.offset)[1]
 
     def out(t, x, u, params):
         cur = inv(params)
         warn_if_zero_start(name, t, x, cur.initial_state)
-        return np.array([cur.step(x, u[0])[0]])
+        return np.array([cur.step(x, u[0] - cur.offset)[0]])
 
     try:
         inv(forward.params)

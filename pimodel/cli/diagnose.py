@@ -163,9 +163,12 @@ def _write_exports(rep, out: Path, fmu: bool) -> list:
     from ..model_files import save_model
 
     aug, nom = rep.model(augmented=True), rep.model(augmented=False)
-    paths = [aug.save(out / "augmented.json"), nom.save(out / "nominal.json")]
+    made = {"method": "diagnose"}
+    paths = [save_model(aug, out / "augmented.json", source=made),
+             save_model(nom, out / "nominal.json", source=made)]
     try:
-        paths.append(save_model(nom.operator_form(), out / "nominal.model.json"))
+        paths.append(save_model(nom.operator_form(), out / "nominal.model.json", dt=nom.dt,
+                                source=made))
     except ValueError as err:
         print(f"no operator form of the nominal model: {err}")
     if fmu:

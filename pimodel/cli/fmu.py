@@ -42,7 +42,8 @@ def register(sub) -> None:
                    "operators' FMUs")
     b.add_argument("--dt", type=float, default=None,
                    help="with --model: sample time [s] of rate-independent stages (default: "
-                   "the dt of a rate-dependent or creep stage, else 0.001)")
+                   "the model file's dt, else the dt of a rate-dependent or creep stage, else "
+                   "0.001)")
     b.add_argument("--fmi-version", default="2.0", choices=["2.0", "3.0"],
                    help="FMI version (default 2.0)")
     b.set_defaults(func=run_build)
@@ -62,9 +63,14 @@ def run_build(args: argparse.Namespace) -> int:
 
             stem = "".join(ch if ch.isalnum() else "_" for ch in Path(args.model).stem)
             stem = stem if stem[:1].isalpha() else f"m_{stem}"
-            model = load_model(args.model)
+            from ..model_files.fmu_limits import check_fmu_limits
+
+            loaded = load_model(args.model)
+            check_fmu_limits(loaded, args.model)
+            model = loaded.as_operator()  # the offset folded in
+            dt = args.dt if args.dt is not None else loaded.dt
             paths = build_model_fmus(model, args.out, fmi_version=args.fmi_version,
-                                     Ts=args.dt, stem=stem)
+                                     Ts=dt, stem=stem)
             try:
                 paths += build_inverse_fmu(model, args.out, fmi_version=args.fmi_version,
                                            stem=stem)

@@ -24,7 +24,9 @@ def register(sub) -> None:
         "the loop slopes, radii from the adaptive estimator (or the conventional baseline).",
     )
     p.add_argument("data", help="record (CSV with header, NPZ or MATLAB .mat)")
-    p.add_argument("--json", required=True, help="output JSON file")
+    p.add_argument("--json", required=True,
+                   help="output model file (pimodel.model_files: the PI operator, its offset, "
+                   "sample time, units, provenance and the fit report)")
     p.add_argument("--method", choices=["adaptive", "conventional", "joint"], default="adaptive",
                    help="adaptive: the paper's (slopes, then radii); conventional: preset radii, "
                    "least-squares weights; joint: weights and radii estimated together")
@@ -38,6 +40,28 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _unit(column: str) -> str | None:
+    """The unit in a column name ``quantity_unit`` (``voltage_V`` -> ``V``), else None."""
+    head, sep, tail = column.rpartition("_")
+    return tail if sep and head and tail else None
+
+
+def _save_model_file(idn, rec, args: argparse.Namespace) -> None:
+    """Write the identified model as a model file (``--json``)."""
+    from pathlib import Path
+
+    from ..model_files import Model, save_model
+    from .common import columns_for
+
+    tcol, vcol, ycol = columns_for(args, args.data)
+    units = {k: u for k, u in (("time", _unit(tcol) or "s"), ("input", _unit(vcol)),
+                               ("output", _unit(ycol))) if u}
+    Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+    save_model(Model(idn.operator, offset=idn.offset, dt=rec.dt, units=units), args.json,
+               source={"record": str(args.data), "columns": [tcol, vcol, ycol],
+                       "method": idn.method}, report=idn.to_json())
+
+
 def run(args: argparse.Namespace) -> int:
     from ..identification.chain import identify
 
@@ -48,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
         gains = args.gains[0] if len(args.gains) == 1 else args.gains
     idn = identify(rec.v, rec.y, dt=rec.dt, n_plays=args.plays, method=args.method,
                    gains=gains, passes=args.passes)
-    idn.save_json(args.json)
+    _save_model_file(idn, rec, args)
     if args.plots:
         from ..identification.plots import plot_identification
 

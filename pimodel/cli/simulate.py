@@ -25,8 +25,11 @@ def register(sub) -> None:
         "warning). The output file must not be the input file.",
     )
     p.add_argument("data", help="input record (CSV with header, NPZ or MATLAB .mat)")
-    p.add_argument("--weights", type=float_list, required=True, help="weights p_i, e.g. 1,0.5")
-    p.add_argument("--radii", type=float_list, required=True, help="radii r_i, e.g. 0,0.2")
+    p.add_argument("--model", default=None, metavar="MODEL.json",
+                   help="a model file (pimodel identify --json, save_model): its operator and "
+                   "offset, instead of --weights and --radii")
+    p.add_argument("--weights", type=float_list, default=None, help="weights p_i, e.g. 1,0.5")
+    p.add_argument("--radii", type=float_list, default=None, help="radii r_i, e.g. 0,0.2")
     p.add_argument("--initial-state", type=float, default=0.0,
                    help="initial play state z_i[-1] (default 0)")
     p.add_argument("--inverse", action="store_true",
@@ -40,9 +43,18 @@ def run(args: argparse.Namespace) -> int:
     from ..operators.pi import PIOperator
     from ..records import Record, save_record
 
-    refuse_overwrite({"DATA": [args.data]}, {"--out": args.out})
+    if (args.model is None) == (args.weights is None or args.radii is None) or \
+            (args.model is not None and (args.weights or args.radii)):
+        raise ValueError("give either --model or both --weights and --radii")
+    refuse_overwrite({"DATA": [args.data], "--model": [args.model] if args.model else []},
+                     {"--out": args.out})
     (rec,) = load_inputs(args, [args.data], output_required=False)
-    op = PIOperator(args.weights, args.radii, initial_state=args.initial_state)
+    if args.model is not None:
+        from ..model_files import load_model
+
+        op = load_model(args.model)
+    else:
+        op = PIOperator(args.weights, args.radii, initial_state=args.initial_state)
     if args.inverse:
         op = op.inverse()
     y = op.simulate(rec.v)

@@ -1,8 +1,7 @@
-"""JSON form of the operators: :func:`model_to_dict`, :func:`model_from_dict`, :func:`load_model`
-and :func:`save_model`.
+"""JSON form of the operators: :func:`model_to_dict` and :func:`model_from_dict`.
 
-Format: one JSON object with a ``"type"``; the other keys are the operator's ``to_dict()``
-(constructor arguments)::
+One JSON object with a ``"type"``; the other keys are the operator's ``to_dict()``
+(constructor arguments), checked by :func:`.schema.check_model_dict` first::
 
     {"type": "GeneralizedPI", "weights": [...], "radii": [...], "initial_state": [...],
      "signed_weights": false, "input_envelope": {"kind": "tanh", "coefficients": [...]},
@@ -22,18 +21,16 @@ Format: one JSON object with a ``"type"``; the other keys are the operator's ``t
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
+from ..operators.asymmetric import AsymmetricPI, AsymmetricPIInverse
+from ..operators.cascade import Cascade
+from ..operators.creep import CreepOperator
+from ..operators.envelopes import Envelope
+from ..operators.generalized import GeneralizedPI
+from ..operators.pi import PIOperator
+from ..operators.rate_dependent import RateDependentPI, RateDependentPIInverse
+from .schema import TYPES, check_model_dict
 
-from .operators.asymmetric import AsymmetricPI, AsymmetricPIInverse
-from .operators.cascade import Cascade
-from .operators.creep import CreepOperator
-from .operators.envelopes import Envelope
-from .operators.generalized import GeneralizedPI
-from .operators.pi import PIOperator
-from .operators.rate_dependent import RateDependentPI, RateDependentPIInverse
-
-__all__ = ["load_model", "model_from_dict", "model_to_dict", "save_model"]
+__all__ = ["model_from_dict", "model_to_dict"]
 
 
 def _envelope(d, where: str) -> Envelope:
@@ -50,7 +47,7 @@ def _build(kind: str, d: dict, where: str):
                              output_envelope=_envelope(d["output_envelope"],
                                                        f"{where}.output_envelope"),
                              initial_state=d.get("initial_state", 0.0),
-                             signed_weights=bool(d.get("signed_weights", False)))
+                             signed_weights=d.get("signed_weights", False))
     if kind == "AsymmetricPI":
         return AsymmetricPI(d["direct_weight"], d["weights"], d["radii"],
                             ascending=d.get("ascending", (1.0, 0.0)),
@@ -65,26 +62,29 @@ def _build(kind: str, d: dict, where: str):
     if kind == "CreepOperator":
         return CreepOperator(d["gains"], d["time_constants"], dt=d["dt"],
                              initial_state=d.get("initial_state", 0.0),
-                             inverted=bool(d.get("inverted", False)))
+                             inverted=d.get("inverted", False))
     if kind == "PIOperator":
         return PIOperator(d["weights"], d["radii"], initial_state=d.get("initial_state", 0.0))
     if kind == "Inverse":
-        return model_from_dict(d["operator"], where=f"{where}.operator").inverse()
+        return _operator(d["operator"], f"{where}.operator").inverse()
     if kind == "Cascade":
-        stages = d["stages"]
-        if not isinstance(stages, list) or not stages:
-            raise ValueError(f"{where}.stages: expected a non-empty list of operators")
-        return Cascade(*(model_from_dict(s, where=f"{where}.stages[{i}]")
-                         for i, s in enumerate(stages)))
+        return Cascade(*(_operator(s, f"{where}.stages[{i}]")
+                         for i, s in enumerate(d["stages"])))
     if kind == "DiagnosedModel":
-        from .diagnosis.model import DiagnosedModel
+        from ..diagnosis.model import DiagnosedModel
 
         return DiagnosedModel.from_dict(d)
     raise ValueError(f"{where}.type: unknown model type {kind!r}; expected one of {TYPES}")
 
 
-TYPES = ("GeneralizedPI", "AsymmetricPI", "RateDependentPI", "CreepOperator", "PIOperator",
-         "Inverse", "Cascade", "DiagnosedModel")
+def _operator(d: dict, where: str):
+    """Build a checked object; constructor errors name ``where`` and the type."""
+    try:
+        return _build(d["type"], d, where)
+    except (TypeError, ValueError, OverflowError) as err:
+        if str(err).startswith(where):
+            raise ValueError(str(err)) from None
+        raise ValueError(f"{where} ({d['type']}): {err}") from None
 
 
 def model_from_dict(d: dict, *, where: str = "model"):
@@ -102,13 +102,14 @@ def model_from_dict(d: dict, *, where: str = "model"):
     -------
     object
         The operator (with ``simulate``, ``step``, ``reset`` and, where it exists,
-        ``inverse``).
+        ``inverse``); the file's offset, units and provenance are left out
+        (:func:`pimodel.model_files.load_model` keeps them).
 
     Raises
     ------
     ValueError
-        Not an object, a missing or unknown ``type``, a missing key, or bad parameters (the
-        message names the place, e.g. ``model.stages[1].gains``).
+        Anything :func:`.schema.check_model_dict` refuses, or parameters the operator refuses
+        (the message names the place, e.g. ``model.stages[1].gains``).
 
     Examples
     --------
@@ -117,17 +118,8 @@ def model_from_dict(d: dict, *, where: str = "model"):
     >>> op.m
     1
     """
-    if not isinstance(d, dict) or "type" not in d:
-        raise ValueError(f"{where}: expected a JSON object with a 'type', got {d!r:.80}")
-    try:
-        return _build(d["type"], d, where)
-    except KeyError as err:
-        raise ValueError(f"{where}: missing key {err.args[0]!r} for type {d['type']!r}") \
-            from None
-    except (TypeError, ValueError) as err:
-        if str(err).startswith(where):
-            raise ValueError(str(err)) from None
-        raise ValueError(f"{where} ({d['type']}): {err}") from None
+    check_model_dict(d, where=where)
+    return _operator(d, where)
 
 
 def model_to_dict(model) -> dict:
@@ -137,7 +129,8 @@ def model_to_dict(model) -> dict:
     ----------
     model : object
         A GeneralizedPI, AsymmetricPI, RateDependentPI, CreepOperator, PIOperator, one of
-        their inverses, or a Cascade of these.
+        their inverses, a Cascade of these, a DiagnosedModel or a
+        :class:`~pimodel.model_files.file_model.Model` (then with its offset and metadata).
 
     Returns
     -------
@@ -154,6 +147,8 @@ def model_to_dict(model) -> dict:
     >>> model_to_dict(CreepOperator([0.05], [0.1], dt=1e-3).inverse())["inverted"]
     True
     """
+    if callable(getattr(model, "as_file_dict", None)):
+        return model.as_file_dict()
     if isinstance(model, Cascade):
         return {"type": "Cascade", "stages": [model_to_dict(s) for s in model.stages]}
     if isinstance(model, (AsymmetricPIInverse, RateDependentPIInverse)):
@@ -167,72 +162,3 @@ def model_to_dict(model) -> dict:
     if callable(getattr(model, "to_dict", None)):
         return model.to_dict()
     raise TypeError(f"model: no JSON form for {type(model).__name__}")
-
-
-def load_model(path):
-    """Read a model JSON file and rebuild it (:func:`model_from_dict`).
-
-    Parameters
-    ----------
-    path : str or Path
-        A file written by :func:`save_model` (or by hand in the same form).
-
-    Returns
-    -------
-    object
-        The operator, inverse or :class:`~pimodel.operators.cascade.Cascade`.
-
-    Raises
-    ------
-    FileNotFoundError
-        No such file.
-    ValueError
-        Not JSON, or not a valid model (the message names the file and the place).
-
-    Examples
-    --------
-    >>> import os, tempfile
-    >>> from pimodel.operators.creep import CreepOperator
-    >>> path = save_model(CreepOperator([0.05], [0.1], dt=1e-3),
-    ...                   os.path.join(tempfile.mkdtemp(), "creep.json"))
-    >>> load_model(path).gains
-    array([0.05])
-    """
-    p = Path(path)
-    try:
-        d = json.loads(p.read_text())
-    except json.JSONDecodeError as err:
-        raise ValueError(f"{p}: not JSON ({err})") from None
-    try:
-        return model_from_dict(d)
-    except ValueError as err:
-        raise ValueError(f"{p}: {err}") from None
-
-
-def save_model(model, path) -> Path:
-    """Write :func:`model_to_dict` of ``model`` as JSON to ``path`` and return the path.
-
-    Parameters
-    ----------
-    model : object
-        An operator, an inverse or a :class:`~pimodel.operators.cascade.Cascade` of them.
-    path : str or Path
-        The JSON file to write (overwritten).
-
-    Returns
-    -------
-    Path
-        ``path``.
-
-    Examples
-    --------
-    >>> import json, os, tempfile
-    >>> from pimodel.operators.creep import CreepOperator
-    >>> path = save_model(CreepOperator([0.05], [0.1], dt=1e-3),
-    ...                   os.path.join(tempfile.mkdtemp(), "creep.json"))
-    >>> json.loads(path.read_text())["type"]
-    'CreepOperator'
-    """
-    p = Path(path)
-    p.write_text(json.dumps(model_to_dict(model), indent=2) + "\n")
-    return p
