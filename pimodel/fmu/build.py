@@ -82,8 +82,9 @@ CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-DP
 EXPORTS = "{\n  global: fmi2*; fmi3*;\n  local: *;\n};\n"
 
 SAMPLING = ("Internal sample k at time k*Ts; doStep(t, h) processes every sample with k*Ts in "
-            "[t, t+h) using the inputs set before the call; outputs hold the last sample's "
-            "values.")
+            "[t, t+h) (up to a master's rounding of the grid) using the inputs set before the "
+            "call; outputs hold the last sample's values, and after initialization the first "
+            "sample's response to the inputs set so far.")
 
 
 def fmi_headers() -> Path:

@@ -31,9 +31,11 @@
  * values after model_defaults.
  *
  * Sampling rule: internal sample k (an int64 counter) happens at time k*Ts.  A step from t over
- * h processes every sample with k*Ts in [t, t+h) (tolerance 1e-9*Ts), each with the inputs set
- * before the call (held over the step); outputs are those of the last processed sample and hold
- * between samples.  A step shorter than Ts that contains no sample instant changes nothing.
+ * h processes every sample with k*Ts in [t, t+h) (up to a master's rounding of the grid:
+ * unit_first_sample), each with the inputs set before the call (held over the step); outputs are
+ * those of the last processed sample and hold between samples, and after initialization those of
+ * the first sample for the inputs set so far (unit_start_outputs).  A step shorter than Ts that
+ * contains no sample instant changes nothing.
  *
  * Limits (each breach is an error with a logged reason, never a crash or a hang):
  *   n in 1..PIM_UNIT_NMAX (64; DiagnosedModel, DiagnosedInverse: 128) plays; Ts finite and
