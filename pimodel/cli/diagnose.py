@@ -99,7 +99,7 @@ def export_models(rep, out_dir, *, fmu: bool = True) -> list:
         from ..fmu.model_fmu import build_inverse_fmu, build_model_fmus
 
         # the default experiment runs the length of the longest validate record
-        stop = max((len(r) * r.dt for r in rep.validate), default=None)
+        stop = max((len(s.t) * aug.dt for s in rep.validate), default=None)
         for stem, model in (("augmented", aug), ("nominal", nom)):
             for build, what in ((build_model_fmus, "FMU"), (build_inverse_fmu, "inverse FMU")):
                 try:

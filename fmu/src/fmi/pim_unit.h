@@ -417,8 +417,10 @@ static int unit_settable(const pim_unit *u, const pim_var *v)
 /* Error paths out of line, so that the accessors stay small (they run on every get/set). */
 #if defined(__GNUC__)
 #define PIM_COLD __attribute__((noinline, cold))
+#define PIM_HOT_INLINE __attribute__((always_inline)) inline
 #else
 #define PIM_COLD
+#define PIM_HOT_INLINE inline
 #endif
 
 /* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
@@ -450,7 +452,8 @@ PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, 
  * has type `type`) and, for set != 0, against the mode (unit_settable).  *count: values it
  * holds (1, or PIM_NMAX for an FMI 3 array).  NULL with the reason in u->msg on failure.
  */
-static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set, size_t *count)
+static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set,
+                                     size_t *count)
 {
     int elem = -1;
     const pim_var *v = unit_var(vr, elements, &elem);
