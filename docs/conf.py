@@ -83,6 +83,7 @@ STRICT_MODULES = [
     "pimodel.operators.envelopes",
     "pimodel.operators.cascade",
     "pimodel.fmu.model_fmu",
+    "pimodel.fmu.units",
     "pimodel.checks",
     "pimodel.loops.simulation",
     "pimodel.operators.generalized",

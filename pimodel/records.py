@@ -36,6 +36,7 @@ __all__ = [
     "DataError",
     "load_record",
     "Record",
+    "sample_time",
     "save_record",
 ]
 
@@ -161,8 +162,13 @@ class Record:
 
     @property
     def dt(self) -> float:
-        """Median sample interval [s]."""
-        return float(np.median(np.diff(self.t)))
+        """Sample time [s]: exact where the clock is regular (:func:`sample_time`); computed
+        once per time column (the diagnosis asks for it per segment)."""
+        key = (id(self.t), self.t.size, float(self.t[0]), float(self.t[-1]))
+        cached = self.__dict__.get("_dt_cache")
+        if cached is None or cached[0] != key:
+            cached = self.__dict__["_dt_cache"] = (key, sample_time(self.t))
+        return cached[1]
 
     def slice(self, start: int | None = None, stop: int | None = None) -> Record:
         """Samples ``start:stop`` as a new record (extras included).
@@ -236,6 +242,62 @@ class Record:
             raise ValueError(f"fraction: {fraction} of {len(self)} samples leaves {k} train and "
                              f"{len(self) - k} validate samples; each part needs at least 2")
         return self.slice(0, k), self.slice(k, None)
+
+
+def _resolution(t: np.ndarray) -> float:
+    """The time column's resolution [s]: the coarsest decimal step all its values sit on (to a
+    few ulps), else a few ulps of its largest value."""
+    ulps = 8.0 * np.spacing(float(np.max(np.abs(t))) or 1.0)
+    for digits in range(16):
+        if np.all(np.abs(t - np.round(t, digits)) <= ulps):
+            return max(0.5 * 10.0 ** -digits, ulps)
+    return ulps
+
+
+def sample_time(t) -> float:
+    """The sample time [s] of the times ``t``: exact where the clock is regular.
+
+    The rate ``1 / mean(diff(t))`` (and the interval itself) rounded to the fewest significant
+    digits such that every ``t[k]`` equals ``t[0] + k * Ts`` to the resolution of the time
+    column (its decimal step, or a few ulps) plus the rounding of a clock that adds ``Ts`` per
+    sample (one ulp per sample); e.g. ``2e-4`` for a 5 kHz record rather than
+    ``1.9999999999997797e-4``, and ``1 / 3000`` for a 3 kHz one. When no rounding fits (a
+    jittering clock), the median interval.
+
+    Parameters
+    ----------
+    t : array_like of float, shape (N,)
+        Strictly increasing sample times [s], N >= 2.
+
+    Returns
+    -------
+    float
+        The sample time [s].
+
+    Raises
+    ------
+    ValueError
+        If ``t`` has fewer than 2 values or does not increase strictly.
+
+    Examples
+    --------
+    >>> sample_time(np.arange(12_000) * 2e-4), sample_time(np.arange(9) / 3000) == 1 / 3000
+    (0.0002, True)
+    """
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.size < 2 or not np.all(np.diff(t) > 0):
+        raise ValueError(f"t: expected at least 2 strictly increasing times, got {t.size}")
+    k = np.arange(t.size)
+    mean = (t[-1] - t[0]) / (t.size - 1)
+    # the column's resolution plus the rounding a clock accumulates as t[k] = t[k-1] + Ts
+    # (at most one ulp of max |t| per sample), and never more than 1e-3 samples
+    ulp = np.spacing(float(np.max(np.abs(t))) or 1.0)
+    tol = min(_resolution(t) + t.size * ulp, 1e-3 * mean)
+    for digits in range(1, 16):
+        for ts in (float(f"{mean:.{digits}g}"), 1.0 / float(f"{1.0 / mean:.{digits}g}")):
+            if np.max(np.abs(t - (t[0] + k * ts))) <= tol:
+                return ts
+    return float(np.median(np.diff(t)))
 
 
 def _row(k: int) -> str:

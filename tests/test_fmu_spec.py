@@ -137,6 +137,18 @@ def test_limits_are_the_c_header():
     assert isinstance(LIMITS["PIM_MAX_PLAYS"], int) and isinstance(LIMITS["PIM_TS_MIN"], float)
 
 
+NUMBER_WORDS = ("zero one two three four five six seven eight nine ten eleven twelve "
+                "thirteen fourteen fifteen").split()
+
+
+def test_docs_name_the_unit_count_of_the_spec():
+    """"the N units" / "all N units" in docs/fmu.md and fmu/README.md is len(MODELS)."""
+    for doc in (ROOT / "docs" / "fmu.md", ROOT / "fmu" / "README.md"):
+        words = re.findall(r"\b(?:the|all) (\w+)\s+units\b", doc.read_text(), re.IGNORECASE)
+        counts = {NUMBER_WORDS.index(w.lower()) for w in words if w.lower() in NUMBER_WORDS}
+        assert counts == {len(MODELS)}, (doc.name, words, len(MODELS))
+
+
 def test_docs_name_the_state_format_version_of_the_code():
     """docs/fmu.md and fmu/README.md state the FMU state format version that the C code
     writes (PIM_STATE_VERSION), so the two cannot drift apart."""

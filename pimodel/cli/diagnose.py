@@ -174,10 +174,12 @@ def _write_exports(rep, out: Path, fmu: bool) -> list:
     if fmu:
         from ..fmu.model_fmu import build_inverse_fmu, build_model_fmus
 
+        # the default experiment runs the length of the longest validate record
+        stop = max((len(s.t) * aug.dt for s in rep.validate), default=None)
         for stem, model in (("augmented", aug), ("nominal", nom)):
             for build, what in ((build_model_fmus, "FMU"), (build_inverse_fmu, "inverse FMU")):
                 try:
-                    paths += build(model, out, stem=stem)
+                    paths += build(model, out, stem=stem, stop_time=stop)
                 except ValueError as err:
                     print(f"{stem} model: no {what} ({err})")
     return paths

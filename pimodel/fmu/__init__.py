@@ -10,7 +10,9 @@ config_h         -- a unit's C config.h: ValueReference enum and variable table,
 
 Model descriptions and building
 ===============================
-description      -- model_description(name, fmi_version): one writer for FMI 2.0 and 3.0
+description      -- model_description(name, fmi_version): one writer for FMI 2.0 and 3.0,
+                    default_experiment (stepSize Ts, stopTime)
+units            -- the variables' physical units (V, um, s, ...) and UnitDefinitions
 sources          -- where the C lives: fmu/src/core (numeric core), fmi (glue, framework),
                     units/<Unit> (each unit's own code); what an FMU compiles
 build            -- build_fmus (compile and package), find_compiler, fmi_headers, fmu_filename

@@ -75,12 +75,16 @@ def fmu_filename(name: str, fmi_version: str = "2.0") -> str:
     ('PIHysteresis.fmu', 'PIHysteresis_fmi3.fmu')
     """
     return f"{name}{SUFFIX[check_fmi_version(fmi_version)]}.fmu"
-CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-O2", "-fPIC",
-          "-shared"]
+CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-DPIM_CORE_HIDDEN",
+          "-O3", "-fPIC", "-shared"]
+# only the FMI functions leave the binary (the core's pim_* stay inside: PIM_CORE_HIDDEN, and
+# this version script for the linker)
+EXPORTS = "{\n  global: fmi2*; fmi3*;\n  local: *;\n};\n"
 
 SAMPLING = ("Internal sample k at time k*Ts; doStep(t, h) processes every sample with k*Ts in "
-            "[t, t+h) using the inputs set before the call; outputs hold the last sample's "
-            "values.")
+            "[t, t+h) (up to a master's rounding of the grid) using the inputs set before the "
+            "call; outputs hold the last sample's values, and after initialization the first "
+            "sample's response to the inputs set so far.")
 
 
 def fmi_headers() -> Path:
@@ -159,6 +163,7 @@ def build_description(name: str) -> str:
         f'  <BuildConfiguration modelIdentifier="{name}">\n'
         '    <SourceFileSet language="C99">\n'
         f"{files}\n"
+        '        <PreprocessorDefinition name="PIM_CORE_HIDDEN"/>\n'
         "    </SourceFileSet>\n  </BuildConfiguration>\n</fmiBuildDescription>\n"
     )
 
@@ -243,8 +248,10 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
             for f in files:
                 shutil.copy(f, tmp / f.name)
             so = tmp / f"{name}.so"
+            (tmp / "exports.map").write_text(EXPORTS)
             cmd = [cc, *CFLAGS, "-I", str(tmp), "-I", str(inc), str(tmp / "model.c"),
-                   *[str(tmp / s) for s in CORE_SOURCES], "-o", str(so), "-lm"]
+                   *[str(tmp / s) for s in CORE_SOURCES], "-o", str(so), "-lm",
+                   f"-Wl,--version-script={tmp / 'exports.map'}"]
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if proc.returncode != 0:
                 raise RuntimeError(f"compiling {name} (FMI {fmi_version}) failed:\n"

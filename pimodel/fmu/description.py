@@ -11,9 +11,11 @@ from __future__ import annotations
 from xml.sax.saxutils import escape
 
 from .sources import CORE_SOURCES
-from .spec import NMAX, TIME, check_fmi_version, guid, spec_of, token
+from .spec import NMAX, TIME, check_fmi_version, guid, spec_of, token, unit_of
+from .units import unit_definitions, variable_unit
 
-__all__ = ["LOG_CATEGORIES", "PLATFORM", "TYPES", "model_description", "model_description3"]
+__all__ = ["LOG_CATEGORIES", "PLATFORM", "TYPES", "default_experiment", "model_description",
+           "model_description3"]
 
 TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}  # FMI 2 -> FMI 3 type
 PLATFORM = {"2.0": "linux64", "3.0": "x86_64-linux"}  # binaries/<platform>/ per FMI version
@@ -78,19 +80,51 @@ def _attributes(causality: str, fmi_version: str) -> str:
     return 'causality="output" variability="discrete" initial="exact"'
 
 
+def _unit_attr(unit: str, name: str) -> str:
+    u = variable_unit(unit, name)
+    return f' unit="{u}"' if u else ""
+
+
+def default_experiment(name: str) -> tuple[float, float]:
+    """``(stopTime, stepSize)`` of a unit's ``DefaultExperiment``: one sample time ``Ts`` per
+    step (the start value of ``Ts``) until the spec's ``stop_time`` (a model's FMU: the length
+    of the record it was made from), else 1000 samples.
+
+    Parameters
+    ----------
+    name : str
+        The unit's model identifier.
+
+    Returns
+    -------
+    tuple of float
+        Stop time [s] and step size [s].
+
+    Examples
+    --------
+    >>> default_experiment("PIHysteresis")
+    (1.0, 0.001)
+    """
+    spec = spec_of(name)
+    ts = float(next(v.start for v in spec["vars"] if v.name == "Ts"))
+    stop = spec.get("stop_time")
+    return (float(stop) if stop else 1000 * ts), ts
+
+
 def _variables_xml(name: str, fmi_version: str) -> tuple[list[str], list[int]]:
     """The ModelVariables lines and the outputs (FMI 2: 1-based indices; FMI 3: references)."""
     lines, outputs = [], []
+    unit = unit_of(name)
     if fmi_version == "3.0":
         lines.append(f'    <Float64 name="{TIME.name}" valueReference="{TIME.vr}" '
                      f'causality="{TIME.causality}" variability="continuous" '
-                     f'description="{TIME.description}"/>')
+                     f'description="{TIME.description}" unit="s"/>')
         for vname, vr, kind, causality, start, desc, is_array in _variables3(name):
             if causality == "output":
                 outputs.append(vr)
             head = (f'    <{kind} name="{vname}" valueReference="{vr}" '
-                    f'{_attributes(causality, fmi_version)} description="{escape(desc)}" '
-                    f'start="{start}"')
+                    f'{_attributes(causality, fmi_version)} description="{escape(desc)}"'
+                    f'{_unit_attr(unit, vname)} start="{start}"')
             lines.append(f'{head}><Dimension start="{NMAX}"/></{kind}>' if is_array
                          else f"{head}/>")
         return lines, outputs
@@ -99,8 +133,8 @@ def _variables_xml(name: str, fmi_version: str) -> tuple[list[str], list[int]]:
             outputs.append(idx)
         lines.append(f'    <ScalarVariable name="{v.name}" valueReference="{v.vr}" '
                      f'{_attributes(v.causality, fmi_version)} '
-                     f'description="{escape(v.description)}"><{v.kind} start="{v.start}"/>'
-                     "</ScalarVariable>")
+                     f'description="{escape(v.description)}"><{v.kind}'
+                     f'{_unit_attr(unit, v.name)} start="{v.start}"/></ScalarVariable>')
     return lines, outputs
 
 
@@ -137,8 +171,13 @@ def model_description(name: str, fmi_version: str = "2.0") -> str:
     """
     check_fmi_version(fmi_version)
     variables, outputs = _variables_xml(name, fmi_version)
+    unit = unit_of(name)
+    units = unit_definitions({variable_unit(unit, v.name) for v in spec_of(name)["vars"]}
+                             | ({"s"} if fmi_version == "3.0" else set()))
+    stop, step = default_experiment(name)
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', *_header(name, fmi_version),
-             LOG_CATEGORIES, '  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>',
+             *([units] if units else []), LOG_CATEGORIES,
+             f'  <DefaultExperiment startTime="0" stopTime="{stop!r}" stepSize="{step!r}"/>',
              "  <ModelVariables>", *variables, "  </ModelVariables>", "  <ModelStructure>"]
     if fmi_version == "3.0":
         lines += [f'    <Output valueReference="{vr}"/>' for vr in outputs]

@@ -52,7 +52,7 @@ def _defaults(unit: str, params: dict) -> str:
     return " ".join(out)
 
 
-def _spec(unit: str, params: dict, salt: str) -> dict:
+def _spec(unit: str, params: dict, salt: str, stop_time: float | None = None) -> dict:
     spec = MODELS[unit]
     names = {v.name for v in spec["vars"]}
     unknown = set(params) - names
@@ -60,11 +60,13 @@ def _spec(unit: str, params: dict, salt: str) -> dict:
         raise ValueError(f"parameters {sorted(unknown)} are not variables of {unit}")
     variables = [replace(v, start=_xml_value(v, params[v.name])) if v.name in params else v
                  for v in spec["vars"]]
-    return {**spec, "vars": variables, "salt": salt, "defaults": _defaults(unit, params)}
+    return {**spec, "vars": variables, "salt": salt, "defaults": _defaults(unit, params),
+            **({"stop_time": stop_time} if stop_time else {})}
 
 
 def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | None = None,
-                     stem: str = "model", compiler: str | None = None) -> list[Path]:
+                     stem: str = "model", compiler: str | None = None,
+                     stop_time: float | None = None) -> list[Path]:
     """Build one FMU per operator of ``model`` with the operator's parameters as start values.
 
     Parameters
@@ -81,6 +83,9 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
         File name prefix (a C identifier).
     compiler : str, optional
         C compiler (default: found on PATH).
+    stop_time : float, optional
+        ``stopTime`` of the ``DefaultExperiment`` [s] (e.g. the length of the record the
+        model was made from; its ``stepSize`` is ``Ts``); default 1000 samples.
 
     Returns
     -------
@@ -104,6 +109,8 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
     check_fmi_version(fmi_version)
     if not stem.isidentifier():
         raise ValueError(f"stem: expected a C identifier, got {stem!r}")
+    if stop_time is not None and not (np.isfinite(stop_time) and stop_time > 0):
+        raise ValueError(f"stop_time: expected a finite time > 0 [s], got {stop_time!r}")
     stages = model.stages if isinstance(model, Cascade) else (model,)
     dts = {s.dt for s in stages if hasattr(s, "dt")} | {s.forward.dt for s in stages
                                                         if hasattr(getattr(s, "forward", None),
@@ -121,7 +128,7 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
                 raise ValueError(f"model stage {i}: {err}") from None
             ident = f"{stem}_{i}_{unit}"
             salt = hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()[:16]
-            MODEL_UNITS[ident] = _spec(unit, params, salt)
+            MODEL_UNITS[ident] = _spec(unit, params, salt, stop_time)
             names.append(ident)
         return build_fmus(out_dir, names, compiler=compiler, fmi_version=fmi_version)
     finally:
@@ -130,7 +137,7 @@ def build_model_fmus(model, out_dir, *, fmi_version: str = "2.0", Ts: float | No
 
 
 def build_inverse_fmu(model, out_dir, *, fmi_version: str = "2.0", stem: str = "model",
-                      compiler: str | None = None) -> list[Path]:
+                      compiler: str | None = None, stop_time: float | None = None) -> list[Path]:
     """The feedforward FMU of a diagnosed model (unit DiagnosedInverse), beside its model FMU.
 
     Parameters
@@ -146,6 +153,8 @@ def build_inverse_fmu(model, out_dir, *, fmi_version: str = "2.0", stem: str = "
         File name prefix (a C identifier), as :func:`build_model_fmus`.
     compiler : str, optional
         C compiler (default: found on PATH).
+    stop_time : float, optional
+        ``stopTime`` of the ``DefaultExperiment`` [s], as :func:`build_model_fmus`.
 
     Returns
     -------
@@ -171,7 +180,7 @@ def build_inverse_fmu(model, out_dir, *, fmi_version: str = "2.0", stem: str = "
     if not isinstance(model, DiagnosedModel):
         return []
     return build_model_fmus(model.inverse(), out_dir, fmi_version=fmi_version, stem=stem,
-                            compiler=compiler)
+                            compiler=compiler, stop_time=stop_time)
 
 
 def cosimulate_chain(paths, u, Ts: float) -> np.ndarray:

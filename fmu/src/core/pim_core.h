@@ -20,7 +20,11 @@
 #include "pim_limits.h" /* PIM_MAX_PLAYS (the fixed-size users' limit; the array functions
                             * take any n) and every other limit */
 
-#if defined(_WIN32)
+/* PIM_API exports a core function from the Python extension; an FMU build defines
+ * PIM_CORE_HIDDEN so that only the FMI functions are exported from the FMU's binary. */
+#if defined(PIM_CORE_HIDDEN)
+#define PIM_API
+#elif defined(_WIN32)
 #define PIM_API __declspec(dllexport)
 #else
 #define PIM_API __attribute__((visibility("default")))

@@ -127,7 +127,7 @@ fmi2Status fmi2Reset(fmi2Component comp)
 #define PIM_ACCESS(TYPE_CHAR, CTYPE, SET, FROM_UNIT, TO_UNIT)                                  \
     INST(comp);                                                                               \
     for (size_t i = 0; i < nvr; ++i) {                                                        \
-        size_t cnt;                                                                           \
+        size_t cnt = 0;                                                                       \
         CTYPE *x = (CTYPE *)unit_ref(&c->u, vr[i], TYPE_CHAR, 1, SET, &cnt);                  \
         if (!x) return status(c, -1);                                                         \
         if (SET) { TO_UNIT; } else { FROM_UNIT; }                                             \

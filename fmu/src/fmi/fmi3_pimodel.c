@@ -169,7 +169,7 @@ fmi3Status fmi3DoStep(fmi3Instance inst, fmi3Float64 t, fmi3Float64 h, fmi3Boole
     INST(inst);                                                                               \
     size_t k = 0;                                                                             \
     for (size_t i = 0; i < nvr; ++i) {                                                        \
-        size_t cnt;                                                                           \
+        size_t cnt = 0;                                                                       \
         CTYPE *x = (CTYPE *)unit_ref(&c->u, vr[i], TYPE_CHAR, 0, SET, &cnt);                  \
         if (!x) return status(c, -1);                                                         \
         if (k + cnt > nValues)                                                                \

@@ -31,9 +31,11 @@
  * values after model_defaults.
  *
  * Sampling rule: internal sample k (an int64 counter) happens at time k*Ts.  A step from t over
- * h processes every sample with k*Ts in [t, t+h) (tolerance 1e-9*Ts), each with the inputs set
- * before the call (held over the step); outputs are those of the last processed sample and hold
- * between samples.  A step shorter than Ts that contains no sample instant changes nothing.
+ * h processes every sample with k*Ts in [t, t+h) (up to a master's rounding of the grid:
+ * unit_first_sample), each with the inputs set before the call (held over the step); outputs are
+ * those of the last processed sample and hold between samples, and after initialization those of
+ * the first sample for the inputs set so far (unit_start_outputs).  A step shorter than Ts that
+ * contains no sample instant changes nothing.
  *
  * Limits (each breach is an error with a logged reason, never a crash or a hang):
  *   n in 1..PIM_UNIT_NMAX (64; DiagnosedModel, DiagnosedInverse: 128) plays; Ts finite and
@@ -208,10 +210,15 @@ static int model_report(const pim_unit *u, char *buf, size_t size)
 }
 #endif
 
-/* Index of the first sample at or after time t. */
+/* Index of the first sample at or after time t: ceil(t / Ts) up to the rounding of a time
+ * computed by a master (PIM_SAMPLE_TOL plus x^2 eps samples at sample x, what a clock that adds
+ * its step x times accumulates; at most 1e-3 samples), so that a communication grid that
+ * differs from k*Ts by floating-point rounding never shifts a sample. */
 static double unit_first_sample(const pim_unit *u, double t)
 {
-    return ceil(t / u->Ts - PIM_SAMPLE_TOL);
+    const double x = t / u->Ts;
+    const double tol = PIM_SAMPLE_TOL + x * x * 2.220446049250313e-16;
+    return ceil(x - (tol < 1e-3 ? tol : 1e-3));
 }
 
 static void unit_defaults(pim_unit *u)
@@ -257,6 +264,25 @@ static int unit_check_parameters(pim_unit *u)
     return model_check_parameters(u);
 }
 
+/* The outputs at the start time (FMI: after initialization the outputs are those of the
+ * inputs set so far): the response of sample k_next to the inputs held now, computed on a copy
+ * so that the states stay those before that sample, which the first doStep processes.  Inputs
+ * that a step would refuse, or outputs that overflow, leave the start values. */
+static void unit_start_outputs(pim_unit *u)
+{
+    pim_unit *c = (pim_unit *)malloc(sizeof *c);
+    if (!c) return;
+    *c = *u;
+    if (isfinite(c->in1) && model_check_inputs(c) == 0) {
+        model_sample(c);
+        if (isfinite(c->out1) && isfinite(c->out2) && model_outputs_finite(c)) {
+            u->out1 = c->out1;
+            u->out2 = c->out2;
+        }
+    }
+    free(c);
+}
+
 /* Checks the parameters and sets up the states (exitInitializationMode). */
 static int unit_setup(pim_unit *u)
 {
@@ -266,7 +292,9 @@ static int unit_setup(pim_unit *u)
         return unit_error(u, "start time %g is beyond the sample counter's range (2^52 samples "
                              "of Ts = %g)", u->time, u->Ts);
     u->k_next = (int64_t)k0;
-    return model_setup(u);
+    if (model_setup(u) != 0) return -1;
+    unit_start_outputs(u);
+    return 0;
 }
 
 /* The inputs held over a step: finite (and the unit's further inputs admissible). */
@@ -282,15 +310,17 @@ static int unit_check_inputs(pim_unit *u)
 static int unit_do_step(pim_unit *u, double t, double h)
 {
     if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
-    if (!isfinite(t) || t < 0.0)
-        return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
-    if (!isfinite(h) || !(h > 0.0))
+    if (!(h > 0.0) || !isfinite(h))
         return unit_error(u, "communication step size h = %g: must be finite and > 0", h);
-    const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
-    const double tol = 1e-9 * scale < 1e-3 * u->Ts ? 1e-9 * scale : 1e-3 * u->Ts;
-    if (t != u->time && fabs(t - u->time) > tol)
-        return unit_error(u, "communication point t = %.17g does not match the FMU's time "
-                             "%.17g (the end of the last step)", t, u->time);
+    if (t != u->time) { /* u->time is finite and >= 0: only another t needs the checks */
+        if (!isfinite(t) || t < 0.0)
+            return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
+        const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
+        const double tol = 1e-9 * scale < 1e-3 * u->Ts ? 1e-9 * scale : 1e-3 * u->Ts;
+        if (fabs(t - u->time) > tol)
+            return unit_error(u, "communication point t = %.17g does not match the FMU's time "
+                                 "%.17g (the end of the last step)", t, u->time);
+    }
     const double t_end = t + h;
     if (!(t_end > t))
         return unit_error(u, "no progress: t + h == t at t = %g, h = %g (h is below the time "
@@ -350,11 +380,12 @@ static const pim_var *unit_var(unsigned vr, int elements, int *elem)
 {
     for (size_t i = 0; i < PIM_NVARS; ++i) {
         const pim_var *v = &unit_vars[i];
+        const unsigned d = vr - v->vr; /* wraps for vr < v->vr */
         if (v->size > 1 && elements) { /* FMI 2 array elements: v->vr + 0 .. v->vr + size - 1 */
-            if (vr < v->vr || vr - v->vr >= (unsigned)v->size) continue;
-            *elem = (int)(vr - v->vr);
+            if (d >= (unsigned)v->size) continue;
+            *elem = (int)d;
         } else {
-            if (vr != v->vr) continue;
+            if (d != 0) continue;
             if (elements && v->causality == PIM_INDEPENDENT) return NULL; /* FMI 2: no time */
             *elem = -1;
         }
@@ -386,8 +417,10 @@ static int unit_settable(const pim_unit *u, const pim_var *v)
 /* Error paths out of line, so that the accessors stay small (they run on every get/set). */
 #if defined(__GNUC__)
 #define PIM_COLD __attribute__((noinline, cold))
+#define PIM_HOT_INLINE __attribute__((always_inline)) inline
 #else
 #define PIM_COLD
+#define PIM_HOT_INLINE inline
 #endif
 
 /* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
@@ -419,7 +452,8 @@ PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, 
  * has type `type`) and, for set != 0, against the mode (unit_settable).  *count: values it
  * holds (1, or PIM_NMAX for an FMI 3 array).  NULL with the reason in u->msg on failure.
  */
-static void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set, size_t *count)
+static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set,
+                                     size_t *count)
 {
     int elem = -1;
     const pim_var *v = unit_var(vr, elements, &elem);
