@@ -12,6 +12,7 @@ from pimodel.experiments.estimator_map import (
     STARTS,
     input_signal,
     random_stage,
+    run_cell,
     start_radii,
 )
 from pimodel.identification.adaptive.polish import (
@@ -100,17 +101,21 @@ def test_polish_false_is_the_online_iterate():
     assert np.max(np.abs(res.history[-1] - res.radii)) < 0.1  # the last iterate, one update on
 
 
+# Record length [s] at 1 kHz per input kind where the 5 % property holds with margin at
+# 20 dB over these seeds and starts (docs/estimator.md, "20 dB on every input: record
+# length"). Stair steps are left out: 4.2 % at 120 s (one run in a local minimum); 200 s
+# would hold (1.0 % from far above) but costs too much here.
+TWENTY_DB_SECONDS = {"centred sine": 120.0, "offset sine": 60.0, "triangle": 120.0,
+                     "multisine": 120.0, "random": 20.0, "decaying loops": 20.0}
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("kind", ["centred sine", "offset sine", "decaying loops"])
+@pytest.mark.parametrize("kind", sorted(TWENTY_DB_SECONDS))
 def test_twenty_db_within_five_percent_over_ten_seeds(kind):
+    """Random stages of 3-7 plays (seed 0-9), output noise at 20 dB, the three starts in turn:
+    the refined estimate's largest radius error is within 5 % of the largest radius."""
     errs = []
-    t = np.arange(int(60 * FS)) / FS
     for seed in range(10):
-        rng = np.random.default_rng(100 + seed)
-        p, r = random_stage(rng)
-        v = input_signal(kind, t, seed=seed)
-        y0 = PIOperator(p, r).simulate(v)
-        y = y0 + rng.normal(0, np.std(y0) / 10, y0.size)
-        res = estimate_radii(v, y, p, dt=1 / FS, initial_radii=start_radii("zero", r))
-        errs.append(np.max(np.abs(res.radii - r)) / r[-1])
+        cell = run_cell(kind, 20.0, STARTS[seed % 3], seed, duration=TWENTY_DB_SECONDS[kind])
+        errs.append(cell["polished"])
     assert max(errs) < 0.05, errs
