@@ -194,6 +194,26 @@ def refined_health(v, y, weights, radii, *, linear_play: bool = False,
     level of y, or ``1e-12 range(y)`` on a clean record); merged and pinned from ``radii``;
     not still moving (a batch estimate); the fit over the last quarter with ``radii``.
 
+    Parameters
+    ----------
+    v, y : array_like of float
+        The record: input ``v[k]`` and measured output ``y[k]``.
+    weights : array_like of float
+        Play weights ``p_j`` (known).
+    radii : array_like of float
+        The refined radii ``r_j`` [input units].
+    linear_play : bool, optional
+        Whether the first play is the linear (radius 0) play.
+    initial_state : float, optional
+        Play states before ``v[0]``.
+    warn : bool, optional
+        Emit the report's messages as a UserWarning.
+
+    Returns
+    -------
+    EstimatorHealth
+        Excitation, convergence and fit of the refined estimate (``radii_sd`` from the bound).
+
     Examples
     --------
     >>> import numpy as np

@@ -592,10 +592,22 @@ def estimate_radii(v, y, weights, *, dt: float, gains=None, initial_radii=None,
     res.settings = {**settings, "law": law, "polish": bool(polish)}
     if polish and x.size >= 3:
         res.online_radii = res.radii if res.radii_mean is None else res.radii_mean
-        res.radii = refine_radii(x, m, est.weights, res.online_radii, linear_play=linear_play,
-                                 initial_state=initial_state)
-        res.health = refined_health(x, m, est.weights, res.radii, linear_play=linear_play,
+        try:  # weights far outside float64's comfortable range can defeat the least squares
+            refined = refine_radii(x, m, est.weights, res.online_radii,
+                                   linear_play=linear_play, initial_state=initial_state)
+            health = refined_health(x, m, est.weights, refined, linear_play=linear_play,
                                     initial_state=initial_state, warn=warn)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            refined, why = None, str(exc)
+        else:
+            why = "non-finite radii"
+        if refined is None or not np.all(np.isfinite(refined)):
+            warnings.warn(f"weights: the batch refinement failed for these weights ({why}); "
+                          "keeping the online estimate (polish=False)", RuntimeWarning,
+                          stacklevel=2)
+            res.radii = res.online_radii
+        else:
+            res.radii, res.health = refined, health
     return res
 
 
