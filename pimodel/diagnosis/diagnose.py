@@ -52,6 +52,7 @@ from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
 from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment, segment_of_rows
+from .gain import gain_note, record_gains
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
@@ -713,10 +714,17 @@ def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):
 
 def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float) -> dict:
     """The part of the validate gap no accepted effect explains: its share of the gap energy
-    before (``(gap_after^2 - noise^2) / gap_before^2``) and where the remaining residual lies."""
+    before (``(gap_after^2 - noise^2) / gap_before^2``) and where the remaining residual lies.
+    A gap that a gain per validate record explains (:func:`.gain.record_gains`) is unexplained
+    whatever its share, with the gains named in ``gain`` and ``note``."""
     share = max(gap_after**2 - noise**2, 0.0) / max(gap_before**2, 1e-300)
-    present = gap_after > UNEXPLAINED_FACTOR * noise and share > UNEXPLAINED_SHARE
+    above = gap_after > UNEXPLAINED_FACTOR * noise
+    gain = record_gains(va, outputs, noise) if above else None
+    present = above and (share > UNEXPLAINED_SHARE or gain is not None)
     out: dict = {"present": bool(present), "share": share}
+    if gain is not None:
+        out["gain"] = gain
+        out["note"] = gain_note(gain)
     if present:
         wb = residual_breakdown(va, [s.y - o for s, o in zip(va, outputs, strict=True)])
         out["where"] = [r["region"] for r in wb["regions"][:3]]
