@@ -60,7 +60,8 @@ class NativeInverse:
     ------
     ValueError
         A Wiener model (``dynamics_position = "before"``), more than 128 plays or 64 creep
-        lags, a parameter the C core refuses (named), or one the Python solver refuses.
+        lags, a parameter the C core refuses (named), one the Python solver refuses, or a
+        saturated rate term (``rate_saturation``: the FMU has none).
 
     Examples
     --------
