@@ -23,6 +23,7 @@ from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import (
     RATE_BANDS,
     RATE_FAMILIES,
+    RATE_POLISH_ROUNDS,
     RATE_SATURATION_REFINE,
     RATE_SATURATIONS,
     RATE_TAU_REFINE,
@@ -581,11 +582,17 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         # the saturation of the filtered rate at that filter (module rate), then steps
         best = search([{**best[0].params, "rate_saturation": s_} for s_ in RATE_SATURATIONS
                        if s_ is not None], best)
-        for step in RATE_SATURATION_REFINE:
-            s_ = best[0].params["rate_saturation"]
-            if s_ is not None:
-                best = search([{**best[0].params, "rate_saturation": s_ * f}
-                               for f in (1 / step, step)], best)
+        for _ in range(RATE_POLISH_ROUNDS):  # then the filter and the saturation in turn
+            before, p_ = best[0], best[0].params
+            if p_["rate_saturation"] is None:
+                break
+            best = search([{**p_, "rate_saturation": p_["rate_saturation"] * f}
+                           for f in (1 / RATE_SATURATION_REFINE, RATE_SATURATION_REFINE)]
+                          + [{**p_, "rate_tau": p_["rate_tau"] * f}
+                             for f in (1 / RATE_TAU_REFINE[-1], RATE_TAU_REFINE[-1])
+                             if p_["rate_tau"] > 0], best)
+            if best[0] is before:
+                break
     if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
         i = int(np.searchsorted(dgrid, best[0].params["d"]))
         lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]

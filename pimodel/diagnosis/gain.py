@@ -10,7 +10,7 @@ mean(y_hat))``; the gains explain the gap when, pooled over the records, what is
 with some ``|c|`` at least ``GAIN_MIN``. On the train records the hysteresis weights absorb any
 common gain, so the test reads the validate records only. Measured on
 ``pimodel.stages.density_stage`` (a gain 1.04-1.08 on the validate record): the level leaves
-0.79 um (8.7 noise floors), level and gain 0.092 um (1.0 floor), ``c`` = 0.069 (seed 0).
+0.79 um (8.8 noise floors), level and gain 0.094 um (1.05 floors), ``c`` = 0.069 (seed 0).
 """
 
 from __future__ import annotations

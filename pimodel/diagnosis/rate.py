@@ -33,7 +33,10 @@ up to a bound, as a stage's does. Without it, gains fitted on slow train records
 rates are at most a few ``rate_scale``) extrapolate linearly to fast validate records (measured
 on ``pimodel.stages.density_stage``, train up to about 600 V/s, validate up to 8000 V/s: a
 validate RMS 6.7 times the nominal's). ``S`` is chosen on train after the filter, on the grid
-``RATE_SATURATIONS`` (None among them), then by the steps ``RATE_SATURATION_REFINE``.
+``RATE_SATURATIONS`` (None among them); then ``S`` by the steps ``RATE_SATURATION_REFINE`` and
+``tau`` by the finest of ``RATE_TAU_REFINE``, both tried in each of up to ``RATE_POLISH_ROUNDS``
+rounds while the train residual falls (the two trade against each other: a longer filter
+lowers the peaks the saturation bounds).
 """
 
 from __future__ import annotations
@@ -51,11 +54,13 @@ RATE_BANDS = 8  # play bands: the candidate has RATE_BANDS gains
 RATE_FAMILIES = ("radius", "weight")  # radii or weights growing with the rate
 STEP_SHARE = 0.05  # without a filter, a one-sample jump above this share of the range is a step
 RATE_SATURATIONS = (None, 4.0, 2.0, 1.0, 0.5)  # S [-]: rho_f / (1 + rho_f / S), None: linear
-RATE_SATURATION_REFINE = (2**0.25,)  # then steps around the best finite S: 1/4 octave
+RATE_SATURATION_REFINE = 2**0.25  # then steps of S (1/4 octave) and of the filter (1/8 decade)
+RATE_POLISH_ROUNDS = 4  # ... in turn, while the train residual falls
 
 __all__ = [
     "RATE_BANDS",
     "RATE_FAMILIES",
+    "RATE_POLISH_ROUNDS",
     "RATE_SATURATIONS",
     "RATE_SATURATION_REFINE",
     "RATE_TAUS",
