@@ -243,7 +243,7 @@ def polish_radii(v, y, weights, radii, *, tail: float = 1.0, iterations: int = 3
     return r
 
 
-def refine_radii(v, y, weights, online, *, linear_play: bool = False,
+def refine_radii(v, y, weights, online, *, tail: float = 1.0, linear_play: bool = False,
                  initial_state: float = 0.0) -> np.ndarray:
     """The batch refinement :func:`pimodel.estimate_radii` applies by default.
 
@@ -257,7 +257,9 @@ def refine_radii(v, y, weights, online, *, linear_play: bool = False,
     differing on at most 0.1 % of the samples, or radii closer than ``SPLIT_GAP`` of the
     input's range) the polish restarts from the pair pushed apart by ``SPLIT_STEPS`` of the
     range (``r_j - h``, ``r_{j+1} + h``); an end that fits better replaces the estimate, and
-    the pairs are checked again (at most n rounds).
+    the pairs are checked again (at most n rounds). ``tail``: the fraction of the record, at
+    its end, whose residuals are fitted and compared (the model runs over the whole record;
+    see :func:`polish_radii`).
 
     Examples
     --------
@@ -274,10 +276,13 @@ def refine_radii(v, y, weights, online, *, linear_play: bool = False,
     starts = [_project(as_vector(online, "online", length=p.size), linear_play),
               *(_project(profile_radii(x, m, p, bins=b), linear_play) for b in REFINE_BINS)]
 
+    lo = int(x.size * (1 - tail)) if 0 < tail <= 1 else 0  # polish_radii checks tail
+
     def polish(r):
-        end = polish_radii(x, m, p, r, linear_play=linear_play, initial_state=initial_state)
+        end = polish_radii(x, m, p, r, tail=tail, linear_play=linear_play,
+                           initial_state=initial_state)
         z, s = play_sensitivity(x, end, initial_state=initial_state)
-        return end, float(np.sum((m - z @ p) ** 2)), s
+        return end, float(np.sum((m[lo:] - z[lo:] @ p) ** 2)), s[lo:]
 
     best, cost, s = min((polish(r) for r in starts), key=lambda e: e[1])
     span = float(np.ptp(x))
