@@ -369,8 +369,8 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     if v.size * p.size <= REFINE_LIMIT:  # the batch refinement holds N x n arrays
         offset = float(np.mean(y - PIOperator(p, radii).simulate(v)))
         # the last half, as the online mean: a real stage's start-up (creep from its initial
-        # state) is not in the model (shared real record: held-out RMS 0.113 um fitting all of
-        # it, against 0.065 um fitting the last half and 0.089 um for the online mean)
+        # state) is not in the model (shared real record, held-out RMS: 0.113 um fitting all
+        # of it, 0.086 um fitting the last half, 0.089 um for the online mean alone)
         radii = refine_radii(v, y - offset, p, radii, tail=0.5, linear_play=slopes.linear_play)
         health = refined_health(v, y - offset, p, radii, linear_play=slopes.linear_play)
         radii_from = ("batch refinement (refine_radii, last half of the record) from the "
