@@ -30,6 +30,7 @@ __all__ = ["INPUT_KINDS", "STARTS", "input_signal", "random_stage", "run_cell"]
 INPUT_KINDS = ("centred sine", "offset sine", "triangle", "multisine", "random",
                "stair steps", "decaying loops")
 STARTS = ("below", "zero", "far above")
+NOISE_STREAM = 1  # :func:`run_cell`'s output noise: default_rng([seed, NOISE_STREAM])
 
 
 def _unit(x: np.ndarray) -> np.ndarray:
@@ -105,8 +106,8 @@ def start_radii(name: str, r: np.ndarray) -> np.ndarray:
 def run_cell(kind: str, snr_db: float | None, start: str, seed: int, *, fs: float = 1000.0,
              duration: float = 60.0) -> dict:
     """One cell: a random stage (``seed``), its input, output noise at ``snr_db`` (None:
-    clean; noise standard deviation ``std(y) / 10^(snr/20)``), :func:`estimate_radii` from
-    ``start`` with its defaults.
+    clean; else white Gaussian noise of standard deviation ``std(y) / 10^(snr/20)``,
+    independent of the input), :func:`estimate_radii` from ``start`` with its defaults.
 
     Returns a dict with ``online`` and ``polished`` (largest radius error relative to the
     largest radius), ``ratio`` (largest ``|error_j| / sd_j`` of the polished estimate, sd the
@@ -120,7 +121,10 @@ def run_cell(kind: str, snr_db: float | None, start: str, seed: int, *, fs: floa
     sigma = None
     if snr_db is not None:
         sigma = float(np.std(y) / 10 ** (snr_db / 20))
-        y = y + rng.normal(0.0, sigma, y.size)
+        # a stream of its own: rng continues default_rng(seed), the stream input_signal's
+        # band-limited random input is made of, so its draws would be that white noise
+        # shifted by a few samples: output noise correlated with the input (a bias)
+        y = y + np.random.default_rng([seed, NOISE_STREAM]).normal(0.0, sigma, y.size)
     res = estimate_radii(v, y, p, dt=1 / fs, initial_radii=start_radii(start, r))
     out = {"kind": kind, "snr_db": snr_db, "start": start, "seed": seed, "n": p.size,
            "online": float(np.max(np.abs(res.online_radii - r)) / r[-1]),

@@ -243,14 +243,23 @@ def polish_radii(v, y, weights, radii, *, tail: float = 1.0, iterations: int = 3
     return r
 
 
-def refine_radii(v, y, weights, online, *, linear_play: bool = False,
+def refine_radii(v, y, weights, online, *, tail: float = 1.0, linear_play: bool = False,
                  initial_state: float = 0.0) -> np.ndarray:
     """The batch refinement :func:`pimodel.estimate_radii` applies by default.
 
     Gauss-Newton (:func:`polish_radii`, whole record) from ``online`` (the online estimate)
     and from :func:`profile_radii` with 512, 128 and 32 bins (the coarse profiles are less
     noisy, the fine one more precise); the end that fits the record better (smaller sum of
-    squared output errors) is returned.
+    squared output errors) is kept. Then **split moves**: Gauss-Newton cannot separate two
+    neighbouring plays whose switching patterns are the same (equal columns of J, e.g. both
+    ``2 r_j`` between the same two levels of a stair-step input: only their weighted sum is
+    determined), a local minimum with the plays nearly merged. For each such pair (patterns
+    differing on at most 0.1 % of the samples, or radii closer than ``SPLIT_GAP`` of the
+    input's range) the polish restarts from the pair pushed apart by ``SPLIT_STEPS`` of the
+    range (``r_j - h``, ``r_{j+1} + h``); an end that fits better replaces the estimate, and
+    the pairs are checked again (at most n rounds). ``tail``: the fraction of the record, at
+    its end, whose residuals are fitted and compared (the model runs over the whole record;
+    see :func:`polish_radii`).
 
     Examples
     --------
@@ -266,11 +275,42 @@ def refine_radii(v, y, weights, online, *, linear_play: bool = False,
     p = check_weights(weights)
     starts = [_project(as_vector(online, "online", length=p.size), linear_play),
               *(_project(profile_radii(x, m, p, bins=b), linear_play) for b in REFINE_BINS)]
-    ends = [polish_radii(x, m, p, r, linear_play=linear_play, initial_state=initial_state)
-            for r in starts]
-    sse = [float(np.sum((m - play_sensitivity(x, r, initial_state=initial_state)[0] @ p) ** 2))
-           for r in ends]
-    return ends[int(np.argmin(sse))]
+
+    lo = int(x.size * (1 - tail)) if 0 < tail <= 1 else 0  # polish_radii checks tail
+
+    def polish(r):
+        end = polish_radii(x, m, p, r, tail=tail, linear_play=linear_play,
+                           initial_state=initial_state)
+        z, s = play_sensitivity(x, end, initial_state=initial_state)
+        return end, float(np.sum((m[lo:] - z[lo:] @ p) ** 2)), s[lo:]
+
+    best, cost, s = min((polish(r) for r in starts), key=lambda e: e[1])
+    span = float(np.ptp(x))
+    for _ in range(p.size):
+        improved = False
+        for j in _merged_pairs(best, s, SPLIT_GAP * span):
+            for h in SPLIT_STEPS:
+                r = best.copy()
+                r[j] -= h * span
+                r[j + 1] += h * span
+                end, c, s_end = polish(_project(r, linear_play))
+                if c < cost:
+                    best, cost, s, improved = end, c, s_end, True
+            if improved:
+                break
+        if not improved:
+            break
+    return best
+
+
+SPLIT_GAP = 0.005  # radii closer than this fraction of the input range: try a split
+SPLIT_STEPS = (0.005, 0.02)  # split moves of :func:`refine_radii`, fractions of the range
+
+
+def _merged_pairs(r: np.ndarray, s: np.ndarray, gap: float) -> list[int]:
+    """0-based j of neighbours (j, j + 1) with (nearly) the same switching pattern."""
+    same = np.mean(s[:, 1:] != s[:, :-1], axis=0) <= 1e-3
+    return [int(j) for j in np.flatnonzero(same | (np.diff(r) < gap))]
 
 
 class RadiusBound:
