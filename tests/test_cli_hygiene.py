@@ -38,6 +38,25 @@ def test_help_lists_every_command_without_loading_numpy():
     assert all(f"    {name} " in out for name in COMMANDS)
 
 
+def test_sweep_help_lists_the_sweep_names_without_loading_the_simulator():
+    from pimodel.cli.sweep import HELP_NAMES
+    from pimodel.experiments.stage_sweeps import DIAGNOSE_SETTINGS, IDENTIFY_SETTINGS, TRUTH_PARAMS
+
+    assert HELP_NAMES == {"Truth parameters": (*TRUTH_PARAMS, "fs"),
+                          "Diagnose settings": DIAGNOSE_SETTINGS,
+                          "Identify settings": IDENTIFY_SETTINGS}
+    code = ("import sys\nfrom pimodel.cli import main\ntry:\n    main(['sweep', '--help'])\n"
+            "except SystemExit:\n    pass\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'scipy' or "
+            "m.startswith('pimodel.stages')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip().endswith("[]")
+    text = " ".join(out.split())  # argparse wraps the description
+    for what, names in HELP_NAMES.items():
+        assert f"{what}: {', '.join(names)}." in text
+
+
 def test_json_folder_refused_before_any_work(record, tmp_path, capsys, monkeypatch):  # noqa: F811
     import pimodel.identification.chain as chain
 
@@ -52,6 +71,22 @@ def test_json_folder_refused_before_any_work(record, tmp_path, capsys, monkeypat
     assert main(["identify", str(record), "--json", str(tmp_path / "m.json"), "--plots",
                  str(tmp_path / "afile")]) == 2
     assert f"--plots {tmp_path / 'afile'}: a file; expected a folder" in capsys.readouterr().err
+
+
+
+@pytest.mark.parametrize("other", ["--report", "--export"])
+def test_diagnose_outputs_that_name_one_file_are_refused_before_any_work(
+        record, tmp_path, capsys, monkeypatch, other):  # noqa: F811
+    import pimodel.diagnosis as diagnosis
+
+    monkeypatch.setattr(diagnosis, "diagnose", lambda *a, **k: pytest.fail("the diagnosis ran"))
+    name = {"--report": "report.md", "--export": "augmented.json"}[other]
+    out = tmp_path / "out"
+    code = main(["diagnose", "--train", str(record), "--validate", str(record), "--json",
+                 str(out / name), other, str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and f"{other} {name}" in err and f"the output --json ({out / name})" in err
+    assert not out.exists()
 
 
 def test_each_warning_printed_once(tmp_path, capsys, monkeypatch):

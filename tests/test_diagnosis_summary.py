@@ -2,12 +2,21 @@
 sure it is, where the gap sits and a next step drawn from the report's own figures; the
 Markdown report holds them and its figures."""
 
+import re
+
 import numpy as np
 import pytest
 
 from pimodel.cli import main
 from pimodel.diagnosis.diagnose import DiagnosisReport
-from pimodel.diagnosis.summary import confidence, hints, next_step, summarize, write_report
+from pimodel.diagnosis.summary import (
+    confidence,
+    hints,
+    markdown_table,
+    next_step,
+    summarize,
+    write_report,
+)
 
 STARTUP = "start-up (until the input first spans 90 % of its range)"
 
@@ -131,3 +140,35 @@ def test_report_folder_that_is_an_input_is_refused(tmp_path, capsys):
                  str(tmp_path / "r.json"), "--report", str(rec)])
     assert code == 2 and "--report" in capsys.readouterr().err
     assert not (tmp_path / "r.json").exists()  # refused before any work
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_markdown_table_cells_round_trip(seed):
+    """The one table helper (report and demo): a header, a rule, one line per row with one
+    cell per column; floats read back to 4 significant digits, text with ``|`` intact."""
+    from pimodel.experiments import demo
+
+    assert demo.markdown_table is markdown_table
+    rng = np.random.default_rng(seed)
+    ncols, nrows = int(rng.integers(1, 6)), int(rng.integers(0, 8))
+    header = [f"c{j}|x" if rng.random() < 0.3 else f"c{j}" for j in range(ncols)]
+    rows = [[float(rng.lognormal(0, 5)) * rng.choice([-1, 1]) if rng.random() < 0.5 else
+             f"t{i}{'|' if rng.random() < 0.5 else ''}{j}" for j in range(ncols)]
+            for i in range(nrows)]
+    lines = markdown_table(header, rows).splitlines()
+    assert len(lines) == nrows + 2 and lines[1] == "|" + "---|" * ncols
+
+    def cells(line):  # split at the unescaped pipes, then unescape
+        parts = re.split(r"(?<!\\)\|", line)
+        assert parts[0] == parts[-1] == ""
+        return [c.strip().replace("\\|", "|") for c in parts[1:-1]]
+
+    assert cells(lines[0]) == header
+    for line, row in zip(lines[2:], rows, strict=True):
+        got = cells(line)
+        assert len(got) == ncols
+        for g, x in zip(got, row, strict=True):
+            if isinstance(x, float):
+                assert abs(float(g) - x) <= 5e-4 * abs(x)
+            else:
+                assert g == x

@@ -130,7 +130,7 @@ def _same_file(a: Path, b: Path) -> bool:
 
 def refuse_overwrite(inputs: dict[str, list[str]], outputs: dict[str, str | None],
                      folders: dict[str, str | None] | None = None) -> None:
-    """Raise ValueError when an output would write over an input file.
+    """Raise ValueError when an output would write over an input file or another output.
 
     Parameters
     ----------
@@ -145,8 +145,9 @@ def refuse_overwrite(inputs: dict[str, list[str]], outputs: dict[str, str | None
     Raises
     ------
     ValueError
-        Naming the output argument, its path and the input argument and file it names; or
-        an output path that cannot be written (:func:`check_outputs`).
+        Naming the output argument, its path and the input argument and file it names; two
+        output arguments that name one file; or an output path that cannot be written
+        (:func:`check_outputs`).
 
     Examples
     --------
@@ -165,6 +166,12 @@ def refuse_overwrite(inputs: dict[str, list[str]], outputs: dict[str, str | None
             if _same_file(Path(out), path):
                 raise ValueError(f"{out_arg} {out} is the input file {in_arg} ({path}); pimodel "
                                  "never writes over an input file: choose another output name")
+    given = [(arg, out) for arg, out in outputs.items() if out is not None]
+    for i, (out_arg, out) in enumerate(given):
+        for other_arg, other in given[:i]:
+            if _same_file(Path(out), Path(other)):
+                raise ValueError(f"{out_arg} {out} is also the output {other_arg} ({other}): "
+                                 "one would write over the other; choose another output name")
     for out_arg, folder in (folders or {}).items():
         if folder is None:
             continue

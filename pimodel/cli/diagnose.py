@@ -88,13 +88,10 @@ def run(args: argparse.Namespace) -> int:
 
     exported = {f"--export {name}": str(Path(args.export) / name) for name in EXPORT_FILES} \
         if args.export else {}
+    report = str(Path(args.report) / "report.md") if args.report else None
     refuse_overwrite({"--train": args.train, "--validate": args.validate},
-                     {"--json": args.json, **exported}, {"--plots": args.plots,
-                                                         "--export": args.export})
-    if args.report:
-        refuse_overwrite({"--train": args.train, "--validate": args.validate},
-                         {"--report report.md": str(Path(args.report) / "report.md")},
-                         {"--report": args.report})
+                     {"--json": args.json, "--report report.md": report, **exported},
+                     {"--plots": args.plots, "--export": args.export, "--report": args.report})
     inputs = args.train + args.validate
     train = load_inputs(args, args.train, inputs)
     validate = load_inputs(args, args.validate, inputs)

@@ -13,12 +13,25 @@ from .common import check_outputs
 
 __all__ = [
     "HELP",
+    "HELP_NAMES",
     "build_cases",
     "register",
     "run",
 ]
 
 HELP = "sweep the truth simulator and diagnosis/identification settings (tidy table)"
+
+# The names the description lists, written out so that ``pimodel sweep --help`` imports no
+# simulator (pimodel.stages loads SciPy and python-control: ~10 s on a loaded machine).
+# tests/test_cli_hygiene.py holds them equal to pimodel.experiments.stage_sweeps' tuples.
+HELP_NAMES = {
+    "Truth parameters": ("creep_percent_per_decade", "mode_hz", "mode_damping", "delay_s",
+                         "asymmetry", "drift_um_per_s", "drift_clock", "rate_gain", "noise_um",
+                         "fs"),
+    "Diagnose settings": ("max_effects",),
+    "Identify settings": ("method", "n_plays", "linear_play", "gains", "passes", "guard",
+                          "conventional_span", "max_segments"),
+}
 
 
 def _value(text: str):
@@ -53,11 +66,6 @@ def _range(text: str) -> tuple[str, tuple[float, float]]:
 
 
 def register(sub) -> None:
-    from ..experiments.stage_sweeps import (
-        DIAGNOSE_SETTINGS,
-        IDENTIFY_SETTINGS,
-        TRUTH_PARAMS,
-    )
     from ..experiments.studies import add_run_options
 
     p = sub.add_parser(
@@ -67,9 +75,8 @@ def register(sub) -> None:
         "over a grid (--grid) or a random sample (--random) of parameters, on a local Dask "
         "cluster or a given scheduler, and write OUT/table.csv (one row per case; "
         ".parquet with pyarrow). Finished cases are kept in OUT/cases, so a rerun computes "
-        f"only the missing ones. Truth parameters: {', '.join(TRUTH_PARAMS)}, fs. "
-        f"Diagnose settings: {', '.join(DIAGNOSE_SETTINGS)}. Identify settings: "
-        f"{', '.join(IDENTIFY_SETTINGS)}.",
+        "only the missing ones. "
+        + " ".join(f"{what}: {', '.join(names)}." for what, names in HELP_NAMES.items()),
     )
     p.add_argument("target", choices=["diagnose", "identify"], help="what each case runs")
     p.add_argument("--grid", type=_grid_axis, action="append", default=[], metavar="NAME=V1,V2",

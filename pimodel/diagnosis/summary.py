@@ -11,6 +11,7 @@ from pathlib import Path
 __all__ = [
     "confidence",
     "hints",
+    "markdown_table",
     "next_step",
     "summarize",
     "write_report",
@@ -224,9 +225,22 @@ def summarize(rep) -> str:
     return "\n".join(lines)
 
 
-def _table(cols, rows) -> str:
-    out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    out += ["| " + " | ".join(str(x).replace("|", "\\|") for x in r) + " |" for r in rows]
+def markdown_table(header: list[str], rows: list[list]) -> str:
+    """A Markdown table (the reports' and the demo's): one row per list, floats to 4
+    significant digits, other cells as ``str``, a ``|`` inside a cell escaped.
+
+    Examples
+    --------
+    >>> print(markdown_table(["a", "b"], [[0.123456, "x|y"]]), end="")
+    | a | b |
+    |---|---|
+    | 0.1235 | x\\|y |
+    """
+    def cell(x) -> str:
+        return (f"{x:.4g}" if isinstance(x, float) else str(x)).replace("|", "\\|")
+
+    out = ["| " + " | ".join(cell(c) for c in header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(cell(x) for x in r) + " |" for r in rows]
     return "\n".join(out) + "\n"
 
 
@@ -279,7 +293,7 @@ def write_report(rep, out_dir, *, title: str = "Diagnosis", units=("V", "um")) -
                   "with the named effects over time; right: against the input. Below: the "
                   "loops of the first validate record, and where the nominal residual "
                   "concentrates (1 is uniform).\n"]
-    parts += ["## Numbers\n", _table(
+    parts += ["## Numbers\n", markdown_table(
         ["", "value"],
         [["verdict", ", ".join(v["effects"])],
          [f"validate gap before (RMS) [{uy}]", f"{v['gap_before']:.4g}"],
@@ -295,12 +309,12 @@ def write_report(rep, out_dir, *, title: str = "Diagnosis", units=("V", "um")) -
         parts += ["## Each effect alone\n",
                   "Each candidate fitted alone on the train records, scored on validate "
                   "(negative delta BIC: better than the nominal).\n",
-                  _table(["effect", f"validate RMS [{uy}]", "delta BIC"],
-                         [[c["effect"], f"{c['validate']['rms']:.4g}",
-                           f"{c['delta_bic']:.0f}"] for c in cands])]
+                  markdown_table(["effect", f"validate RMS [{uy}]", "delta BIC"],
+                                 [[c["effect"], f"{c['validate']['rms']:.4g}",
+                                   f"{c['delta_bic']:.0f}"] for c in cands])]
     regs = rep.where.get("regions") or []
     if regs:
-        parts += ["## Where the nominal residual lies\n", _table(
+        parts += ["## Where the nominal residual lies\n", markdown_table(
             ["region", "energy share", "sample share", "concentration"],
             [[r["region"], f"{100 * r['energy_share']:.0f} %",
               f"{100 * r['sample_share']:.0f} %", f"{r['concentration']:.2f}"]

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..diagnosis.summary import markdown_table
 from ..identification.chain import identify
 from ..loops.actuators import stage_dynamics
 from ..loops.compiled import PID, run_loop
@@ -40,15 +41,6 @@ FS_ID = 1000.0  # Hz, identification record
 FS_LOOP = 10_000.0  # Hz, compensation loops
 NOISE_UM = 0.005
 GAIN = 50.0  # estimator gain in the co-simulated loop
-
-
-def _md_table(header: list[str], rows: list[list]) -> str:
-    def fmt(x):
-        return f"{x:.4g}" if isinstance(x, float) else str(x)
-
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(fmt(x) for x in r) + " |" for r in rows]
-    return "\n".join(lines) + "\n"
 
 
 def step_identify(out: Path) -> tuple[dict, str]:
@@ -110,8 +102,8 @@ def step_identify(out: Path) -> tuple[dict, str]:
         f"Adaptive model: weights {np.round(adaptive.weights, 4).tolist()} um/V, radii "
         f"{np.round(adaptive.radii, 4).tolist()} V (truth {STAGE.weights.tolist()}, "
         f"{STAGE.radii.tolist()}).\n\n"
-        + _md_table(["model", "plays (nonzero weight)", "fit RMS [%]", "held-out RMS [%]",
-                     "held-out max [%]"], rows)
+        + markdown_table(["model", "plays (nonzero weight)", "fit RMS [%]",
+                          "held-out RMS [%]", "held-out max [%]"], rows)
         + "\n![identification](identify.png)\n\n"
     )
     nums = {r[0]: {"n": r[1], "fit_rms_percent": r[2], "heldout_rms_percent": r[3],
@@ -179,8 +171,8 @@ def step_compensate(out: Path, models: dict) -> tuple[dict, str]:
         f"{FS_LOOP:.0f} Hz loop, 1 kHz mode (damping 0.05) after the hysteresis. Feedforward "
         "`v = PI_model^-1[y_d]`; the PID loop adds integral action (ki = 20 V/(um s)). Errors "
         "in % of the reference range.\n\n"
-        + _md_table(["feedforward", "open loop max", "open loop RMS", "with PID max",
-                     "with PID RMS"], rows)
+        + markdown_table(["feedforward", "open loop max", "open loop RMS", "with PID max",
+                          "with PID RMS"], rows)
         + "\n![compensation](compensate.png)\n\n"
     )
     return {"compensate": nums}, text
@@ -289,7 +281,7 @@ def step_diagnose(out: Path) -> tuple[dict, str]:
         + "; ".join(f"{r['region']} ({100 * r['energy_share']:.0f} % of the energy in "
                     f"{100 * r['sample_share']:.0f} % of the samples)" for r in top)
         + ".\n\n"
-        + _md_table(["candidate alone", "validate RMS [um]", "delta BIC"], rows)
+        + markdown_table(["candidate alone", "validate RMS [um]", "delta BIC"], rows)
         + "\n" + "\n".join(f"![{p.stem}]({p.name})" for p in figs) + "\n"
     )
     return {"diagnose": v}, text
