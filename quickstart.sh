@@ -36,8 +36,7 @@ case "$cmd" in
     test|quick)
         .venv/bin/ruff check .
         # one pytest worker per core, at most 4 (pytest-xdist); a test file stays on one worker
-        # so its module fixtures are built once, and the files go out longest first
-        # (tests/conftest.py FILE_SECONDS). PIMODEL_TEST_WORKERS=0 runs in this process.
+        # so its module fixtures are built once. PIMODEL_TEST_WORKERS=0 runs in this process.
         workers=${PIMODEL_TEST_WORKERS:-$(nproc 2>/dev/null || echo 1)}
         case $workers in
             ''|*[!0-9]*) echo "quickstart: PIMODEL_TEST_WORKERS: expected a whole number >= 0" \
@@ -46,8 +45,7 @@ case "$cmd" in
         [ "$workers" -gt 4 ] && workers=4
         tier=()
         [ "$cmd" = quick ] && tier=(-m "not slow")
-        exec .venv/bin/python -m pytest -q -n "$workers" --dist loadfile --no-loadscope-reorder \
-            "${tier[@]}" "$@" ;;
+        exec .venv/bin/python -m pytest -q -n "$workers" --dist loadfile "${tier[@]}" "$@" ;;
     *)
         echo "usage: bash quickstart.sh {demo|test|quick} [args...]" >&2; exit 2 ;;
 esac
