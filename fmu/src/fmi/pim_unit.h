@@ -20,6 +20,9 @@
  *   model_outputs_finite(u) *  the unit's further outputs are finite (out1, out2 checked here)
  *   model_saved, model_save(u, s), model_restore(u, s)   the states a step changes, for the
  *                              rollback of a step that overflows (once per doStep, not per sample)
+ *   model_step_safe(u) *       1 when no sample at the held inputs can overflow (a bound from the
+ *                              checked parameters, derived once): the step then runs without the
+ *                              rollback copy and without the per-sample output checks
  *   model_step_done(u) *       after a step's samples (e.g. the RadiusEstimator's health output)
  *   model_check_states(u, s)   the states of a loaded FMU state s (parameters already checked)
  *   model_report(u, buf, size) * a report in words logged once at terminate (0: none)
@@ -199,6 +202,9 @@ static int model_check_inputs(pim_unit *u) { (void)u; return 0; }
 #ifndef HAS_MODEL_OUTPUTS_FINITE
 static int model_outputs_finite(const pim_unit *u) { (void)u; return 1; }
 #endif
+#ifndef HAS_MODEL_STEP_SAFE
+static int model_step_safe(const pim_unit *u) { (void)u; return 0; }
+#endif
 #ifndef HAS_MODEL_STEP_DONE
 static void model_step_done(pim_unit *u) { (void)u; }
 #endif
@@ -306,13 +312,43 @@ static int unit_check_inputs(pim_unit *u)
     return model_check_inputs(u);
 }
 
+/* Samples k_next .. k1-1 with the outputs checked after each; a step that overflows is not
+ * taken: the states it changes are restored (a copy per step, for the units whose step can
+ * fail: model_step_safe). */
+static int unit_samples_checked(pim_unit *u, int64_t k1)
+{
+    const int64_t k_saved = u->k_next;
+    const double out_saved[2] = {u->out1, u->out2};
+    model_saved saved;
+    model_save(u, &saved);
+    for (; u->k_next < k1; ++u->k_next) {
+        model_sample(u);
+        if (!isfinite(u->out1) || !isfinite(u->out2) || !model_outputs_finite(u)) {
+            const double y1 = u->out1, y2 = u->out2;
+            const long long k_bad = (long long)u->k_next;
+            u->k_next = k_saved;
+            u->out1 = out_saved[0];
+            u->out2 = out_saved[1];
+            model_restore(u, &saved);
+            return unit_error(u, "the outputs overflowed or are undefined (%g, %g) at sample "
+                                 "%lld with the inputs held over this step (an input beyond an "
+                                 "envelope's domain or range, or a numeric overflow); the step "
+                                 "was not taken", y1, y2, k_bad);
+        }
+    }
+    return 0;
+}
+
 /* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
 static int unit_do_step(pim_unit *u, double t, double h)
 {
     if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
     if (!(h > 0.0) || !isfinite(h))
         return unit_error(u, "communication step size h = %g: must be finite and > 0", h);
-    if (t != u->time) { /* u->time is finite and >= 0: only another t needs the checks */
+    /* u->time is finite and >= 0: only another t needs the checks, and one within the
+     * smallest tolerance (1e-9 s, or 1e-3 Ts) not even the scale of the time */
+    const double dt = fabs(t - u->time);
+    if (dt != 0.0 && !(t >= 0.0 && dt <= (u->Ts < 1e-6 ? 1e-3 * u->Ts : 1e-9))) {
         if (!isfinite(t) || t < 0.0)
             return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
         const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
@@ -339,25 +375,13 @@ static int unit_do_step(pim_unit *u, double t, double h)
         return 0;
     }
     if (unit_check_inputs(u) != 0) return -1;
-    /* a step that overflows is not taken: the states it changes are restored */
-    const int64_t k_saved = u->k_next;
-    const double out_saved[2] = {u->out1, u->out2};
-    model_saved saved;
-    model_save(u, &saved);
-    for (; u->k_next < k1; ++u->k_next) {
-        model_sample(u);
-        if (!isfinite(u->out1) || !isfinite(u->out2) || !model_outputs_finite(u)) {
-            const double y1 = u->out1, y2 = u->out2;
-            u->k_next = k_saved;
-            u->out1 = out_saved[0];
-            u->out2 = out_saved[1];
-            model_restore(u, &saved);
-            return unit_error(u, "the outputs overflowed or are undefined (%g, %g) at sample "
-                                 "%lld with the inputs held over this step (an input beyond an "
-                                 "envelope's domain or range, or a numeric overflow); the step "
-                                 "was not taken", y1, y2,
-                              (long long)u->k_next);
-        }
+    if (model_step_safe(u)) { /* no sample can overflow: a tight loop, nothing to roll back */
+        int64_t k = u->k_next;
+        do model_sample(u);
+        while (++k < k1);
+        u->k_next = k1;
+    } else if (unit_samples_checked(u, k1) != 0) {
+        return -1;
     }
     model_step_done(u);
     u->time = t_end;
