@@ -76,7 +76,7 @@ def fmu_filename(name: str, fmi_version: str = "2.0") -> str:
     """
     return f"{name}{SUFFIX[check_fmi_version(fmi_version)]}.fmu"
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden", "-DPIM_CORE_HIDDEN",
-          "-O3", "-flto", "-fPIC", "-shared"]
+          "-O3", "-fPIC", "-shared"]
 # only the FMI functions leave the binary (the core's pim_* stay inside: PIM_CORE_HIDDEN, and
 # this version script for the linker)
 EXPORTS = "{\n  global: fmi2*; fmi3*;\n  local: *;\n};\n"
