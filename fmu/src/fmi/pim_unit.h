@@ -86,21 +86,26 @@
 #define NMAX PIM_NMAX
 
 
-typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
+typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT, PIM_STRUCTURAL } pim_causality;
+
+/* The size of an FMI 3 array sized by the structural parameter n_plays (the per-play arrays p,
+ * r, r_hat, ...: <Dimension valueReference="n_plays"/>); the C storage stays PIM_NMAX wide. */
+#define PIM_PER_PLAY (-1)
 
 typedef struct {
     const char *name;
     unsigned vr;
-    char type; /* 'R' Real/Float64, 'I' Integer/Int32, 'B' Boolean */
+    char type; /* 'R' Real/Float64, 'I' Integer/Int32, 'B' Boolean, 'U' UInt64 (FMI 3) */
     pim_causality causality;
-    int size;      /* 1, or PIM_NMAX for an array */
+    int size;      /* 1, PIM_NMAX for an array, or PIM_PER_PLAY (FMI 3: n_plays elements) */
     size_t offset; /* of the value(s) in pim_unit */
 } pim_var;
 
 
 /* Life cycle (FMI 2 and 3 Co-Simulation): instantiated -> initialization mode -> step mode
- * (after a successful exitInitializationMode) -> terminated; reset goes back to instantiated. */
-enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED };
+ * (after a successful exitInitializationMode) -> terminated; reset goes back to instantiated.
+ * FMI 3 also: instantiated <-> configuration mode (the structural parameter n_plays). */
+enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED, PIM_CONFIG_MODE };
 
 /* The unit: the common part (the same layout in every unit, mirrored by tests/fmu_driver.py),
  * then the unit's own fields (units/<Unit>/fields.h). */
@@ -117,6 +122,8 @@ typedef struct {
     double time;    /* the end of the last communication step (the start time before any) */
     int64_t k_next; /* index of the next sample to process */
     int n, mode;
+    /* FMI 3's structural parameter: the size of the per-play arrays (FMI 2: PIM_NMAX) */
+    uint64_t n_plays;
     /* the unit's own parameters, states and derived quantities */
 #include "fields.h"
     char msg[256]; /* reason of the last failure */
@@ -164,6 +171,7 @@ static const char *unit_mode_name(int mode)
     case PIM_INIT_MODE: return "in initialization mode";
     case PIM_STEP_MODE: return "in step mode";
     case PIM_TERMINATED: return "terminated";
+    case PIM_CONFIG_MODE: return "in configuration mode";
     default: return "in an unknown mode";
     }
 }
@@ -171,7 +179,7 @@ static const char *unit_mode_name(int mode)
 /* 0 if the unit's mode is one of the bits in `allowed` (1 << mode), else -1 naming the call. */
 static int unit_require_mode(pim_unit *u, unsigned allowed, const char *call)
 {
-    if (u->mode >= PIM_INSTANTIATED && u->mode <= PIM_TERMINATED && (allowed & (1u << u->mode)))
+    if (u->mode >= PIM_INSTANTIATED && u->mode <= PIM_CONFIG_MODE && (allowed & (1u << u->mode)))
         return 0;
     return unit_error(u, "%s is not allowed now: the FMU is %s", call, unit_mode_name(u->mode));
 }
@@ -232,6 +240,7 @@ static void unit_defaults(pim_unit *u)
     memset(u, 0, sizeof *u);
     u->Ts = 1e-3;
     u->n = 1;
+    u->n_plays = PIM_NMAX;
     u->mode = PIM_INSTANTIATED;
     for (int i = 0; i < PIM_NMAX; ++i) u->p[i] = 1.0;
     model_defaults(u);
@@ -258,11 +267,26 @@ static int unit_derive(pim_unit *u)
     return model_derive(u);
 }
 
+/* The structural parameter n_plays (fmi3ExitConfigurationMode, restored states). */
+static int unit_check_n_plays(pim_unit *u)
+{
+    if (u->n_plays < 1 || u->n_plays > PIM_NMAX)
+        return unit_error(u, "structural parameter n_plays = %llu out of range: 1 <= n_plays "
+                             "<= %d", (unsigned long long)u->n_plays, PIM_NMAX);
+    return 0;
+}
+
 /* The parameter rules, shared by initialization and by every FMU state that is restored. */
 static int unit_check_parameters(pim_unit *u)
 {
     if (u->n < 1 || u->n > PIM_UNIT_NMAX)
         return unit_error(u, "parameter n = %d out of range: 1 <= n <= %d", u->n, PIM_UNIT_NMAX);
+    if (unit_check_n_plays(u) != 0) return -1;
+    if ((uint64_t)(u->n < PIM_NMAX ? u->n : PIM_NMAX) > u->n_plays)
+        return unit_error(u, "parameter n = %d exceeds n_plays = %llu, the size of the per-play "
+                             "arrays (set n_plays in configuration mode%s)", u->n,
+                          (unsigned long long)u->n_plays,
+                          u->n > PIM_NMAX ? "; plays beyond 64 need n_plays = 64" : "");
     if (!isfinite(u->Ts) || !(u->Ts >= PIM_TS_MIN))
         return unit_error(u, "parameter Ts = %g: the sample time must be > 0 (finite, >= %g)",
                           u->Ts, PIM_TS_MIN);
@@ -428,14 +452,15 @@ static const char *unit_label(const pim_var *v, int elem, char *buf, size_t size
     return buf;
 }
 
-/* Whether variable v may be set now: parameters before initialization, inputs until
- * terminate, never outputs or time. */
+/* Whether variable v may be set now: the structural parameter in configuration mode,
+ * parameters before initialization, inputs until terminate, never outputs or time. */
 static int unit_settable(const pim_unit *u, const pim_var *v)
 {
     if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT) return 0;
+    if (v->causality == PIM_STRUCTURAL) return u->mode == PIM_CONFIG_MODE;
     if (v->causality == PIM_PARAMETER)
         return u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE;
-    return u->mode != PIM_TERMINATED;
+    return u->mode != PIM_TERMINATED && u->mode != PIM_CONFIG_MODE;
 }
 
 /* Error paths out of line, so that the accessors stay small (they run on every get/set). */
@@ -450,7 +475,8 @@ static int unit_settable(const pim_unit *u, const pim_var *v)
 /* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
 PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, unsigned vr, char type)
 {
-    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : "Boolean";
+    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : type == 'U' ? "UInt64"
+                                                                        : "Boolean";
     char name[40];
     if (!v)
         unit_error(u, "no %s variable with value reference %u in the model description", tname,
@@ -462,6 +488,10 @@ PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, 
         unit_error(u, "variable %s (value reference %u) is %s and cannot be set",
                    unit_label(v, elem, name, sizeof name), vr,
                    v->causality == PIM_OUTPUT ? "an output" : "the independent variable");
+    else if (v->causality == PIM_STRUCTURAL)
+        unit_error(u, "structural parameter %s (value reference %u) can be set in configuration "
+                      "mode only (fmi3EnterConfigurationMode after instantiation)",
+                   unit_label(v, elem, name, sizeof name), vr);
     else if (v->causality == PIM_PARAMETER)
         unit_error(u, "cannot set parameter %s (value reference %u) after initialization",
                    unit_label(v, elem, name, sizeof name), vr);
@@ -474,7 +504,8 @@ PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, 
 /*
  * Storage of the variable with reference vr, checked against the model description (exists,
  * has type `type`) and, for set != 0, against the mode (unit_settable).  *count: values it
- * holds (1, or PIM_NMAX for an FMI 3 array).  NULL with the reason in u->msg on failure.
+ * holds (1; an FMI 3 array's PIM_NMAX, or n_plays for a per-play array).  NULL with the
+ * reason in u->msg on failure.
  */
 static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set,
                                      size_t *count)
@@ -483,7 +514,7 @@ static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int el
     const pim_var *v = unit_var(vr, elements, &elem);
     if (!v || v->type != type || (set && !unit_settable(u, v)))
         return unit_ref_refused(u, v, elem, vr, type);
-    *count = elem >= 0 ? 1 : (size_t)v->size;
+    *count = elem >= 0 ? 1 : v->size == PIM_PER_PLAY ? (size_t)u->n_plays : (size_t)v->size;
     return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
 }
 
@@ -502,9 +533,9 @@ static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int el
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 6u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+#define PIM_STATE_VERSION 7u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
                                 prefilter (Wiener); 5: DiagnosedInverse fields, post sections;
-                                6: the common part, then the unit's own fields */
+                                6: the common part, then the unit's own fields; 7: n_plays */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {
@@ -606,13 +637,15 @@ static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
     memcpy(s, bytes + sizeof h, sizeof *s);
     s->msg[0] = '\0';
     int rc = 0;
-    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_TERMINATED)
+    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_CONFIG_MODE)
         rc = unit_error(u, "FMU state rejected: unknown mode %d", s->mode);
     else if (!isfinite(s->time) || s->time < 0.0)
         rc = unit_error(u, "FMU state rejected: time %g must be finite and >= 0", s->time);
     else if (!isfinite(s->out1) || !isfinite(s->out2))
         rc = unit_error(u, "FMU state rejected: an output is not finite");
-    else if (s->mode >= PIM_STEP_MODE) {
+    else if (unit_check_n_plays(s) != 0)
+        rc = unit_error(u, "FMU state rejected: %s", s->msg);
+    else if (s->mode == PIM_STEP_MODE || s->mode == PIM_TERMINATED) {
         if (unit_check_parameters(s) != 0)
             rc = unit_error(u, "FMU state rejected: %s", s->msg);
         else
