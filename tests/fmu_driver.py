@@ -53,7 +53,7 @@ class UnitPrefix(ctypes.Structure):
                 ("n_plays", ctypes.c_uint64)]
 
 
-FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q"}  # others are doubles
+FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q", "n_plays": "Q"}  # others are doubles
 
 
 def field_offset(field: str, index: int = 0) -> int:

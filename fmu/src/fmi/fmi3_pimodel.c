@@ -289,6 +289,8 @@ fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nv
 fmi3Status fmi3GetFMUState(fmi3Instance inst, fmi3FMUState *state)
 {
     INST(inst);
+    IN_MODES(PIM_IN(PIM_INSTANTIATED) | PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) |
+             PIM_IN(PIM_TERMINATED), "fmi3GetFMUState");
     if (!state) return fail(c, "fmi3GetFMUState: null state pointer");
     unsigned char *buf = *state ? (unsigned char *)*state : (unsigned char *)malloc(PIM_STATE_SIZE);
     if (!buf) return fail(c, "fmi3GetFMUState: out of memory");
@@ -300,6 +302,8 @@ fmi3Status fmi3GetFMUState(fmi3Instance inst, fmi3FMUState *state)
 fmi3Status fmi3SetFMUState(fmi3Instance inst, fmi3FMUState state)
 {
     INST(inst);
+    IN_MODES(PIM_IN(PIM_INSTANTIATED) | PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) |
+             PIM_IN(PIM_TERMINATED), "fmi3SetFMUState");
     return status(c, unit_state_read(&c->u, (const unsigned char *)state, PIM_STATE_SIZE,
                                      PIM_MODEL_TOKEN, 3, &c->u));
 }

@@ -637,7 +637,7 @@ static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
     memcpy(s, bytes + sizeof h, sizeof *s);
     s->msg[0] = '\0';
     int rc = 0;
-    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_CONFIG_MODE)
+    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_TERMINATED) /* none in configuration mode */
         rc = unit_error(u, "FMU state rejected: unknown mode %d", s->mode);
     else if (!isfinite(s->time) || s->time < 0.0)
         rc = unit_error(u, "FMU state rejected: time %g must be finite and >= 0", s->time);
