@@ -1,8 +1,9 @@
 /* Minimal FMI 2.0 host: loads an FMU binary, runs N doStep calls of one sample each (n plays)
  * and prints the time per sample in ns (wall clock, then the process's CPU time, which a loaded
  * machine inflates less) and a checksum of the outputs.  Every call's status is checked (a
- * failing call ends the run with exit status 1, so no failing call is timed).  Value references: the enum
- * ValueReference in fmu/src/pim_unit.h.  Usage: fmu_host BINARY.so GUID N n */
+ * failing call ends the run with exit status 1, so no failing call is timed).  Value
+ * references: the enum ValueReference of the unit's generated config.h.
+ * Usage: fmu_host BINARY.so GUID N n */
 #include <dlfcn.h>
 #include <stdio.h>
 #include <stdlib.h>

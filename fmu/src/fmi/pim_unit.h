@@ -51,7 +51,10 @@
  * reference, type, causality, size, member of pim_unit), generated from the Python spec like
  * the model description, are the one source of truth; tests/test_fmu3.py holds every built
  * modelDescription.xml (FMI 2 and 3) equal to it.  In FMI 2 array element x[i+1] has reference
- * base + i (p 100, r 200, r_hat 300, ...: pimodel.fmu.spec); in FMI 3 an array is one variable.
+ * base + i (p 100, r 200, r_hat 300, ...: pimodel.fmu.spec); in FMI 3 an array is one variable,
+ * a per-play one (size PIM_PER_PLAY) of n_plays elements: the UInt64 structural parameter
+ * (reference 18, FMI 3 only), set in configuration mode, 1..PIM_NMAX, default PIM_NMAX, and
+ * n <= n_plays (n > PIM_NMAX, the Diagnosed units' plays in the _hi arrays: n_plays = PIM_NMAX).
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
@@ -86,7 +89,9 @@
 #define NMAX PIM_NMAX
 
 
-typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT, PIM_STRUCTURAL } pim_causality;
+typedef enum {
+    PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT, PIM_STRUCTURAL
+} pim_causality;
 
 /* The size of an FMI 3 array sized by the structural parameter n_plays (the per-play arrays p,
  * r, r_hat, ...: <Dimension valueReference="n_plays"/>); the C storage stays PIM_NMAX wide. */
@@ -495,6 +500,9 @@ PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, 
     else if (v->causality == PIM_PARAMETER)
         unit_error(u, "cannot set parameter %s (value reference %u) after initialization",
                    unit_label(v, elem, name, sizeof name), vr);
+    else if (u->mode == PIM_CONFIG_MODE)
+        unit_error(u, "cannot set input %s (value reference %u) in configuration mode (only "
+                      "n_plays)", unit_label(v, elem, name, sizeof name), vr);
     else
         unit_error(u, "cannot set input %s (value reference %u) after terminate",
                    unit_label(v, elem, name, sizeof name), vr);
