@@ -49,10 +49,11 @@ class UnitPrefix(ctypes.Structure):
                 ("p", ctypes.c_double * NMAX), ("r", ctypes.c_double * NMAX),
                 ("in1", ctypes.c_double), ("in2", ctypes.c_double), ("out1", ctypes.c_double),
                 ("out2", ctypes.c_double), ("time", ctypes.c_double),
-                ("k_next", ctypes.c_int64), ("n", ctypes.c_int), ("mode", ctypes.c_int)]
+                ("k_next", ctypes.c_int64), ("n", ctypes.c_int), ("mode", ctypes.c_int),
+                ("n_plays", ctypes.c_uint64)]
 
 
-FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q"}  # others are doubles
+FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q", "n_plays": "Q"}  # others are doubles
 
 
 def field_offset(field: str, index: int = 0) -> int:

@@ -88,6 +88,33 @@ def test_substepping_matches_operator(fmus, m):
     np.testing.assert_allclose(vals, y[list(idx)], rtol=0, atol=1e-12)
 
 
+@pytest.mark.parametrize("suffix", ["", "_fmi3"])
+def test_input_beyond_the_safe_bound_takes_the_checked_path(fmus, suffix):
+    """PIHysteresis steps without a rollback copy only while no sample can overflow (|v| below
+    a bound from the weights and radii); an input beyond it still gets the checked step: an
+    overflow is refused and rolled back, and the run goes on equal to Python."""
+    rng = np.random.default_rng(29)
+    p = [1e10, *rng.uniform(0.1, 1.0, 2)]
+    r = [0.0, *np.sort(rng.uniform(0.0, 1.0, 2))]
+    unit = FMUUnit(fmus / f"PIHysteresis{suffix}.fmu", {"Ts": TS, "n": 3, **arr("p", p),
+                                                        **arr("r", r)})
+    v = rng.uniform(-2.0, 2.0, 50)
+    ys = []
+    for j, x in enumerate(v):
+        if j == 20:  # 1e300 * 1e10 overflows: refused, states and output kept
+            y_before = unit.get(["y"])[0]
+            unit.set({"v": 1e300})
+            with pytest.raises(ValueError, match="the outputs overflowed .* not taken"):
+                unit.step(TS)
+            assert unit.get(["y"])[0] == y_before
+        unit.set({"v": x})
+        unit.step(TS)
+        ys.append(unit.get(["y"])[0])
+    unit.close()
+    want = PIOperator(p, r).simulate(v)
+    assert np.max(np.abs(np.array(ys) - want)) <= 1e-12 * np.max(np.abs(want))
+
+
 def test_estimator_fmu_matches_python(fmus):
     t, v = triangle(2, 1, fs=1 / TS, duration=4)
     y = STAGE.simulate(v)

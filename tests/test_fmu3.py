@@ -45,7 +45,11 @@ def test_fmi3_validates(fmus, name):
     md = fmpy.read_model_description(str(path(fmus, name)))
     assert md.fmiVersion == "3.0"
     p = next(v for v in md.modelVariables if v.name in ("p", "c"))  # weights / creep gains
-    assert [int(d.start) for d in p.dimensions] == [NMAX]  # a real array, not scalars
+    n_plays = next(v for v in md.modelVariables if v.name == "n_plays")
+    assert n_plays.causality == "structuralParameter" and int(n_plays.start) == NMAX
+    # a real array, not scalars, sized by the structural parameter
+    assert [d.valueReference for d in p.dimensions] == [n_plays.valueReference]
+    assert p.shape == (NMAX,)
     exe = shutil.which("fmutool", path=str(Path(sys.executable).parent))
     if exe is None:
         pytest.skip("fmutool (fmu-manipulation-toolbox) is not installed")

@@ -16,7 +16,6 @@ import zipfile
 from pathlib import Path
 
 import fmpy
-import numpy as np
 import pytest
 
 from pimodel._native import LIMITS
@@ -31,6 +30,7 @@ HOST = r"""
 #include <stdio.h>
 #include "pim_limits.h"
 #define PIM_NMAX PIM_MAX_PLAYS
+#define PIM_PER_PLAY (-1)
 #include "config.h"
 #define ROW(name, vr, type, causality, size, member) \
     printf("%s %u %c %s %d\n", name, (unsigned)(vr), type, #causality, (int)(size));
@@ -61,15 +61,20 @@ def _c_table(fmu: Path, tmp: Path) -> set[tuple[str, int, str, str, int]]:
 def test_generated_c_table_equals_built_model_description(built_fmus, tmp_path, name,
                                                           fmi_version):
     """Every variable of the built modelDescription.xml has the name, value reference, type,
-    causality and size of the C table compiled from the same FMU's config.h, and back."""
+    causality and size of the C table compiled from the same FMU's config.h, and back; in FMI 3
+    the per-play arrays (size -1 in C) have one dimension, the structural parameter n_plays."""
     fmu = built_fmus / fmu_filename(name, fmi_version)
     table = _c_table(fmu, tmp_path)
     types = ({"R": "Real", "I": "Integer", "B": "Boolean"} if fmi_version == "2.0"
-             else {"R": "Float64", "I": "Int32", "B": "Boolean"})
+             else {"R": "Float64", "I": "Int32", "B": "Boolean", "U": "UInt64"})
+    n_plays = next((vr for vname, vr, *_ in table if vname == "n_plays"), None)
+    assert (n_plays is not None) == (fmi_version == "3.0")
     want = set()
     for vname, vr, typ, causality, size in table:
+        causality = "structuralParameter" if causality == "structural" else causality
         if fmi_version == "3.0":
-            want.add((vname, vr, types[typ], causality, size))
+            want.add((vname, vr, types[typ], causality, f"n_plays({n_plays})" if size == -1
+                      else size))
         elif causality == "independent":
             continue  # FMI 2 Co-Simulation has no time variable
         elif size == 1:
@@ -79,10 +84,14 @@ def test_generated_c_table_equals_built_model_description(built_fmus, tmp_path, 
                      for i in range(size)}
     md = fmpy.read_model_description(str(fmu))
     got = {(v.name, v.valueReference, v.type, v.causality,
-            int(np.prod([int(d.start) for d in v.dimensions])) if v.dimensions else 1)
+            (f"n_plays({v.dimensions[0].valueReference})" if v.dimensions[0].start is None
+             else int(v.dimensions[0].start)) if v.dimensions else 1)
            for v in md.modelVariables}
     assert got == want, got ^ want
-    assert max(size for *_, size in table) == LIMITS["PIM_MAX_PLAYS"]
+    assert all(len(v.dimensions) <= 1 for v in md.modelVariables)
+    assert max(abs(size) for *_, size in table) in (1, LIMITS["PIM_MAX_PLAYS"])
+    assert any(size == (-1 if fmi_version == "3.0" else LIMITS["PIM_MAX_PLAYS"])
+               for *_, size in table)
 
 
 def test_no_value_reference_typed_in_c():

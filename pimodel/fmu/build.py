@@ -182,9 +182,11 @@ def _documentation(name: str) -> str:
                    "</td></tr>" for v in spec["vars"] if "[" not in v.name or "[1]" in v.name)
     return (f"<html><body><h1>{name}</h1><p>{escape(spec['description'])}.</p>"
             f"<p>{escape(SAMPLING)} Arrays are declared up to index {NMAX}; the first n are "
-            "used. Bad parameters or non-finite inputs return an error status (fmi2Error, "
-            "fmi3Error) with a logged message, as do a call in the wrong state, an unknown "
-            "value reference, a doStep whose t is not the FMU's time, a step of more than "
+            "used (FMI 3: the per-play arrays have n_plays elements, a structural parameter "
+            "set in configuration mode, default 64). Bad parameters or non-finite inputs "
+            "return an error status (fmi2Error, fmi3Error) with a logged message, as do a call "
+            "in the wrong state, an unknown value reference, a doStep whose t is not the "
+            "FMU's time, a step of more than "
             f"{MAX_SUBSTEPS:,} samples, and an FMU state that fails its checks (format, "
             "checksum, parameters, finite states)."
             f"</p><table>{rows}</table></body></html>\n")

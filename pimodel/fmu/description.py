@@ -2,8 +2,10 @@
 
 Both versions come from the same spec (:mod:`pimodel.fmu.spec`), as FMPy reads both with one
 ``ModelDescription``: FMI 2.0 lists every array element as a scalar (``p[1]..p[64]``, element
-``p[i]`` at reference ``vr(p) + i - 1``); FMI 3.0 turns them into arrays ``p``, ``r``, ``r_hat``
-of ``NMAX`` elements (the first ``n`` used) and adds the independent variable ``time``.
+``p[i]`` at reference ``vr(p) + i - 1``); FMI 3.0 turns them into arrays and adds the
+independent variable ``time`` and the structural parameter ``n_plays``, which sizes the
+per-play arrays ``p``, ``r``, ``r_hat``, ... (``PER_PLAY``: ``<Dimension valueReference>``, the
+first ``n`` used); the other arrays have ``NMAX`` elements.
 """
 
 from __future__ import annotations
@@ -11,13 +13,14 @@ from __future__ import annotations
 from xml.sax.saxutils import escape
 
 from .sources import CORE_SOURCES
-from .spec import NMAX, TIME, check_fmi_version, guid, spec_of, token, unit_of
+from .spec import N_PLAYS, NMAX, PER_PLAY, TIME, check_fmi_version, guid, spec_of, token, unit_of
 from .units import unit_definitions, variable_unit
 
 __all__ = ["LOG_CATEGORIES", "PLATFORM", "TYPES", "default_experiment", "model_description",
            "model_description3"]
 
-TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}  # FMI 2 -> FMI 3 type
+TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean",
+         "UInt64": "UInt64"}  # FMI 2 -> FMI 3 type
 PLATFORM = {"2.0": "linux64", "3.0": "x86_64-linux"}  # binaries/<platform>/ per FMI version
 LOG_CATEGORIES = ('  <LogCategories><Category name="logStatusWarning" description="warnings (the '
                   'radius estimate\'s health)"/><Category name="logStatusError" '
@@ -35,8 +38,10 @@ def _variables3(name: str) -> list[tuple[str, int, str, str, str, str, bool]]:
             seen.add(v.base)
             what = v.description.rsplit(",", 1)[0]
             starts = [w.start for w in variables if w.base == v.base]
+            per = ("per play (first n of n_plays used)" if v.base in PER_PLAY
+                   else f"{NMAX} elements")
             out.append((v.base, v.vr, TYPES[v.kind], v.causality, " ".join(starts),
-                        f"{what}, per play (first n of {NMAX} used)", True))
+                        f"{what}, {per}", True))
         else:
             out.append((v.name, v.vr, TYPES[v.kind], v.causality, v.start, v.description,
                         False))
@@ -119,14 +124,19 @@ def _variables_xml(name: str, fmi_version: str) -> tuple[list[str], list[int]]:
         lines.append(f'    <Float64 name="{TIME.name}" valueReference="{TIME.vr}" '
                      f'causality="{TIME.causality}" variability="continuous" '
                      f'description="{TIME.description}" unit="s"/>')
+        lines.append(f'    <{N_PLAYS.kind} name="{N_PLAYS.name}" valueReference="{N_PLAYS.vr}" '
+                     f'causality="{N_PLAYS.causality}" variability="fixed" '
+                     f'description="{escape(N_PLAYS.description)}" start="{N_PLAYS.start}" '
+                     f'min="1" max="{NMAX}"/>')
         for vname, vr, kind, causality, start, desc, is_array in _variables3(name):
             if causality == "output":
                 outputs.append(vr)
             head = (f'    <{kind} name="{vname}" valueReference="{vr}" '
                     f'{_attributes(causality, fmi_version)} description="{escape(desc)}"'
                     f'{_unit_attr(unit, vname)} start="{start}"')
-            lines.append(f'{head}><Dimension start="{NMAX}"/></{kind}>' if is_array
-                         else f"{head}/>")
+            dim = (f'valueReference="{N_PLAYS.vr}"' if vname in PER_PLAY
+                   else f'start="{NMAX}"')
+            lines.append(f'{head}><Dimension {dim}/></{kind}>' if is_array else f"{head}/>")
         return lines, outputs
     for idx, v in enumerate(spec_of(name)["vars"], start=1):
         if v.causality == "output":

@@ -2,7 +2,9 @@
 ``FMU2Slave`` / ``FMU3Slave``: parameters and signals by name, fixed-step stepping, state
 save/restore. FMI 3 arrays are set whole by their name (``"p": [...]``, shorter sequences fill
 the first elements) or element-wise with the FMI 2 style names (``"p[2]"``), so the same
-names drive both versions."""
+names drive both versions. An FMI 3 structural parameter in ``start`` (the pimodel units'
+``n_plays``, the size of their per-play arrays) is set in configuration mode, before the
+others."""
 
 from __future__ import annotations
 
@@ -43,7 +45,8 @@ class FMUUnit:
         The ``.fmu`` file (FMI 2.0 or 3.0, Co-Simulation).
     start : dict, optional
         Parameters and start values by variable name, set before initialisation (``n``,
-        ``Ts``, ``p[1]`` ..., or a whole FMI 3 array ``"p": [...]``).
+        ``Ts``, ``p[1]`` ..., or a whole FMI 3 array ``"p": [...]``); FMI 3 structural
+        parameters (``n_plays``) in configuration mode first.
     instance_name : str, optional
         The FMU instance's name (in its log). Default ``"unit"``.
 
@@ -93,6 +96,7 @@ class FMUUnit:
             self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=self._dir,
                                  modelIdentifier=ident, instanceName=instance_name)
             self.fmu.instantiate(loggingOn=True, logMessage=self._logger3)
+            start = self._configure(start or {})
             self.fmu.enterInitializationMode(startTime=0.0)
         else:
             self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self._dir,
@@ -125,6 +129,31 @@ class FMUUnit:
     def _logger3(self, env, status, category, message) -> None:
         self._logger(env, None, status, category, message)
 
+    def _configure(self, start: dict) -> dict:
+        """Sets the structural parameters in ``start`` (FMI 3 configuration mode) and keeps
+        their values for the array sizes; returns the other start values."""
+        self.structural: dict[int, int] = {
+            v.valueReference: int(v.start) for v in self.md.modelVariables
+            if v.causality == "structuralParameter" and v.start is not None}
+        items = [(k, x) for k, x in start.items()
+                 if k in self.vars and self.vars[k].causality == "structuralParameter"]
+        if items:
+            self.fmu.enterConfigurationMode()
+            try:
+                for name, value in items:
+                    v = self.vars[name]
+                    if v.type != "UInt64":
+                        raise TypeError(f"{name}: unsupported structural type {v.type}")
+                    self.fmu.setUInt64([v.valueReference], [int(value)])
+                    self.structural[v.valueReference] = int(value)
+                self.fmu.exitConfigurationMode()
+            except Exception as exc:
+                self.fmu.freeInstance()
+                raise ValueError(f"{self.path.name}: configuration failed: "
+                                 f"{'; '.join(self.log) or exc}") from None
+        done = {k for k, _ in items}
+        return {k: x for k, x in start.items() if k not in done}
+
     def _var(self, name: str):
         """(variable, element index or None) for ``name`` or an FMI 3 element ``base[i]``."""
         if name in self.vars:
@@ -141,9 +170,11 @@ class FMUUnit:
                 return v, i
         raise KeyError(f"{self.path.name}: no variable {name!r}")
 
-    @staticmethod
-    def _size(v) -> int:
-        return int(np.prod([int(d.start) for d in v.dimensions]))
+    def _size(self, v) -> int:
+        """Elements of an FMI 3 array (a dimension bound to a structural parameter: its
+        value as configured)."""
+        return int(np.prod([int(d.start) if d.start is not None
+                            else self.structural[d.valueReference] for d in v.dimensions]))
 
     def _get_array(self, v) -> np.ndarray:
         return np.array(self.fmu.getFloat64([v.valueReference], nValues=self._size(v)))

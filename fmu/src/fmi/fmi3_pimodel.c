@@ -2,10 +2,11 @@
  * FMI 3.0 Co-Simulation glue for the pimodel units (pim_unit.h), one source for every unit,
  * without unit-specific code; the including model.c includes the unit's config.h first
  * (PIM_MODEL, PIM_MODEL_TOKEN the instantiation token, the variables).  Sampling rule and value
- * references, limits, modes and the FMU state format: pim_unit.h.  Here p (100), r (200) and
- * r_hat (300) are real arrays of PIM_NMAX elements (the first n are used): getting or setting
- * one moves PIM_NMAX values.  Reference 9 is the independent variable time (the end of the last
- * communication step).  Every failure returns fmi3Error and logs the reason.
+ * references, limits, modes and the FMU state format: pim_unit.h.  Here the per-play arrays
+ * (p 100, r 200, r_hat 300, ...) have n_plays elements, the UInt64 structural parameter set in
+ * configuration mode (default PIM_NMAX; the first n are used), the others PIM_NMAX: getting or
+ * setting one moves all its values.  Reference 9 is the independent variable time (the end of
+ * the last communication step).  Every failure returns fmi3Error and logs the reason.
  */
 #include <stdlib.h>
 
@@ -164,7 +165,7 @@ fmi3Status fmi3DoStep(fmi3Instance inst, fmi3Float64 t, fmi3Float64 h, fmi3Boole
 /* ---- variables --------------------------------------------------------------------------- */
 
 /* Get (SET 0) or set (SET 1) values of one type through unit_ref; an FMI 3 array moves all
- * PIM_NMAX values. */
+ * its values (n_plays or PIM_NMAX). */
 #define PIM_ACCESS(TYPE_CHAR, CTYPE, SET, FROM_UNIT, TO_UNIT)                                  \
     INST(inst);                                                                               \
     size_t k = 0;                                                                             \
@@ -219,6 +220,18 @@ fmi3Status fmi3SetBoolean(fmi3Instance inst, const fmi3ValueReference vr[], size
     PIM_ACCESS('B', int, 1, (void)0, x[j] = values[k] ? 1 : 0);
 }
 
+fmi3Status fmi3GetUInt64(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
+                         fmi3UInt64 values[], size_t nValues)
+{
+    PIM_ACCESS('U', uint64_t, 0, values[k] = x[j], (void)0);
+}
+
+fmi3Status fmi3SetUInt64(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
+                         const fmi3UInt64 values[], size_t nValues)
+{
+    PIM_ACCESS('U', uint64_t, 1, (void)0, x[j] = values[k]);
+}
+
 /* Types the units do not use: any access is an error (an empty access is fine). */
 #define PIM_NO_TYPE(NAME, T, CONST)                                                           \
     fmi3Status fmi3Get##NAME(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,      \
@@ -241,7 +254,6 @@ PIM_NO_TYPE(Int16, fmi3Int16, const)
 PIM_NO_TYPE(UInt16, fmi3UInt16, const)
 PIM_NO_TYPE(UInt32, fmi3UInt32, const)
 PIM_NO_TYPE(Int64, fmi3Int64, const)
-PIM_NO_TYPE(UInt64, fmi3UInt64, const)
 PIM_NO_TYPE(String, fmi3String, const)
 
 fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,
@@ -277,6 +289,8 @@ fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nv
 fmi3Status fmi3GetFMUState(fmi3Instance inst, fmi3FMUState *state)
 {
     INST(inst);
+    IN_MODES(PIM_IN(PIM_INSTANTIATED) | PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) |
+             PIM_IN(PIM_TERMINATED), "fmi3GetFMUState");
     if (!state) return fail(c, "fmi3GetFMUState: null state pointer");
     unsigned char *buf = *state ? (unsigned char *)*state : (unsigned char *)malloc(PIM_STATE_SIZE);
     if (!buf) return fail(c, "fmi3GetFMUState: out of memory");
@@ -288,6 +302,8 @@ fmi3Status fmi3GetFMUState(fmi3Instance inst, fmi3FMUState *state)
 fmi3Status fmi3SetFMUState(fmi3Instance inst, fmi3FMUState state)
 {
     INST(inst);
+    IN_MODES(PIM_IN(PIM_INSTANTIATED) | PIM_IN(PIM_INIT_MODE) | PIM_IN(PIM_STEP_MODE) |
+             PIM_IN(PIM_TERMINATED), "fmi3SetFMUState");
     return status(c, unit_state_read(&c->u, (const unsigned char *)state, PIM_STATE_SIZE,
                                      PIM_MODEL_TOKEN, 3, &c->u));
 }
@@ -369,14 +385,23 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference u[]
     return fail((Inst *)c, "adjoint derivatives are not provided");
 }
 
-fmi3Status fmi3EnterConfigurationMode(fmi3Instance c)
+/* Configuration mode: the structural parameter n_plays (the per-play arrays' size) can be set,
+ * and is checked when the mode is left. */
+fmi3Status fmi3EnterConfigurationMode(fmi3Instance inst)
 {
-    return fail((Inst *)c, "no structural parameters");
+    INST(inst);
+    IN_MODES(PIM_IN(PIM_INSTANTIATED), "fmi3EnterConfigurationMode");
+    c->u.mode = PIM_CONFIG_MODE;
+    return fmi3OK;
 }
 
-fmi3Status fmi3ExitConfigurationMode(fmi3Instance c)
+fmi3Status fmi3ExitConfigurationMode(fmi3Instance inst)
 {
-    return fail((Inst *)c, "no structural parameters");
+    INST(inst);
+    IN_MODES(PIM_IN(PIM_CONFIG_MODE), "fmi3ExitConfigurationMode");
+    if (unit_check_n_plays(&c->u) != 0) return status(c, -1);
+    c->u.mode = PIM_INSTANTIATED;
+    return fmi3OK;
 }
 
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[], size_t n,

@@ -20,6 +20,9 @@
  *   model_outputs_finite(u) *  the unit's further outputs are finite (out1, out2 checked here)
  *   model_saved, model_save(u, s), model_restore(u, s)   the states a step changes, for the
  *                              rollback of a step that overflows (once per doStep, not per sample)
+ *   model_step_safe(u) *       1 when no sample at the held inputs can overflow (a bound from the
+ *                              checked parameters, derived once): the step then runs without the
+ *                              rollback copy and without the per-sample output checks
  *   model_step_done(u) *       after a step's samples (e.g. the RadiusEstimator's health output)
  *   model_check_states(u, s)   the states of a loaded FMU state s (parameters already checked)
  *   model_report(u, buf, size) * a report in words logged once at terminate (0: none)
@@ -48,7 +51,10 @@
  * reference, type, causality, size, member of pim_unit), generated from the Python spec like
  * the model description, are the one source of truth; tests/test_fmu3.py holds every built
  * modelDescription.xml (FMI 2 and 3) equal to it.  In FMI 2 array element x[i+1] has reference
- * base + i (p 100, r 200, r_hat 300, ...: pimodel.fmu.spec); in FMI 3 an array is one variable.
+ * base + i (p 100, r 200, r_hat 300, ...: pimodel.fmu.spec); in FMI 3 an array is one variable,
+ * a per-play one (size PIM_PER_PLAY) of n_plays elements: the UInt64 structural parameter
+ * (reference 18, FMI 3 only), set in configuration mode, 1..PIM_NMAX, default PIM_NMAX, and
+ * n <= n_plays (n > PIM_NMAX, the Diagnosed units' plays in the _hi arrays: n_plays = PIM_NMAX).
  */
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
@@ -83,21 +89,28 @@
 #define NMAX PIM_NMAX
 
 
-typedef enum { PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT } pim_causality;
+typedef enum {
+    PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT, PIM_STRUCTURAL
+} pim_causality;
+
+/* The size of an FMI 3 array sized by the structural parameter n_plays (the per-play arrays p,
+ * r, r_hat, ...: <Dimension valueReference="n_plays"/>); the C storage stays PIM_NMAX wide. */
+#define PIM_PER_PLAY (-1)
 
 typedef struct {
     const char *name;
     unsigned vr;
-    char type; /* 'R' Real/Float64, 'I' Integer/Int32, 'B' Boolean */
+    char type; /* 'R' Real/Float64, 'I' Integer/Int32, 'B' Boolean, 'U' UInt64 (FMI 3) */
     pim_causality causality;
-    int size;      /* 1, or PIM_NMAX for an array */
+    int size;      /* 1, PIM_NMAX for an array, or PIM_PER_PLAY (FMI 3: n_plays elements) */
     size_t offset; /* of the value(s) in pim_unit */
 } pim_var;
 
 
 /* Life cycle (FMI 2 and 3 Co-Simulation): instantiated -> initialization mode -> step mode
- * (after a successful exitInitializationMode) -> terminated; reset goes back to instantiated. */
-enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED };
+ * (after a successful exitInitializationMode) -> terminated; reset goes back to instantiated.
+ * FMI 3 also: instantiated <-> configuration mode (the structural parameter n_plays). */
+enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED, PIM_CONFIG_MODE };
 
 /* The unit: the common part (the same layout in every unit, mirrored by tests/fmu_driver.py),
  * then the unit's own fields (units/<Unit>/fields.h). */
@@ -114,6 +127,8 @@ typedef struct {
     double time;    /* the end of the last communication step (the start time before any) */
     int64_t k_next; /* index of the next sample to process */
     int n, mode;
+    /* FMI 3's structural parameter: the size of the per-play arrays (FMI 2: PIM_NMAX) */
+    uint64_t n_plays;
     /* the unit's own parameters, states and derived quantities */
 #include "fields.h"
     char msg[256]; /* reason of the last failure */
@@ -161,6 +176,7 @@ static const char *unit_mode_name(int mode)
     case PIM_INIT_MODE: return "in initialization mode";
     case PIM_STEP_MODE: return "in step mode";
     case PIM_TERMINATED: return "terminated";
+    case PIM_CONFIG_MODE: return "in configuration mode";
     default: return "in an unknown mode";
     }
 }
@@ -168,7 +184,7 @@ static const char *unit_mode_name(int mode)
 /* 0 if the unit's mode is one of the bits in `allowed` (1 << mode), else -1 naming the call. */
 static int unit_require_mode(pim_unit *u, unsigned allowed, const char *call)
 {
-    if (u->mode >= PIM_INSTANTIATED && u->mode <= PIM_TERMINATED && (allowed & (1u << u->mode)))
+    if (u->mode >= PIM_INSTANTIATED && u->mode <= PIM_CONFIG_MODE && (allowed & (1u << u->mode)))
         return 0;
     return unit_error(u, "%s is not allowed now: the FMU is %s", call, unit_mode_name(u->mode));
 }
@@ -199,6 +215,9 @@ static int model_check_inputs(pim_unit *u) { (void)u; return 0; }
 #ifndef HAS_MODEL_OUTPUTS_FINITE
 static int model_outputs_finite(const pim_unit *u) { (void)u; return 1; }
 #endif
+#ifndef HAS_MODEL_STEP_SAFE
+static int model_step_safe(const pim_unit *u) { (void)u; return 0; }
+#endif
 #ifndef HAS_MODEL_STEP_DONE
 static void model_step_done(pim_unit *u) { (void)u; }
 #endif
@@ -226,6 +245,7 @@ static void unit_defaults(pim_unit *u)
     memset(u, 0, sizeof *u);
     u->Ts = 1e-3;
     u->n = 1;
+    u->n_plays = PIM_NMAX;
     u->mode = PIM_INSTANTIATED;
     for (int i = 0; i < PIM_NMAX; ++i) u->p[i] = 1.0;
     model_defaults(u);
@@ -252,11 +272,26 @@ static int unit_derive(pim_unit *u)
     return model_derive(u);
 }
 
+/* The structural parameter n_plays (fmi3ExitConfigurationMode, restored states). */
+static int unit_check_n_plays(pim_unit *u)
+{
+    if (u->n_plays < 1 || u->n_plays > PIM_NMAX)
+        return unit_error(u, "structural parameter n_plays = %llu out of range: 1 <= n_plays "
+                             "<= %d", (unsigned long long)u->n_plays, PIM_NMAX);
+    return 0;
+}
+
 /* The parameter rules, shared by initialization and by every FMU state that is restored. */
 static int unit_check_parameters(pim_unit *u)
 {
     if (u->n < 1 || u->n > PIM_UNIT_NMAX)
         return unit_error(u, "parameter n = %d out of range: 1 <= n <= %d", u->n, PIM_UNIT_NMAX);
+    if (unit_check_n_plays(u) != 0) return -1;
+    if ((uint64_t)(u->n < PIM_NMAX ? u->n : PIM_NMAX) > u->n_plays)
+        return unit_error(u, "parameter n = %d exceeds n_plays = %llu, the size of the per-play "
+                             "arrays (set n_plays in configuration mode%s)", u->n,
+                          (unsigned long long)u->n_plays,
+                          u->n > PIM_NMAX ? "; plays beyond 64 need n_plays = 64" : "");
     if (!isfinite(u->Ts) || !(u->Ts >= PIM_TS_MIN))
         return unit_error(u, "parameter Ts = %g: the sample time must be > 0 (finite, >= %g)",
                           u->Ts, PIM_TS_MIN);
@@ -306,13 +341,43 @@ static int unit_check_inputs(pim_unit *u)
     return model_check_inputs(u);
 }
 
+/* Samples k_next .. k1-1 with the outputs checked after each; a step that overflows is not
+ * taken: the states it changes are restored (a copy per step, for the units whose step can
+ * fail: model_step_safe). */
+static int unit_samples_checked(pim_unit *u, int64_t k1)
+{
+    const int64_t k_saved = u->k_next;
+    const double out_saved[2] = {u->out1, u->out2};
+    model_saved saved;
+    model_save(u, &saved);
+    for (; u->k_next < k1; ++u->k_next) {
+        model_sample(u);
+        if (!isfinite(u->out1) || !isfinite(u->out2) || !model_outputs_finite(u)) {
+            const double y1 = u->out1, y2 = u->out2;
+            const long long k_bad = (long long)u->k_next;
+            u->k_next = k_saved;
+            u->out1 = out_saved[0];
+            u->out2 = out_saved[1];
+            model_restore(u, &saved);
+            return unit_error(u, "the outputs overflowed or are undefined (%g, %g) at sample "
+                                 "%lld with the inputs held over this step (an input beyond an "
+                                 "envelope's domain or range, or a numeric overflow); the step "
+                                 "was not taken", y1, y2, k_bad);
+        }
+    }
+    return 0;
+}
+
 /* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
 static int unit_do_step(pim_unit *u, double t, double h)
 {
     if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
     if (!(h > 0.0) || !isfinite(h))
         return unit_error(u, "communication step size h = %g: must be finite and > 0", h);
-    if (t != u->time) { /* u->time is finite and >= 0: only another t needs the checks */
+    /* u->time is finite and >= 0: only another t needs the checks, and one within the
+     * smallest tolerance (1e-9 s, or 1e-3 Ts) not even the scale of the time */
+    const double dt = fabs(t - u->time);
+    if (dt != 0.0 && !(t >= 0.0 && dt <= (u->Ts < 1e-6 ? 1e-3 * u->Ts : 1e-9))) {
         if (!isfinite(t) || t < 0.0)
             return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
         const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
@@ -339,25 +404,13 @@ static int unit_do_step(pim_unit *u, double t, double h)
         return 0;
     }
     if (unit_check_inputs(u) != 0) return -1;
-    /* a step that overflows is not taken: the states it changes are restored */
-    const int64_t k_saved = u->k_next;
-    const double out_saved[2] = {u->out1, u->out2};
-    model_saved saved;
-    model_save(u, &saved);
-    for (; u->k_next < k1; ++u->k_next) {
-        model_sample(u);
-        if (!isfinite(u->out1) || !isfinite(u->out2) || !model_outputs_finite(u)) {
-            const double y1 = u->out1, y2 = u->out2;
-            u->k_next = k_saved;
-            u->out1 = out_saved[0];
-            u->out2 = out_saved[1];
-            model_restore(u, &saved);
-            return unit_error(u, "the outputs overflowed or are undefined (%g, %g) at sample "
-                                 "%lld with the inputs held over this step (an input beyond an "
-                                 "envelope's domain or range, or a numeric overflow); the step "
-                                 "was not taken", y1, y2,
-                              (long long)u->k_next);
-        }
+    if (model_step_safe(u)) { /* no sample can overflow: a tight loop, nothing to roll back */
+        int64_t k = u->k_next;
+        do model_sample(u);
+        while (++k < k1);
+        u->k_next = k1;
+    } else if (unit_samples_checked(u, k1) != 0) {
+        return -1;
     }
     model_step_done(u);
     u->time = t_end;
@@ -404,14 +457,15 @@ static const char *unit_label(const pim_var *v, int elem, char *buf, size_t size
     return buf;
 }
 
-/* Whether variable v may be set now: parameters before initialization, inputs until
- * terminate, never outputs or time. */
+/* Whether variable v may be set now: the structural parameter in configuration mode,
+ * parameters before initialization, inputs until terminate, never outputs or time. */
 static int unit_settable(const pim_unit *u, const pim_var *v)
 {
     if (v->causality == PIM_OUTPUT || v->causality == PIM_INDEPENDENT) return 0;
+    if (v->causality == PIM_STRUCTURAL) return u->mode == PIM_CONFIG_MODE;
     if (v->causality == PIM_PARAMETER)
         return u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE;
-    return u->mode != PIM_TERMINATED;
+    return u->mode != PIM_TERMINATED && u->mode != PIM_CONFIG_MODE;
 }
 
 /* Error paths out of line, so that the accessors stay small (they run on every get/set). */
@@ -426,7 +480,8 @@ static int unit_settable(const pim_unit *u, const pim_var *v)
 /* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
 PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, unsigned vr, char type)
 {
-    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : "Boolean";
+    const char *tname = type == 'R' ? "Real" : type == 'I' ? "Integer" : type == 'U' ? "UInt64"
+                                                                        : "Boolean";
     char name[40];
     if (!v)
         unit_error(u, "no %s variable with value reference %u in the model description", tname,
@@ -438,9 +493,16 @@ PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, 
         unit_error(u, "variable %s (value reference %u) is %s and cannot be set",
                    unit_label(v, elem, name, sizeof name), vr,
                    v->causality == PIM_OUTPUT ? "an output" : "the independent variable");
+    else if (v->causality == PIM_STRUCTURAL)
+        unit_error(u, "structural parameter %s (value reference %u) can be set in configuration "
+                      "mode only (fmi3EnterConfigurationMode after instantiation)",
+                   unit_label(v, elem, name, sizeof name), vr);
     else if (v->causality == PIM_PARAMETER)
         unit_error(u, "cannot set parameter %s (value reference %u) after initialization",
                    unit_label(v, elem, name, sizeof name), vr);
+    else if (u->mode == PIM_CONFIG_MODE)
+        unit_error(u, "cannot set input %s (value reference %u) in configuration mode (only "
+                      "n_plays)", unit_label(v, elem, name, sizeof name), vr);
     else
         unit_error(u, "cannot set input %s (value reference %u) after terminate",
                    unit_label(v, elem, name, sizeof name), vr);
@@ -450,7 +512,8 @@ PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, 
 /*
  * Storage of the variable with reference vr, checked against the model description (exists,
  * has type `type`) and, for set != 0, against the mode (unit_settable).  *count: values it
- * holds (1, or PIM_NMAX for an FMI 3 array).  NULL with the reason in u->msg on failure.
+ * holds (1; an FMI 3 array's PIM_NMAX, or n_plays for a per-play array).  NULL with the
+ * reason in u->msg on failure.
  */
 static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int elements, int set,
                                      size_t *count)
@@ -459,7 +522,7 @@ static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int el
     const pim_var *v = unit_var(vr, elements, &elem);
     if (!v || v->type != type || (set && !unit_settable(u, v)))
         return unit_ref_refused(u, v, elem, vr, type);
-    *count = elem >= 0 ? 1 : (size_t)v->size;
+    *count = elem >= 0 ? 1 : v->size == PIM_PER_PLAY ? (size_t)u->n_plays : (size_t)v->size;
     return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
 }
 
@@ -478,9 +541,9 @@ static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int el
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 6u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+#define PIM_STATE_VERSION 7u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
                                 prefilter (Wiener); 5: DiagnosedInverse fields, post sections;
-                                6: the common part, then the unit's own fields */
+                                6: the common part, then the unit's own fields; 7: n_plays */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {
@@ -582,13 +645,15 @@ static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
     memcpy(s, bytes + sizeof h, sizeof *s);
     s->msg[0] = '\0';
     int rc = 0;
-    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_TERMINATED)
+    if (s->mode < PIM_INSTANTIATED || s->mode > PIM_TERMINATED) /* none in configuration mode */
         rc = unit_error(u, "FMU state rejected: unknown mode %d", s->mode);
     else if (!isfinite(s->time) || s->time < 0.0)
         rc = unit_error(u, "FMU state rejected: time %g must be finite and >= 0", s->time);
     else if (!isfinite(s->out1) || !isfinite(s->out2))
         rc = unit_error(u, "FMU state rejected: an output is not finite");
-    else if (s->mode >= PIM_STEP_MODE) {
+    else if (unit_check_n_plays(s) != 0)
+        rc = unit_error(u, "FMU state rejected: %s", s->msg);
+    else if (s->mode == PIM_STEP_MODE || s->mode == PIM_TERMINATED) {
         if (unit_check_parameters(s) != 0)
             rc = unit_error(u, "FMU state rejected: %s", s->msg);
         else
