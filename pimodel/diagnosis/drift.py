@@ -1,5 +1,5 @@
-"""The ``drift`` candidate: a linear trend on the records' clock and levels that differ from
-record to record.
+"""The ``drift`` candidate: a linear trend on the records' clock, levels that differ from
+record to record, or a settling on the clock the records share.
 
 Discrete-time form, with ``t[k]`` the time of sample ``k`` of a record [s] as given (the
 records may share one clock) and ``t[0]`` its first sample; the term is added to the model
@@ -15,6 +15,13 @@ output ``y[k]`` [output units]:
     zeroed anew, a thermal offset, or a drift on a clock the records do not show). With a level
     per record, a trend on the shared clock and one that restarts with each record differ only
     by these levels, so one variant covers both and the levels say which clock they follow.
+``"settle"``
+    ``D (1 - exp(-(t[k] - t_s) / T))``: a slow settling (thermal, after switch-on) on the clock
+    the records share; one offset for all records. ``t_s`` is the first time of the train
+    records, so ``D`` is how far the output still moves from there on. Linear in ``D`` given
+    ``T``; ``T`` is searched on a geometric grid that follows the train records' span on the
+    shared clock (:func:`settle_grid`), then continuously. It depends on ``t`` only, not on the
+    input history: creep (which follows the input) cannot take its place, nor it creep's.
 
 The levels of the train records are fitted jointly with everything else (one indicator column
 per train record after the first). A validate record's level cannot come from train; it is a
@@ -30,9 +37,11 @@ from __future__ import annotations
 
 import numpy as np
 
-DRIFT_VARIANTS = ("record", "absolute", "levels")
-DRIFT_KEYS = ("clock", "levels")  # the grid parameters of a drift variant
+DRIFT_VARIANTS = ("record", "absolute", "levels", "settle")
+DRIFT_KEYS = ("clock", "levels", "settle_tau", "settle_t0")  # a drift variant's grid parameters
 LEVEL_FOLDS = 4  # contiguous blocks of a validate record for its out-of-fold level
+SETTLE_SPAN = (1 / 20, 4.0)  # settle grid: T from span/20 to 4 span (span: train, shared clock)
+SETTLE_POINTS = 12  # geometric grid points of T
 
 __all__ = [
     "DRIFT_KEYS",
@@ -46,6 +55,8 @@ __all__ = [
     "level_report",
     "out_of_fold_level",
     "record_levels",
+    "settle_grid",
+    "settle_start",
 ]
 
 
@@ -73,7 +84,7 @@ def drift_variants(effects, n_validate: int) -> list[dict]:
     >>> drift_variants(("creep",), 1)
     [{}]
     >>> [v["clock"] for v in drift_variants(("creep", "drift"), 1)]
-    ['record', 'absolute', 'levels']
+    ['record', 'absolute', 'levels', 'settle']
     """
     if "drift" not in effects:
         return [{}]
@@ -83,7 +94,7 @@ def drift_variants(effects, n_validate: int) -> list[dict]:
 
 def drift_k(p: dict) -> int:
     """Parameters the drift adds on validate: the slope, plus one level per validate record for
-    the ``"levels"`` variant (``p["levels"]``).
+    the ``"levels"`` variant (``p["levels"]``); ``D`` and ``T`` for ``"settle"``.
 
     Parameters
     ----------
@@ -99,8 +110,62 @@ def drift_k(p: dict) -> int:
     --------
     >>> drift_k({"clock": "record"}), drift_k({"clock": "levels", "levels": 2})
     (1, 3)
+    >>> drift_k({"clock": "settle"})
+    2
     """
+    if p.get("clock") == "settle":
+        return 2
     return 1 + (int(p.get("levels", 0)) if p.get("clock") == "levels" else 0)
+
+
+def settle_start(segments) -> float:
+    """``t_s`` of a settling: the first time of the records (train) on the shared clock [s].
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> settle_start([S(t=np.array([3.0, 4.0])), S(t=np.array([1.0, 2.0]))])
+    1.0
+    """
+    return float(min(s.t[0] for s in segments))
+
+
+def settle_grid(segments) -> np.ndarray:
+    """The grid of the settling time constant ``T`` [s]: ``SETTLE_POINTS`` geometric points
+    from ``SETTLE_SPAN[0]`` to ``SETTLE_SPAN[1]`` times the span of the records on the shared
+    clock (last time minus :func:`settle_start`), so it follows the records, not a fixed scale.
+
+    Parameters
+    ----------
+    segments : list
+        The (train) records, each with its time ``t`` [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Increasing time constants [s].
+
+    Raises
+    ------
+    ValueError
+        The records span no time.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> g = settle_grid([S(t=np.linspace(0.0, 10.0, 5)), S(t=np.linspace(15.0, 20.0, 5))])
+    >>> float(g[0]), float(g[-1])
+    (1.0, 80.0)
+    """
+    span = float(max(s.t[-1] for s in segments)) - settle_start(segments)
+    if not span > 0:
+        raise ValueError(f"segments: expected records spanning some time, got span {span}")
+    return np.geomspace(SETTLE_SPAN[0] * span, SETTLE_SPAN[1] * span, SETTLE_POINTS)
+
+
+def settle_column(t: np.ndarray, tau: float, t0: float) -> np.ndarray:
+    """``1 - exp(-(t[k] - t0) / tau)`` (as ``-expm1``, the C core's form)."""
+    return -np.expm1(-(t - t0) / tau)
 
 
 def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
@@ -121,7 +186,8 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
     Returns
     -------
     numpy.ndarray
-        Shape (N, 1) (the trend ``t[k]`` or ``t[k] - t[0]`` [s]); for ``"levels"`` with
+        Shape (N, 1) (the trend ``t[k]`` or ``t[k] - t[0]`` [s]; for ``"settle"``
+        ``1 - exp(-(t[k] - p["settle_t0"]) / p["settle_tau"])``); for ``"levels"`` with
         several train records, first one indicator column per train record after the first
         (shape (N, n_train)).
 
@@ -133,6 +199,8 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
     >>> drift_columns(t, {"clock": "levels"}, train_record=1, n_train=2).tolist()
     [[1.0, 0.0], [1.0, 0.5], [1.0, 1.0]]
     """
+    if p["clock"] == "settle":
+        return settle_column(t, p["settle_tau"], p["settle_t0"])[:, None]
     trend = (t if p["clock"] == "absolute" else t - t[0])[:, None]
     if p["clock"] != "levels" or n_train < 2:
         return trend
@@ -293,7 +361,9 @@ def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
     params : dict
         ``drift_per_s`` [output units / s], ``drift_clock`` and, for a model with a level per
         record, ``drift_variant == "levels"`` and ``drift_t0_train`` (first time of the train
-        record whose level the model's offset is [s]).
+        record whose level the model's offset is [s]); a settling adds
+        ``D (1 - exp(-(t - t_s) / T))`` with ``drift_settling`` ``D`` [output units],
+        ``drift_settling_time_s`` ``T`` and ``drift_settling_start_s`` ``t_s`` [s].
     t : numpy.ndarray
         Time ``t[k]`` [s].
     y_rest : numpy.ndarray, optional
@@ -318,10 +388,19 @@ def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
     >>> y = np.full(4, 2.0) + 0.5 * np.arange(4.0)  # a record at a level of 2
     >>> drift_term(q, np.arange(4.0), np.zeros(4), y).tolist()
     [2.0, 2.5, 3.0, 3.5]
+    >>> r = {"drift_per_s": 0.0, "drift_clock": "absolute", "drift_settling": 1.0,
+    ...      "drift_settling_time_s": 2.0, "drift_settling_start_s": 1.0}
+    >>> drift_term(r, np.array([1.0, 3.0])).round(4).tolist()  # 1 - exp(-1) after T
+    [0.0, 0.6321]
     """
     s = float(params["drift_per_s"])
     if params.get("drift_variant") != "levels":
-        return s * (t - t[0] if params["drift_clock"] == "record" else t)
+        term = s * (t - t[0] if params["drift_clock"] == "record" else t)
+        if "drift_settling_time_s" in params:
+            term = term + float(params["drift_settling"]) * settle_column(
+                t, float(params["drift_settling_time_s"]),
+                float(params["drift_settling_start_s"]))
+        return term
     term = s * (t - t[0])
     if measured is not None:
         return term + out_of_fold_level(measured - y_rest - term)
