@@ -22,6 +22,10 @@ output ``y[k]`` [output units]:
     ``T``; ``T`` is searched on a geometric grid that follows the train records' span on the
     shared clock (:func:`settle_grid`), then continuously. It depends on ``t`` only, not on the
     input history: creep (which follows the input) cannot take its place, nor it creep's.
+    It is scored twice: with one offset for all records (``drift_variant == "settle"``: the
+    validate records' level extrapolated from train), and with a level per record as
+    ``"levels"`` (``"settle_levels"``: a settling seen only in part on train leaves ``D`` and
+    ``T`` uncertain, and the level they extrapolate to a later record with it).
 
 The levels of the train records are fitted jointly with everything else (one indicator column
 per train record after the first). A validate record's level cannot come from train; it is a
@@ -52,6 +56,7 @@ __all__ = [
     "drift_k",
     "drift_term",
     "drift_variants",
+    "has_levels",
     "level_report",
     "out_of_fold_level",
     "record_levels",
@@ -84,17 +89,18 @@ def drift_variants(effects, n_validate: int) -> list[dict]:
     >>> drift_variants(("creep",), 1)
     [{}]
     >>> [v["clock"] for v in drift_variants(("creep", "drift"), 1)]
-    ['record', 'absolute', 'levels', 'settle']
+    ['record', 'absolute', 'levels', 'settle', 'settle']
     """
     if "drift" not in effects:
         return [{}]
     return [{"clock": c, **({"levels": n_validate} if c == "levels" else {})}
-            for c in DRIFT_VARIANTS]
+            for c in DRIFT_VARIANTS] + [{"clock": "settle", "levels": n_validate}]
 
 
 def drift_k(p: dict) -> int:
     """Parameters the drift adds on validate: the slope, plus one level per validate record for
-    the ``"levels"`` variant (``p["levels"]``); ``D`` and ``T`` for ``"settle"``.
+    the variants with levels (``p["levels"]``); ``D`` and ``T`` instead of the slope for
+    ``"settle"``.
 
     Parameters
     ----------
@@ -110,12 +116,21 @@ def drift_k(p: dict) -> int:
     --------
     >>> drift_k({"clock": "record"}), drift_k({"clock": "levels", "levels": 2})
     (1, 3)
-    >>> drift_k({"clock": "settle"})
-    2
+    >>> drift_k({"clock": "settle"}), drift_k({"clock": "settle", "levels": 1})
+    (2, 3)
     """
-    if p.get("clock") == "settle":
-        return 2
-    return 1 + (int(p.get("levels", 0)) if p.get("clock") == "levels" else 0)
+    return (2 if p.get("clock") == "settle" else 1) + int(p.get("levels", 0))
+
+
+def has_levels(p: dict) -> bool:
+    """Whether the variant ``p`` has a level per record (``"levels"``, or ``p["levels"]``).
+
+    Examples
+    --------
+    >>> has_levels({"clock": "levels"}), has_levels({"clock": "settle", "levels": 2})
+    (True, True)
+    """
+    return p.get("clock") == "levels" or "levels" in p
 
 
 def settle_start(segments) -> float:
@@ -187,9 +202,9 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
     -------
     numpy.ndarray
         Shape (N, 1) (the trend ``t[k]`` or ``t[k] - t[0]`` [s]; for ``"settle"``
-        ``1 - exp(-(t[k] - p["settle_t0"]) / p["settle_tau"])``); for ``"levels"`` with
-        several train records, first one indicator column per train record after the first
-        (shape (N, n_train)).
+        ``1 - exp(-(t[k] - p["settle_t0"]) / p["settle_tau"])``); with levels (``"levels"``,
+        or ``p["levels"]`` given) and several train records, first one indicator column per
+        train record after the first (shape (N, n_train)).
 
     Examples
     --------
@@ -200,9 +215,10 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
     [[1.0, 0.0], [1.0, 0.5], [1.0, 1.0]]
     """
     if p["clock"] == "settle":
-        return settle_column(t, p["settle_tau"], p["settle_t0"])[:, None]
-    trend = (t if p["clock"] == "absolute" else t - t[0])[:, None]
-    if p["clock"] != "levels" or n_train < 2:
+        trend = settle_column(t, p["settle_tau"], p["settle_t0"])[:, None]
+    else:
+        trend = (t if p["clock"] == "absolute" else t - t[0])[:, None]
+    if not has_levels(p) or n_train < 2:
         return trend
     ind = np.zeros((t.size, n_train - 1))
     if train_record is not None and train_record >= 1:
@@ -346,7 +362,10 @@ def level_report(model, validate, train) -> dict:
     >>> level_report(Model("creep", 4, base_features, np.zeros(2)), [], [])
     {}
     """
-    if model.params.get("drift_variant") != "levels":
+    variant = model.params.get("drift_variant")
+    if variant == "settle_levels":
+        return {"drift_record_levels": record_levels(model, validate)}
+    if variant != "levels":
         return {}
     return describe_levels(model.params["drift_per_s"], record_levels(model, validate),
                            [float(s.t[0]) for s in validate], float(train[0].t[0]))
@@ -360,8 +379,9 @@ def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
     ----------
     params : dict
         ``drift_per_s`` [output units / s], ``drift_clock`` and, for a model with a level per
-        record, ``drift_variant == "levels"`` and ``drift_t0_train`` (first time of the train
-        record whose level the model's offset is [s]); a settling adds
+        record, ``drift_variant`` ``"levels"`` (or ``"settle_levels"``) and
+        ``drift_t0_train`` (first time of the train record whose level the model's offset is
+        [s]); a settling adds
         ``D (1 - exp(-(t - t_s) / T))`` with ``drift_settling`` ``D`` [output units],
         ``drift_settling_time_s`` ``T`` and ``drift_settling_start_s`` ``t_s`` [s].
     t : numpy.ndarray
@@ -369,7 +389,7 @@ def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
     y_rest : numpy.ndarray, optional
         The model output without the drift (needed with ``measured``).
     measured : numpy.ndarray, optional
-        The record's measured output: with ``"levels"``, its level is estimated out of fold
+        The record's measured output: with levels, its level is estimated out of fold
         from it, as the diagnosis does on a validate record (every sample scored). Without it,
         the level the reported clock predicts: the train level (``"record"``) or the train
         level moved by the trend since ``drift_t0_train`` (``"absolute"``).
@@ -393,17 +413,13 @@ def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
     >>> drift_term(r, np.array([1.0, 3.0])).round(4).tolist()  # 1 - exp(-1) after T
     [0.0, 0.6321]
     """
-    s = float(params["drift_per_s"])
-    if params.get("drift_variant") != "levels":
-        term = s * (t - t[0] if params["drift_clock"] == "record" else t)
-        if "drift_settling_time_s" in params:
-            term = term + float(params["drift_settling"]) * settle_column(
-                t, float(params["drift_settling_time_s"]),
-                float(params["drift_settling_start_s"]))
-        return term
-    term = s * (t - t[0])
-    if measured is not None:
+    s, variant = float(params["drift_per_s"]), params.get("drift_variant")
+    term = s * (t - t[0] if params["drift_clock"] == "record" or variant == "levels" else t)
+    if "drift_settling_time_s" in params:
+        term = term + float(params["drift_settling"]) * settle_column(
+            t, float(params["drift_settling_time_s"]), float(params["drift_settling_start_s"]))
+    if variant in ("levels", "settle_levels") and measured is not None:
         return term + out_of_fold_level(measured - y_rest - term)
-    if params["drift_clock"] == "absolute":
+    if variant == "levels" and params["drift_clock"] == "absolute":
         return term + s * (t[0] - float(params["drift_t0_train"]))
     return term

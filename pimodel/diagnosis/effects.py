@@ -22,6 +22,7 @@ from .drift import (
     SETTLE_POINTS,
     drift_columns,
     drift_k,
+    has_levels,
     out_of_fold_level,
     settle_grid,
     settle_start,
@@ -557,7 +558,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             tgrid = settle_grid(train)
             grids.append([{"clock": "settle", "settle_t0": settle_start(train),
                            "settle_tau": fixed.get("settle_tau",
-                                                   float(tgrid[SETTLE_POINTS // 2]))}])
+                                                   float(tgrid[SETTLE_POINTS // 2])),
+                           **({"levels": fixed["levels"]} if "levels" in fixed else {})}])
         elif e == "drift":  # the records' levels only on validate: variants chosen there
             grids.append([{k_: fixed[k_] for k_ in ("clock", "levels") if k_ in fixed}]
                          if "clock" in fixed else
@@ -693,7 +695,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         model.params["dynamics_structures_tried"] = lti_trace
     if positions:
         model.params["dynamics_positions_tried"] = positions
-    if "drift" in effects and p["clock"] == "levels":
+    if "drift" in effects and has_levels(p):  # a level per record
         model.params["drift_t0_train"] = float(train[0].t[0])
         in_train = static["train"]
 
@@ -813,7 +815,8 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["rate_time_constant_s"] = model.params["rate_tau"]
             i += RATE_BANDS
     if "drift" in effects and model.params["clock"] == "settle":  # on the shared clock
-        out.update({"drift_per_s": 0.0, "drift_clock": "absolute", "drift_variant": "settle",
+        out.update({"drift_per_s": 0.0, "drift_clock": "absolute",
+                    "drift_variant": "settle_levels" if "levels" in model.params else "settle",
                     "drift_settling": float(model.coef[-1]),
                     "drift_settling_time_s": float(model.params["settle_tau"]),
                     "drift_settling_start_s": float(model.params["settle_t0"])})
