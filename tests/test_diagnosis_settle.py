@@ -2,7 +2,7 @@
 share, :mod:`pimodel.diagnosis.drift` variant ``"settle"``).
 
 The records come from a generator of this file's own, not from ``pimodel.stages``: a PI operator
-of 4-8 plays, random-phase three-tone multisines at 800 Hz, a train record of 12 s and a validate
+of 4-8 plays, random-phase three-tone multisines around held levels at 800 Hz, a train record of 12 s and a validate
 record of 10 s two seconds later on one clock, and either a thermal settling (D 0.3-0.8 um,
 T 2-10 s, started before the first record) or a creep that follows the input history (a lag of
 1-4 s). The settling must be named ``drift`` with a shrink near 1, the creep not ``drift``; the
@@ -40,10 +40,14 @@ def _stage(rng):
 
 
 def _multisine(rng, n):
+    """Three tones with random phases around a level held for 2-4 s at a time (so that a creep
+    shows its dependence on the input history)."""
     t = np.arange(n) / FS
-    return 4.0 + sum(a * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
-                     for a, f in ((3.0, rng.uniform(0.8, 1.5)), (1.5, rng.uniform(2.5, 4.0)),
-                                  (0.8, rng.uniform(6.0, 9.0))))
+    holds = np.repeat(rng.uniform(2.5, 5.5, 8), (rng.uniform(2.0, 4.0, 8) * FS).astype(int))
+    return holds[:n] + sum(a * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+                           for a, f in ((2.2, rng.uniform(0.8, 1.5)),
+                                        (1.2, rng.uniform(2.5, 4.0)),
+                                        (0.6, rng.uniform(6.0, 9.0))))
 
 
 def settling_case(seed: int, kind: str = "settle"):

@@ -125,6 +125,15 @@ def drift_k(p: dict) -> int:
 def has_levels(p: dict) -> bool:
     """Whether the variant ``p`` has a level per record (``"levels"``, or ``p["levels"]``).
 
+    Parameters
+    ----------
+    p : dict
+        A drift variant (``clock``, and ``levels`` when it has levels).
+
+    Returns
+    -------
+    bool
+
     Examples
     --------
     >>> has_levels({"clock": "levels"}), has_levels({"clock": "settle", "levels": 2})
@@ -135,6 +144,15 @@ def has_levels(p: dict) -> bool:
 
 def settle_start(segments) -> float:
     """``t_s`` of a settling: the first time of the records (train) on the shared clock [s].
+
+    Parameters
+    ----------
+    segments : list
+        The records, each with its time ``t`` [s].
+
+    Returns
+    -------
+    float
 
     Examples
     --------
@@ -179,7 +197,25 @@ def settle_grid(segments) -> np.ndarray:
 
 
 def settle_column(t: np.ndarray, tau: float, t0: float) -> np.ndarray:
-    """``1 - exp(-(t[k] - t0) / tau)`` (as ``-expm1``, the C core's form)."""
+    """The settling's regressor ``1 - exp(-(t[k] - t0) / tau)`` (as ``-expm1``, the C core's
+    form).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time ``t[k]`` [s].
+    tau, t0 : float
+        Time constant ``T`` (> 0) and start ``t_s`` [s].
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> settle_column(np.array([1.0, 2.0]), 1.0, 1.0).round(4).tolist()
+    [0.0, 0.6321]
+    """
     return -np.expm1(-(t - t0) / tau)
 
 
