@@ -6,7 +6,7 @@ operator of 4-8 plays, random-phase three-tone multisines around held levels at 
 record of 12 s and a validate record of 10 s two seconds later on one clock, and either a
 thermal settling (D 0.3-0.8 um, T 2-10 s, started before the first record) or a creep that
 follows the input history (a lag of 1-4 s). The settling must be named ``drift`` with a shrink
-near 1, the creep not ``drift``; the exported model (``simulate``, JSON, the C stream, the
+near 1, the creep ``creep`` and not a settling; the exported model (``simulate``, JSON, the C stream, the
 python-control block, the FMU) must predict what the report predicted.
 """
 
@@ -118,9 +118,11 @@ def test_a_settling_is_named_drift(seed):
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_creep_is_not_taken_for_a_settling(seed):
-    rep = _report(seed, "creep")[0]
-    assert "creep" in rep.verdict["effects"]
-    assert "drift" not in rep.verdict["effects"]
+    """Creep comes first and no settling is named beside it (a level of the validate record's
+    own, ``drift_variant == "levels"``, may still be: see docs/diagnosis.md)."""
+    v = _report(seed, "creep")[0].verdict
+    assert v["effects"][0] == "creep"
+    assert not str(v["model"].get("drift_variant", "")).startswith("settle")
 
 
 @pytest.mark.slow  # builds on the session's FMUs and runs a diagnosis
