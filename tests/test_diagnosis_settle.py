@@ -6,8 +6,8 @@ operator of 4-8 plays, random-phase three-tone multisines around held levels at 
 record of 12 s and a validate record of 10 s two seconds later on one clock, and either a
 thermal settling (D 0.3-0.8 um, T 2-10 s, started before the first record) or a creep that
 follows the input history (a lag of 1-4 s). The settling must be named ``drift`` with a shrink
-near 1, the creep ``creep`` and not a settling; the exported model (``simulate``, JSON, the C stream, the
-python-control block, the FMU) must predict what the report predicted.
+near 1, the creep ``creep`` and not a settling; the exported model (``simulate``, JSON, the C
+stream, the python-control block, the FMU) must predict what the report predicted.
 """
 
 from __future__ import annotations
