@@ -21,7 +21,8 @@ output ``y[k]`` [output units]:
     records, so ``D`` is how far the output still moves from there on. Linear in ``D`` given
     ``T``; ``T`` is searched on a geometric grid that follows the train records' span on the
     shared clock (:func:`settle_grid`), then continuously. It depends on ``t`` only, not on the
-    input history: creep (which follows the input) cannot take its place, nor it creep's.
+    input history, which tells it from creep (that follows the input; docs/diagnosis.md gives
+    the measured limits).
     It is scored twice: with one offset for all records (``drift_variant == "settle"``: the
     validate records' level extrapolated from train), and with a level per record as
     ``"levels"`` (``"settle_levels"``: a settling seen only in part on train leaves ``D`` and
