@@ -357,7 +357,8 @@ class DiagParams(ctypes.Structure):
                 ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
                 ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
                 ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP),
-                ("plays_start", c_int)]
+                ("plays_start", c_int), ("settle", c_double), ("settle_tau", c_double),
+                ("settle_t0", c_double)]
 
 
 _check_layout(DiagParams, "pim_diag")

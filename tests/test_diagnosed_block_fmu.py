@@ -56,6 +56,7 @@ CASES = {
     **{e: (e,) for e in EFFECT_PARAMS},
     **{case: ("rate",) for case in RATE_VARIANTS},
     "drift_absolute": ("drift",),
+    "drift_settle": ("drift",),
     "delay_whole": ("delay",),
     "all": tuple(EFFECT_PARAMS),
 }
@@ -69,6 +70,10 @@ def model(case: str) -> DiagnosedModel:
         params.update(EFFECT_PARAMS[e])
     if case == "drift_absolute":
         params["drift_clock"] = "absolute"
+    if case == "drift_settle":  # a settling on the shared clock beside the trend
+        params.update({"drift_clock": "absolute", "drift_variant": "settle",
+                       "drift_settling": -0.4, "drift_settling_time_s": 0.7,
+                       "drift_settling_start_s": -0.2})
     if case == "delay_whole":
         params["delay_samples"] = 4
     if case in RATE_VARIANTS:
@@ -140,7 +145,8 @@ def test_general_lti_coefficients():
     assert np.max(np.abs(stream_simulate(m, v, t) - (lagged + 0.3))) < 1e-12
 
 
-@pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "delay_whole"])
+@pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
+                                  "delay_whole"])
 def test_block_equals_simulate(case):
     m = model(case)
     t, v = signal(1200)
@@ -214,8 +220,8 @@ def fmus(built_fmus) -> Path:
 
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
-@pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "delay_whole", "rate",
-                                  *RATE_VARIANTS])
+@pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
+                                  "delay_whole", "rate", *RATE_VARIANTS])
 def test_unit_equals_simulate(fmus, fmi, case):
     """The generic unit with the model's values (FMU time k Ts from 0: the drift clocks read
     t = k Ts)."""
@@ -286,6 +292,7 @@ def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
      ({"rate_tau": -0.001}, "parameter rate_tau = -0.001: must be finite and >= 0 s"),
      ({"rate_tau": float("nan")}, "parameter rate_tau = nan: must be finite and >= 0 s"),
      ({"drift_clock": 3}, "parameter drift_clock = 3 out of range"),
+     ({"drift_settling_tau": -1.0}, "parameter drift_settling_tau = -1: must be finite"),
      ({"lti_order": 2, "lti_a[1]": 2.0}, "lti_a[1] = 2: the LTI denominator must be normalised"),
      ({"lti_order": 1, "lti_b[2]": 1.0, "lti_a[2]": -1.0}, "pole at z = 1"),
      ({"lti_order": 64}, "parameter lti_order = 64 out of range"),

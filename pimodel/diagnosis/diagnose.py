@@ -69,6 +69,7 @@ BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor 
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
 MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
 NOISE_STOP = 1.5  # no further effect once the validate RMS is within this factor of the noise
+SLOW_DEGREE = 3  # the compression's check beside a slow drift: a cubic in time (_slow_rss)
 UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
 UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
@@ -405,7 +406,9 @@ def _baseline(train, validate, initial_state) -> dict:
 def _compressed(tr, va, nominal: Model):
     """Segments whose play columns are replaced by a few combinations (the nominal's own
     weights, then the leading principal directions of the train play outputs), as few as keep
-    the nominal train RSS within 1 %; the candidates' grid searches filter these columns only.
+    the nominal train RSS within 1 %, and the RSS beside a slow drift too (:func:`_slow_rss`: a
+    drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can hide
+    directions a drift model needs); the candidates' grid searches filter these columns only.
     Returns the new segments, the nominal refitted on them (with the full model's
     ``params``) and the projection ``V`` (play columns = ``Z @ V``; None: not compressed)."""
     n = tr[0].Z.shape[1]
@@ -413,6 +416,7 @@ def _compressed(tr, va, nominal: Model):
     _, vecs = np.linalg.eigh(G)
     w = nominal.coef[:n]
     rss_full = sum(float(np.sum((nominal.predict(s) - s.y)[s.used] ** 2)) for s in tr)
+    slow_full = None
     for q in (32, n):
         if q >= n:
             return tr, va, nominal, None
@@ -421,6 +425,11 @@ def _compressed(tr, va, nominal: Model):
         m = fit_nominal(ctr)
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
         if rss <= 1.01 * rss_full:
+            slow_full = _slow_rss(tr) if slow_full is None else slow_full
+        # beside a slow drift, within 1 % plus what the dropped directions fit of the noise
+        n_fit = sum(int(np.sum(s.used)) if s.mask is not None else s.y.size for s in tr)
+        if rss <= 1.01 * rss_full and _slow_rss(tr, V) <= (
+                1.01 + (n - V.shape[1]) / n_fit) * slow_full:
             m.params = dict(nominal.params)
             for s in tr:
                 _drop_plays(s)
@@ -430,6 +439,27 @@ def _compressed(tr, va, nominal: Model):
                 _drop_plays(s)
             return ctr, cva, m, V
     return tr, va, nominal, None
+
+
+def _slow_rss(segs: list[Segment], V: np.ndarray | None = None) -> float:
+    """RSS of the least-squares fit of the fitted samples of ``y`` on the play columns (``Z V``
+    with ``V``), an offset per record and Legendre polynomials of degree 1 to ``SLOW_DEGREE``
+    of the time on the clock the records share (a slow drift), by a QR of the stacked chunks
+    (``[X y]``'s last diagonal entry of ``R`` squared)."""
+    t0 = min(float(s.t[0]) for s in segs)
+    span = max(float(s.t[-1]) for s in segs) - t0 or 1.0
+    R = None
+    for j, s in enumerate(segs):
+        P = s.play_rows()
+        for c in chunks(s.y.size):
+            x = 2.0 * (s.t[c] - t0) / span - 1.0
+            rows = [P[:, c] if V is None else V.T @ P[:, c],
+                    np.eye(len(segs))[j][:, None] * np.ones(x.size),
+                    np.polynomial.legendre.legvander(x, SLOW_DEGREE)[:, 1:].T, s.y[c][None]]
+            M = np.vstack(rows).T
+            M = M if s.mask is None else M[s.mask[c]]
+            R = np.linalg.qr(M if R is None else np.vstack((R, M)), mode="r")
+    return float(R[-1, -1] ** 2) if R.shape[0] == R.shape[1] else 0.0
 
 
 def _play_gram(s: Segment) -> np.ndarray:

@@ -1,5 +1,5 @@
-"""The ``drift`` candidate: a linear trend on the records' clock and levels that differ from
-record to record.
+"""The ``drift`` candidate: a linear trend on the records' clock, levels that differ from
+record to record, or a settling on the clock the records share.
 
 Discrete-time form, with ``t[k]`` the time of sample ``k`` of a record [s] as given (the
 records may share one clock) and ``t[0]`` its first sample; the term is added to the model
@@ -15,6 +15,18 @@ output ``y[k]`` [output units]:
     zeroed anew, a thermal offset, or a drift on a clock the records do not show). With a level
     per record, a trend on the shared clock and one that restarts with each record differ only
     by these levels, so one variant covers both and the levels say which clock they follow.
+``"settle"``
+    ``D (1 - exp(-(t[k] - t_s) / T))``: a slow settling (thermal, after switch-on) on the clock
+    the records share; one offset for all records. ``t_s`` is the first time of the train
+    records, so ``D`` is how far the output still moves from there on. Linear in ``D`` given
+    ``T``; ``T`` is searched on a geometric grid that follows the train records' span on the
+    shared clock (:func:`settle_grid`), then continuously. It depends on ``t`` only, not on the
+    input history, which tells it from creep (that follows the input; docs/diagnosis.md gives
+    the measured limits).
+    It is scored twice: with one offset for all records (``drift_variant == "settle"``: the
+    validate records' level extrapolated from train), and with a level per record as
+    ``"levels"`` (``"settle_levels"``: a settling seen only in part on train leaves ``D`` and
+    ``T`` uncertain, and the level they extrapolate to a later record with it).
 
 The levels of the train records are fitted jointly with everything else (one indicator column
 per train record after the first). A validate record's level cannot come from train; it is a
@@ -30,9 +42,11 @@ from __future__ import annotations
 
 import numpy as np
 
-DRIFT_VARIANTS = ("record", "absolute", "levels")
-DRIFT_KEYS = ("clock", "levels")  # the grid parameters of a drift variant
+DRIFT_VARIANTS = ("record", "absolute", "levels", "settle")
+DRIFT_KEYS = ("clock", "levels", "settle_tau", "settle_t0")  # a drift variant's grid parameters
 LEVEL_FOLDS = 4  # contiguous blocks of a validate record for its out-of-fold level
+SETTLE_SPAN = (1 / 20, 4.0)  # settle grid: T from span/20 to 4 span (span: train, shared clock)
+SETTLE_POINTS = 12  # geometric grid points of T
 
 __all__ = [
     "DRIFT_KEYS",
@@ -43,9 +57,12 @@ __all__ = [
     "drift_k",
     "drift_term",
     "drift_variants",
+    "has_levels",
     "level_report",
     "out_of_fold_level",
     "record_levels",
+    "settle_grid",
+    "settle_start",
 ]
 
 
@@ -73,17 +90,18 @@ def drift_variants(effects, n_validate: int) -> list[dict]:
     >>> drift_variants(("creep",), 1)
     [{}]
     >>> [v["clock"] for v in drift_variants(("creep", "drift"), 1)]
-    ['record', 'absolute', 'levels']
+    ['record', 'absolute', 'levels', 'settle', 'settle']
     """
     if "drift" not in effects:
         return [{}]
     return [{"clock": c, **({"levels": n_validate} if c == "levels" else {})}
-            for c in DRIFT_VARIANTS]
+            for c in DRIFT_VARIANTS] + [{"clock": "settle", "levels": n_validate}]
 
 
 def drift_k(p: dict) -> int:
     """Parameters the drift adds on validate: the slope, plus one level per validate record for
-    the ``"levels"`` variant (``p["levels"]``).
+    the variants with levels (``p["levels"]``); ``D`` and ``T`` instead of the slope for
+    ``"settle"``.
 
     Parameters
     ----------
@@ -99,8 +117,107 @@ def drift_k(p: dict) -> int:
     --------
     >>> drift_k({"clock": "record"}), drift_k({"clock": "levels", "levels": 2})
     (1, 3)
+    >>> drift_k({"clock": "settle"}), drift_k({"clock": "settle", "levels": 1})
+    (2, 3)
     """
-    return 1 + (int(p.get("levels", 0)) if p.get("clock") == "levels" else 0)
+    return (2 if p.get("clock") == "settle" else 1) + int(p.get("levels", 0))
+
+
+def has_levels(p: dict) -> bool:
+    """Whether the variant ``p`` has a level per record (``"levels"``, or ``p["levels"]``).
+
+    Parameters
+    ----------
+    p : dict
+        A drift variant (``clock``, and ``levels`` when it has levels).
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> has_levels({"clock": "levels"}), has_levels({"clock": "settle", "levels": 2})
+    (True, True)
+    """
+    return p.get("clock") == "levels" or "levels" in p
+
+
+def settle_start(segments) -> float:
+    """``t_s`` of a settling: the first time of the records (train) on the shared clock [s].
+
+    Parameters
+    ----------
+    segments : list
+        The records, each with its time ``t`` [s].
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> settle_start([S(t=np.array([3.0, 4.0])), S(t=np.array([1.0, 2.0]))])
+    1.0
+    """
+    return float(min(s.t[0] for s in segments))
+
+
+def settle_grid(segments) -> np.ndarray:
+    """The grid of the settling time constant ``T`` [s]: ``SETTLE_POINTS`` geometric points
+    from ``SETTLE_SPAN[0]`` to ``SETTLE_SPAN[1]`` times the span of the records on the shared
+    clock (last time minus :func:`settle_start`), so it follows the records, not a fixed scale.
+
+    Parameters
+    ----------
+    segments : list
+        The (train) records, each with its time ``t`` [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Increasing time constants [s].
+
+    Raises
+    ------
+    ValueError
+        The records span no time.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as S
+    >>> g = settle_grid([S(t=np.linspace(0.0, 10.0, 5)), S(t=np.linspace(15.0, 20.0, 5))])
+    >>> float(g[0]), float(g[-1])
+    (1.0, 80.0)
+    """
+    span = float(max(s.t[-1] for s in segments)) - settle_start(segments)
+    if not span > 0:
+        raise ValueError(f"segments: expected records spanning some time, got span {span}")
+    return np.geomspace(SETTLE_SPAN[0] * span, SETTLE_SPAN[1] * span, SETTLE_POINTS)
+
+
+def settle_column(t: np.ndarray, tau: float, t0: float) -> np.ndarray:
+    """The settling's regressor ``1 - exp(-(t[k] - t0) / tau)`` (as ``-expm1``, the C core's
+    form).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Time ``t[k]`` [s].
+    tau, t0 : float
+        Time constant ``T`` (> 0) and start ``t_s`` [s].
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> settle_column(np.array([1.0, 2.0]), 1.0, 1.0).round(4).tolist()
+    [0.0, 0.6321]
+    """
+    return -np.expm1(-(t - t0) / tau)
 
 
 def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
@@ -121,9 +238,10 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
     Returns
     -------
     numpy.ndarray
-        Shape (N, 1) (the trend ``t[k]`` or ``t[k] - t[0]`` [s]); for ``"levels"`` with
-        several train records, first one indicator column per train record after the first
-        (shape (N, n_train)).
+        Shape (N, 1) (the trend ``t[k]`` or ``t[k] - t[0]`` [s]; for ``"settle"``
+        ``1 - exp(-(t[k] - p["settle_t0"]) / p["settle_tau"])``); with levels (``"levels"``,
+        or ``p["levels"]`` given) and several train records, first one indicator column per
+        train record after the first (shape (N, n_train)).
 
     Examples
     --------
@@ -133,8 +251,11 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
     >>> drift_columns(t, {"clock": "levels"}, train_record=1, n_train=2).tolist()
     [[1.0, 0.0], [1.0, 0.5], [1.0, 1.0]]
     """
-    trend = (t if p["clock"] == "absolute" else t - t[0])[:, None]
-    if p["clock"] != "levels" or n_train < 2:
+    if p["clock"] == "settle":
+        trend = settle_column(t, p["settle_tau"], p["settle_t0"])[:, None]
+    else:
+        trend = (t if p["clock"] == "absolute" else t - t[0])[:, None]
+    if not has_levels(p) or n_train < 2:
         return trend
     ind = np.zeros((t.size, n_train - 1))
     if train_record is not None and train_record >= 1:
@@ -278,7 +399,10 @@ def level_report(model, validate, train) -> dict:
     >>> level_report(Model("creep", 4, base_features, np.zeros(2)), [], [])
     {}
     """
-    if model.params.get("drift_variant") != "levels":
+    variant = model.params.get("drift_variant")
+    if variant == "settle_levels":
+        return {"drift_record_levels": record_levels(model, validate)}
+    if variant != "levels":
         return {}
     return describe_levels(model.params["drift_per_s"], record_levels(model, validate),
                            [float(s.t[0]) for s in validate], float(train[0].t[0]))
@@ -292,14 +416,17 @@ def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
     ----------
     params : dict
         ``drift_per_s`` [output units / s], ``drift_clock`` and, for a model with a level per
-        record, ``drift_variant == "levels"`` and ``drift_t0_train`` (first time of the train
-        record whose level the model's offset is [s]).
+        record, ``drift_variant`` ``"levels"`` (or ``"settle_levels"``) and
+        ``drift_t0_train`` (first time of the train record whose level the model's offset is
+        [s]); a settling adds
+        ``D (1 - exp(-(t - t_s) / T))`` with ``drift_settling`` ``D`` [output units],
+        ``drift_settling_time_s`` ``T`` and ``drift_settling_start_s`` ``t_s`` [s].
     t : numpy.ndarray
         Time ``t[k]`` [s].
     y_rest : numpy.ndarray, optional
         The model output without the drift (needed with ``measured``).
     measured : numpy.ndarray, optional
-        The record's measured output: with ``"levels"``, its level is estimated out of fold
+        The record's measured output: with levels, its level is estimated out of fold
         from it, as the diagnosis does on a validate record (every sample scored). Without it,
         the level the reported clock predicts: the train level (``"record"``) or the train
         level moved by the trend since ``drift_t0_train`` (``"absolute"``).
@@ -318,13 +445,18 @@ def drift_term(params: dict, t: np.ndarray, y_rest: np.ndarray | None = None,
     >>> y = np.full(4, 2.0) + 0.5 * np.arange(4.0)  # a record at a level of 2
     >>> drift_term(q, np.arange(4.0), np.zeros(4), y).tolist()
     [2.0, 2.5, 3.0, 3.5]
+    >>> r = {"drift_per_s": 0.0, "drift_clock": "absolute", "drift_settling": 1.0,
+    ...      "drift_settling_time_s": 2.0, "drift_settling_start_s": 1.0}
+    >>> drift_term(r, np.array([1.0, 3.0])).round(4).tolist()  # 1 - exp(-1) after T
+    [0.0, 0.6321]
     """
-    s = float(params["drift_per_s"])
-    if params.get("drift_variant") != "levels":
-        return s * (t - t[0] if params["drift_clock"] == "record" else t)
-    term = s * (t - t[0])
-    if measured is not None:
+    s, variant = float(params["drift_per_s"]), params.get("drift_variant")
+    term = s * (t - t[0] if params["drift_clock"] == "record" or variant == "levels" else t)
+    if "drift_settling_time_s" in params:
+        term = term + float(params["drift_settling"]) * settle_column(
+            t, float(params["drift_settling_time_s"]), float(params["drift_settling_start_s"]))
+    if variant in ("levels", "settle_levels") and measured is not None:
         return term + out_of_fold_level(measured - y_rest - term)
-    if params["drift_clock"] == "absolute":
+    if variant == "levels" and params["drift_clock"] == "absolute":
         return term + s * (t[0] - float(params["drift_t0_train"]))
     return term

@@ -17,7 +17,16 @@ from scipy.optimize import minimize_scalar
 from ..operators.pi import PIOperator
 from .chunked import NormalEquations, chunks
 from .creep import creep_time_constants
-from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
+from .drift import (
+    DRIFT_VARIANTS,
+    SETTLE_POINTS,
+    drift_columns,
+    drift_k,
+    has_levels,
+    out_of_fold_level,
+    settle_grid,
+    settle_start,
+)
 from .filters import lag, mode, mode_coefficients, mode_rows, shift
 from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import (
@@ -554,10 +563,16 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
+        elif e == "drift" and fixed.get("clock") == "settle":  # T searched below
+            tgrid = settle_grid(train)
+            grids.append([{"clock": "settle", "settle_t0": settle_start(train),
+                           "settle_tau": fixed.get("settle_tau",
+                                                   float(tgrid[SETTLE_POINTS // 2])),
+                           **({"levels": fixed["levels"]} if "levels" in fixed else {})}])
         elif e == "drift":  # the records' levels only on validate: variants chosen there
             grids.append([{k_: fixed[k_] for k_ in ("clock", "levels") if k_ in fixed}]
                          if "clock" in fixed else
-                         [{"clock": c} for c in DRIFT_CLOCKS if c != "levels"])
+                         [{"clock": c} for c in DRIFT_CLOCKS if c not in ("levels", "settle")])
         elif e == "rate":  # the filter is searched after the other grids (below)
             grids.append([{k_: fixed.get(k_) for k_ in ("rate_family", "rate_tau",
                                                          "rate_saturation")}]
@@ -593,6 +608,20 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                              if p_["rate_tau"] > 0], best)
             if best[0] is before:
                 break
+    if best[0].params.get("clock") == "settle" and "settle_tau" not in fixed:
+        # the settling time constant (the other grid parameters held): its grid, then
+        # continuously in log T between the grid neighbours of the best point
+        tgrid, tau0 = settle_grid(train), best[0].params["settle_tau"]
+        best = search([{**best[0].params, "settle_tau": float(x)} for x in tgrid if x != tau0],
+                      best)
+        base, step = dict(best[0].params), np.log(tgrid[1] / tgrid[0])
+        r = minimize_scalar(lambda x: _fit(name, k, _combo_features(
+            effects, {**base, "settle_tau": float(np.exp(x))}, nominal, static, ncols),
+            train)[1], bounds=(np.log(base["settle_tau"]) - step,
+                               np.log(base["settle_tau"]) + step),
+            method="bounded", options={"xatol": 0.01})
+        if r.fun < best[1]:
+            best = search([{**base, "settle_tau": float(np.exp(r.x))}], best)
     if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
         i = int(np.searchsorted(dgrid, best[0].params["d"]))
         lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
@@ -691,7 +720,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         model.params["dynamics_structures_tried"] = lti_trace
     if positions:
         model.params["dynamics_positions_tried"] = positions
-    if "drift" in effects and p["clock"] == "levels":
+    if "drift" in effects and has_levels(p):  # a level per record
         model.params["drift_t0_train"] = float(train[0].t[0])
         in_train = static["train"]
 
@@ -811,7 +840,13 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["rate_time_constant_s"] = model.params["rate_tau"]
             out["rate_saturation"] = model.params.get("rate_saturation")
             i += RATE_BANDS
-    if "drift" in effects:
+    if "drift" in effects and model.params["clock"] == "settle":  # on the shared clock
+        out.update({"drift_per_s": 0.0, "drift_clock": "absolute",
+                    "drift_variant": "settle_levels" if "levels" in model.params else "settle",
+                    "drift_settling": float(model.coef[-1]),
+                    "drift_settling_time_s": float(model.params["settle_tau"]),
+                    "drift_settling_start_s": float(model.params["settle_t0"])})
+    elif "drift" in effects:
         out["drift_per_s"] = float(model.coef[-1])
         clock = model.params["clock"]  # "levels": the clock is read from the levels later
         out["drift_clock"] = "record" if clock == "levels" else clock

@@ -12,7 +12,8 @@ The diagnosis fits every candidate *jointly* with the hysteresis weights, in a p
          + q u[k]^2 + c3 u[k]^3,  u = (h0 - center) / half    asymmetry (static output terms)
          + sum_b g_b R_b[k]                                   rate (radii or weights, .rate)
          + s t_clock[k] (+ c_j)                               drift (record or shared clock;
-                                                              or a level c_j per record)
+                                                              or a level c_j per record;
+         (or + D (1 - exp(-(t[k] - t_s) / T)))                or a settling, shared clock)
          + sum_j g_j (D' (E_j - M_1)[h0])[k]                  dynamics: further elements
 
 where ``D`` is the identity, the unit-gain base mode ``M_1`` (ZOH, ``(D Z)[k]`` depends on
@@ -138,7 +139,8 @@ class DiagnosedModel:
         ``asymmetry_quadratic``, ``asymmetry_cubic``, ``center``, ``half_range``;
         ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
         (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,
-        ``drift_t0_train`` for a level per record, :mod:`.drift`);
+        ``drift_t0_train`` for a level per record; ``drift_settling``,
+        ``drift_settling_time_s``, ``drift_settling_start_s`` for a settling, :mod:`.drift`);
         ``mode_hz``, ``mode_damping``, ``lti_elements``, ``lti_gains`` (:mod:`.lti`), or
         ``dynamics_position = "before"`` and ``wiener_elements`` (:mod:`.wiener`);
         ``delay_samples``.

@@ -21,8 +21,10 @@ Two things ``simulate`` takes from the whole record are parameters here:
   defaults to ``ptp(v)``, the block and the FMU to ``2 r_n`` (the diagnosis' grid span, as
   :meth:`DiagnosedInverse.simulate`); pass the same value to compare.
 * the drift clock: ``"record"`` counts from the first sample (``t[k] - t[0]``), ``"absolute"``
-  uses ``t[k]`` as given; in a python-control block ``t[k]`` is python-control's time, in the
-  FMU ``k Ts`` (its sample instants).
+  (and a settling, ``drift_variant == "settle"``) uses ``t[k]`` as given; in a python-control
+  block ``t[k]`` is python-control's time, in the FMU ``k Ts`` (its sample instants): to run a
+  record that starts at ``t[0]`` on the shared clock, subtract ``t[0]`` from the FMU's
+  ``drift_settling_start``.
 
 The dynamics is an LTI part ``b(z^-1) / a(z^-1)`` (``a[0] = 1``): the model's
 ``params["lti_b"]``, ``params["lti_a"]`` when given, else the unit-gain mode
@@ -310,6 +312,9 @@ class NativeModel:
                 raise ValueError(f"params: drift_clock = {p['drift_clock']!r}: expected one of "
                                  f"{sorted(CLOCKS)}")
             d.drift_clock, d.drift = CLOCKS[p["drift_clock"]], p["drift_per_s"]
+            if "drift_settling_time_s" in p:  # a settling on the clock t (drift.drift_term)
+                d.settle, d.settle_tau = p["drift_settling"], p["drift_settling_time_s"]
+                d.settle_t0 = p["drift_settling_start_s"]
             if p.get("drift_variant") == "levels" and p["drift_clock"] == "absolute":
                 # a level per record, predicted by the clock: the trend since the train
                 # record's start, s (t - t0_train) (drift.drift_term without `measured`)
@@ -636,5 +641,8 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
         out["delay_samples"] = d.delay
     if d.drift_clock:
         out.update({"drift_per_s": d.drift, "drift_clock": int(d.drift_clock)})
+    if d.settle_tau:
+        out.update({"drift_settling": d.settle, "drift_settling_tau": d.settle_tau,
+                    "drift_settling_start": d.settle_t0})
     return "DiagnosedModel", out
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 __all__ = [
     "confidence",
+    "drift_words",
     "hints",
     "markdown_table",
     "next_step",
@@ -183,7 +184,8 @@ def summarize(rep) -> str:
     Returns
     -------
     str
-        Four lines, output units as in the records (um for pimodel's stages). With
+        Four lines (five with a drift: :func:`drift_words`), output units as in the records
+        (um for pimodel's stages). With
         ``initial_state="unknown"`` the start-up region (left out of fitting and scoring) is
         not named among the regions.
 
@@ -206,6 +208,8 @@ def summarize(rep) -> str:
     what = "; ".join(MEANING.get(e, e) for e in effects)
     level, why = confidence(rep)
     lines = [f"Verdict: {named} - {what}."]
+    if "drift" in effects and drift_words(v.get("model") or {}):
+        lines.append(f"Drift: {drift_words(v['model'])}.")
     lines.append(f"How sure: {level}: validate gap {v['gap_before']:.3g} -> "
                  f"{v['gap_after']:.3g} (shrink {100 * v['shrink']:.0f} %), noise floor "
                  f"{v['noise_floor']:.3g} ({v.get('noise_floor_method', '?')}); {why}.")
@@ -223,6 +227,42 @@ def summarize(rep) -> str:
     lines.append(f"Where the gap sits (nominal model): {where}.")
     lines.append(f"Next: {next_step(rep)}.")
     return "\n".join(lines)
+
+
+def drift_words(model: dict) -> str:
+    """The fitted drift in words, or ``""`` when ``model`` holds none.
+
+    Parameters
+    ----------
+    model : dict
+        ``verdict["model"]`` (``drift_variant``, ``drift_per_s``, ``drift_clock`` and, for a
+        settling, ``drift_settling``, ``drift_settling_time_s``, ``drift_settling_start_s``).
+
+    Returns
+    -------
+    str
+        One sentence, output units as in the records (um for pimodel's stages).
+
+    Examples
+    --------
+    >>> drift_words({"drift_variant": "settle", "drift_settling": -0.42,
+    ...              "drift_settling_time_s": 4.4, "drift_settling_start_s": 1.5})
+    'settles by -0.42 um with time constant 4.4 s (from t = 1.5 s on the clock the records share)'
+    >>> drift_words({"drift_variant": "trend", "drift_per_s": 0.05, "drift_clock": "record"})
+    "moves 0.05 um/s on each record's own clock"
+    """
+    variant = model.get("drift_variant")
+    if variant is None:
+        return ""
+    levels = ", with a level of each record's own" if "levels" in variant else ""
+    if variant.startswith("settle"):
+        return (f"settles by {model['drift_settling']:.3g} um with time constant "
+                f"{model['drift_settling_time_s']:.3g} s (from t = "
+                f"{model['drift_settling_start_s']:.3g} s on the clock the records share)"
+                f"{levels}")
+    clock = ("each record's own clock" if model["drift_clock"] == "record" else
+             "the clock the records share")
+    return f"moves {model['drift_per_s']:.3g} um/s on {clock}{levels}"
 
 
 def markdown_table(header: list[str], rows: list[list]) -> str:

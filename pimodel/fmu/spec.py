@@ -292,6 +292,13 @@ MODELS: dict[str, dict] = {
                  Var("drift_per_s", 59, "Real", "parameter", "0", "drift [output unit / s]"),
                  Var("drift_clock", 60, "Integer", "parameter", "0",
                      "drift clock: 0 none, 1 record (t - t_start), 2 absolute (t = k Ts)"),
+                 Var("drift_settling", 73, "Real", "parameter", "0",
+                     "settling drift D of D (1 - exp(-(t - drift_settling_start) / "
+                     "drift_settling_tau)), t = k Ts (output unit)"),
+                 Var("drift_settling_tau", 74, "Real", "parameter", "0",
+                     "settling time constant T [s] (>= 0; 0: no settling)"),
+                 Var("drift_settling_start", 75, "Real", "parameter", "0",
+                     "settling start t_s [s] on the FMU clock t = k Ts"),
                  Var("lti_order", 61, "Integer", "parameter", "0",
                      "order of the LTI b(z^-1) / a(z^-1) on the hysteresis (0: none, <= 63)"),
                  *_arrays("lti_b", 800, "parameter", "0",

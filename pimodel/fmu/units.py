@@ -22,10 +22,11 @@ UNITS: dict[str, tuple[dict[str, int], float]] = {
     "s/V": ({"kg": -1, "m": -2, "s": 4, "A": 1}, 1.0),
 }
 
-_TIMES = ("Ts", "time", "tau", "creep_tau", "rate_tau", "rate_time_constant")
+_TIMES = ("Ts", "time", "tau", "creep_tau", "rate_tau", "rate_time_constant",
+          "drift_settling_tau", "drift_settling_start")
 _INPUT_SIDE = ("z0", "r", "r_hat", "guard", "v0", "input_range")
 _OUTPUT_SIDE = ("y_hat", "e", "offset", "reference_offset", "center", "half_range",
-                "reference_range")
+                "reference_range", "drift_settling")
 # the units whose input is v [V] and output y [um] (the others swap them with `inverse`)
 _FIXED_IO = {"PIHysteresis": {"v": "V", "y": "um"},
              "RadiusEstimator": {"v": "V", "y": "um"},

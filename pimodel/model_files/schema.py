@@ -65,6 +65,9 @@ EFFECT_PARAMS = {"creep": {"creep_lag_gains": "nums", "creep_time_constants_s": 
                                "center": "num", "half_range": "num+"},
                  "delay": {"delay_samples": "num0"},
                  "drift": {"drift_clock": "str", "drift_per_s": "num"}}
+# and those a settling drift (params["drift_variant"] "settle" or "settle_levels") needs
+SETTLE_PARAMS = {"drift_settling": "num", "drift_settling_time_s": "num+",
+                 "drift_settling_start_s": "num"}
 # a DiagnosedModel's params that record what the diagnosis tried (not used to simulate): not
 # held to the finiteness check
 TRACE_PARAMS = ("dynamics_structures_tried", "dynamics_positions_tried")
@@ -176,8 +179,11 @@ def _finite_leaves(value, where: str) -> None:
 def _diagnosed_params(d: dict, where: str) -> None:
     params = d["params"]
     _finite_leaves({k: v for k, v in params.items() if k not in TRACE_PARAMS}, f"{where}.params")
-    for effect in d["effects"]:
-        for key, kind in EFFECT_PARAMS.get(effect, {}).items():
+    needs = [(effect, EFFECT_PARAMS.get(effect, {})) for effect in d["effects"]]
+    if "drift" in d["effects"] and params.get("drift_variant") in ("settle", "settle_levels"):
+        needs.append(("drift", SETTLE_PARAMS))
+    for effect, keys in needs:
+        for key, kind in keys.items():
             if key not in params:
                 raise ValueError(f"{where}.params.{key}: missing key; the effect {effect!r} "
                                  f"needs it ({_EXPECT[kind]})")

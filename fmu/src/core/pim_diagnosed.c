@@ -152,6 +152,10 @@ const char *pim_diag_check(const pim_diag *d)
     if (d->drift_clock < 0 || d->drift_clock > 2) return "drift_clock must be 0, 1 or 2";
     if (d->plays_start != 0 && d->plays_start != 1) return "plays_start must be 0 or 1";
     if (!isfinite(d->drift)) return "the drift is not finite";
+    if (!(isfinite(d->settle_tau) && d->settle_tau >= 0.0))
+        return "the settling time constant must be finite and >= 0 (0: none)";
+    if (!isfinite(d->settle) || !isfinite(d->settle_t0))
+        return "the settling amount and start must be finite";
     return NULL;
 }
 
@@ -269,6 +273,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         y += d->drift * (t - x[2]);
     else if (d->drift_clock == 2)
         y += d->drift * t;
+    if (d->settle_tau > 0.0) y += d->settle * -expm1(-(t - d->settle_t0) / d->settle_tau);
     x[0] = 1.0;
     x[1] = v;
     return y;

@@ -32,6 +32,8 @@
  *            + sum_i g_i m_i[k]                 rate, radius family       (g_i: the gain
  *            + rho_f[k] sum_i g_i w0_i z_i[k]   or weight family           of play i's band)
  *            + s (t[k] - t[0])  or  s t[k]                              drift (record/absolute)
+ *            + D (1 - exp(-(t[k] - t_s) / T))     a settling drift on the shared clock, when
+ *                                                 T > 0 (pimodel.diagnosis.drift, "settle")
  *
  * Rate (pimodel.diagnosis.rate): rho[k] = |v[k] - v[k-1]| / dt / rate_scale (rho[0] = 0);
  * tau = rate_tau > 0: rho_f[k] = a rho_f[k-1] + (1 - a) rho[k], a = exp(-dt / tau), from
@@ -101,6 +103,9 @@ typedef struct {
     int plays_start;       /* 0: the plays start at the initial state's z (and zf); 1: at rest
                               at the first input, z_i[-1] = v[0] (zf_i[-1] = x_f[0]), as the
                               diagnosis' nominal (pimodel.diagnosis.effects.make_segment) */
+    double settle;         /* D: the settling's total change from t_s on [output unit] */
+    double settle_tau;     /* T [s] (0: no settling term; else > 0) */
+    double settle_t0;      /* t_s [s], on the clock t[k] */
 } pim_diag;
 
 /* Length of the flat state of d (the layout above). */
@@ -123,7 +128,7 @@ PIM_API size_t pim_diag_delay_length(double delay);
  * rate_scale > 0, rate_family 0 or 1, rate_tau >= 0, input_range > 0 when rate_tau = 0; lags
  * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists, for the LTI and for each
  * section of the further elements and of the prefilter; ne, nw <= PIM_DIAG_MAX_ELEMENTS;
- * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2), else a static message naming the first bad one
+ * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2; settle_tau >= 0), else a static message naming the first bad one
  * (the FMU adds the value).
  */
 PIM_API const char *pim_diag_check(const pim_diag *d);

@@ -36,6 +36,9 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->wf_b = u->wiener_element_b;
     d->wf_a = u->wiener_element_a;
     d->plays_start = u->plays_start;
+    d->settle = u->drift_settling;
+    d->settle_tau = u->drift_settling_tau;
+    d->settle_t0 = u->drift_settling_start;
 }
 
 /* The DiagnosedModel parameter rules, with the variable, index and value in the message. */
@@ -47,6 +50,12 @@ static int model_check_parameters(pim_unit *u)
     if (u->drift_clock < 0 || u->drift_clock > 2)
         return unit_error(u, "parameter drift_clock = %d out of range: 0 none, 1 record, "
                              "2 absolute", u->drift_clock);
+    if (!isfinite(u->drift_settling_tau) || u->drift_settling_tau < 0.0)
+        return unit_error(u, "parameter drift_settling_tau = %g: must be finite and >= 0 (0: no "
+                             "settling)", u->drift_settling_tau);
+    if (!isfinite(u->drift_settling) || !isfinite(u->drift_settling_start))
+        return unit_error(u, "parameters drift_settling = %g, drift_settling_start = %g: must be "
+                             "finite", u->drift_settling, u->drift_settling_start);
     if (u->plays_start < 0 || u->plays_start > 1)
         return unit_error(u, "parameter plays_start = %d out of range: 0 at z0, 1 at rest at "
                              "the first input v[0]", u->plays_start);
