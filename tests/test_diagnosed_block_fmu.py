@@ -58,6 +58,7 @@ CASES = {
     "drift_absolute": ("drift",),
     "drift_settle": ("drift",),
     "delay_whole": ("delay",),
+    "rate_saturated": ("rate",),
     "all": tuple(EFFECT_PARAMS),
 }
 
@@ -76,6 +77,8 @@ def model(case: str) -> DiagnosedModel:
                        "drift_settling_start_s": -0.2})
     if case == "delay_whole":
         params["delay_samples"] = 4
+    if case == "rate_saturated":  # the filtered rate through rho / (1 + rho / S)
+        params.update({"rate_time_constant_s": 3e-3, "rate_saturation": 0.4})
     if case in RATE_VARIANTS:
         params["rate_family"], params["rate_time_constant_s"] = RATE_VARIANTS[case]
     return DiagnosedModel(RADII, [1.2, -0.4, 0.8, -0.3, 0.25], 0.3, dt=DT, effects=effects,
@@ -221,7 +224,7 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
-                                  "delay_whole", "rate", *RATE_VARIANTS])
+                                  "delay_whole", "rate", "rate_saturated", *RATE_VARIANTS])
 def test_unit_equals_simulate(fmus, fmi, case):
     """The generic unit with the model's values (FMU time k Ts from 0: the drift clocks read
     t = k Ts)."""
@@ -291,6 +294,7 @@ def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
      ({"rate_family": 2}, "parameter rate_family = 2 out of range: 0 radius, 1 weight"),
      ({"rate_tau": -0.001}, "parameter rate_tau = -0.001: must be finite and >= 0 s"),
      ({"rate_tau": float("nan")}, "parameter rate_tau = nan: must be finite and >= 0 s"),
+     ({"rate_saturation": -0.5}, "parameter rate_saturation = -0.5: must be finite and >= 0"),
      ({"drift_clock": 3}, "parameter drift_clock = 3 out of range"),
      ({"drift_settling_tau": -1.0}, "parameter drift_settling_tau = -1: must be finite"),
      ({"lti_order": 2, "lti_a[1]": 2.0}, "lti_a[1] = 2: the LTI denominator must be normalised"),

@@ -76,7 +76,7 @@ def test_saturated_columns_stay_bounded_on_fast_input(family):
 @pytest.mark.parametrize("family", ["radius", "weight"])
 def test_block_and_inverse_take_the_saturation(family):
     """The C block equals ``simulate`` with a saturated rate (and differs from the linear
-    rate); the C inverse equals the NumPy stream; the FMU export refuses the saturation."""
+    rate); the C inverse equals the NumPy stream; the FMU parameters carry the saturation."""
     rng = np.random.default_rng(23 if family == "radius" else 29)
     m = _random_model(rng, family, float(rng.uniform(0.3, 1.0)))
     linear = _random_model(np.random.default_rng(23 if family == "radius" else 29), family,
@@ -93,8 +93,7 @@ def test_block_and_inverse_take_the_saturation(family):
     want = np.array([stream.step(x, float(yk)) for yk in y])
     assert np.max(np.abs(native.run(y) - want)) < 1e-9
     assert np.sqrt(np.mean((inv.simulate(y) - v) ** 2)) < 0.05 * span
-    with pytest.raises(ValueError, match="rate_saturation"):
-        fmu_parameters(m)
+    assert fmu_parameters(m)[1]["rate_saturation"] == m.params["rate_saturation"]
 
 
 def test_bad_saturation_is_named():

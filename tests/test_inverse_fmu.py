@@ -25,7 +25,12 @@ from pimodel.fmu.operators import unit_parameters
 from pimodel.fmu.unit import FMUUnit
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_inverse_native import CASES, DT, RADII, model, python_stream, reference  # noqa: E402
+from test_inverse_native import CASES as NATIVE_CASES  # noqa: E402
+from test_inverse_native import DT, RADII, model, python_stream, reference  # noqa: E402
+
+# the inverse's cases, and a rate through the saturating map rho / (1 + rho / S)
+CASES = {**NATIVE_CASES, "rate_saturated": (("rate",), {"rate_family": "weight",
+                                                         "rate_saturation": 0.5})}
 
 
 def unit_path(folder: Path, fmi: str) -> Path:
@@ -53,7 +58,7 @@ def fmus(built_fmus) -> Path:
 
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "dynamics_delay_creep", "rate_weight",
-                                  "rate_weight_filtered", "delay_whole",
+                                  "rate_weight_filtered", "rate_saturated", "delay_whole",
                                   "wiener_two_delay_creep"])
 def test_unit_equals_the_python_stream(fmus, fmi, case):
     effects, extra = CASES[case]

@@ -60,8 +60,7 @@ class NativeInverse:
     ------
     ValueError
         A Wiener model (``dynamics_position = "before"``), more than 128 plays or 64 creep
-        lags, a parameter the C core refuses (named), one the Python solver refuses, or a
-        saturated rate term (``rate_saturation``: the FMU has none).
+        lags, a parameter the C core refuses (named), or one the Python solver refuses.
 
     Examples
     --------
@@ -365,11 +364,9 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})
     if "rate_w" in k:
-        if d.rate_saturation > 0.0:
-            raise ValueError(f"params: rate_saturation = {d.rate_saturation:g}; the FMU's rate "
-                             "term is linear (no saturation parameter yet)")
         out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
-                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
+                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau,
+                    "rate_saturation": d.rate_saturation})
     if d.ns:
         out.update({"n_sections": int(d.ns), **arr("section", k["sos"].ravel())})
     if d.npost:

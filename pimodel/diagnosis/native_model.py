@@ -591,8 +591,7 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
     Raises
     ------
     ValueError
-        More than 128 plays or 64 lags, a parameter the C core refuses, or a saturated rate
-        term (``rate_saturation``: the FMU has none).
+        More than 128 plays or 64 lags, or a parameter the C core refuses.
 
     Examples
     --------
@@ -623,11 +622,9 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})
     if "rate_w" in k:
-        if d.rate_saturation > 0.0:
-            raise ValueError(f"params: rate_saturation = {d.rate_saturation:g}; the FMU's rate "
-                             "term is linear (no saturation parameter yet)")
         out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
-                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
+                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau,
+                    "rate_saturation": d.rate_saturation})
     if d.order:
         out.update({"lti_order": int(d.order), **arr("lti_b", k["b"]), **arr("lti_a", k["a"])})
     if d.ne:

@@ -118,6 +118,9 @@ static int unit_check_diag_static(pim_unit *u)
     if (!isfinite(u->rate_tau) || u->rate_tau < 0.0)
         return unit_error(u, "parameter rate_tau = %g: must be finite and >= 0 s",
                           u->rate_tau);
+    if (!isfinite(u->rate_saturation) || u->rate_saturation < 0.0)
+        return unit_error(u, "parameter rate_saturation = %g: must be finite and >= 0 (0: no "
+                             "saturation)", u->rate_saturation);
     if (!isfinite(u->input_range) || !(u->input_range > 0.0))
         return unit_error(u, "parameter input_range = %g: must be finite and > 0",
                           u->input_range);
@@ -150,7 +153,7 @@ static int unit_check_diag_static(pim_unit *u)
         (d)->input_range = (u)->input_range;                                                    \
         (d)->rate_family = (u)->rate_family;                                                    \
         (d)->rate_tau = (u)->rate_tau;                                                          \
-        (d)->rate_saturation = 0.0; /* the FMUs' rate is linear (fmu_parameters refuses S) */  \
+        (d)->rate_saturation = (u)->rate_saturation;                                            \
     } while (0)
 
 #endif /* PIM_DIAG_STATIC_H */
