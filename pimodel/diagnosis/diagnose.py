@@ -16,7 +16,10 @@ it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lower
 than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the noise
 floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
 effect passes in the first round, every pair is fitted jointly and the best pair kept on the
-same terms (two effects can mask each other). Then the choice is revised on the same terms: a
+same terms (two effects can mask each other). A further effect beside those chosen must also
+pass, on the same terms, against each chosen effect's own model refined one step (a further
+creep lag, a further element of the linear part of ``dynamics``: a low-pass or a mode), so
+the misfit of one effect is not named as another (issue 28). Then the choice is revised on the same terms: a
 chosen effect is swapped for an unchosen one while that passes, and an effect that no longer
 passes against the combination without it is dropped (an effect chosen early can stand in for
 one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure delay
@@ -70,6 +73,7 @@ MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
 NOISE_STOP = 1.5  # no further effect once the validate RMS is within this factor of the noise
 UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
 UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
+REFINED = ("creep", "dynamics")  # effects whose own model a second effect must beat refined
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
 INITIAL_STATES = ("rest", "unknown")
 EFFECT_SIGNATURES = {
@@ -573,6 +577,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                         best = (dbic, (first, name), m, o)
         if not accepted(best):
             break
+        if chosen and not _beyond_refinement((best[2], best[3]), chosen, fixed, fit, va):
+            break  # the misfit of the effects chosen, not a further effect
         dbic, name, m, o = best
         chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
@@ -661,9 +667,7 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
         return fit(effects[-1], effects[:-1], kept or None)
 
     def passes(new, old):
-        (m, o), (mb, ob) = new, old
-        return (_bic(va, o, m.k) - _bic(va, ob, mb.k) <= -MIN_BIC_DROP
-                and _errors(va, o)["rms"] <= (1 - MIN_RMS_CUT) * _errors(va, ob)["rms"])
+        return _passes(va, new, old)
 
     cur = (current, cur_out)
     for _ in range(len(EFFECTS)):  # swaps, the best first
@@ -693,6 +697,25 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
             break
         chosen, cur = worst[1], worst[2]
     return chosen, cur[0], cur[1]
+
+
+def _passes(va, new, old) -> bool:
+    """Whether the model and validate outputs ``new`` pass against ``old``: the validate BIC
+    lower by ``MIN_BIC_DROP`` and the validate RMS cut by ``MIN_RMS_CUT``."""
+    (m, o), (mb, ob) = new, old
+    return (_bic(va, o, m.k) - _bic(va, ob, mb.k) <= -MIN_BIC_DROP
+            and _errors(va, o)["rms"] <= (1 - MIN_RMS_CUT) * _errors(va, ob)["rms"])
+
+
+def _beyond_refinement(new, chosen, fixed, fit, va) -> bool:
+    """The second-effect rule: an effect added to ``chosen`` (``new``: its model and validate
+    outputs) must also pass against each chosen effect's own model refined one step
+    (``REFINED``: a further creep lag, a further element of the linear part; the others held at
+    ``fixed``), so a misfit of one effect is not named as another."""
+    for e in (e for e in chosen if e in REFINED):
+        if not _passes(va, new, fit(chosen[-1], chosen[:-1], {**fixed, "refine": e})):
+            return False
+    return True
 
 
 def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):

@@ -9,7 +9,7 @@ parameters to the nominal model (for the information criterion on the validate r
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -47,6 +47,7 @@ SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the fi
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 DRIFT_CLOCKS = DRIFT_VARIANTS  # t - t[0] of each record, t as given, or a level per record
+REFINED_CREEP_LAG = 10.0  # the refined creep's further lag, this factor beyond the longest
 ASYMMETRY_ITERATIONS = 2  # refits of the asymmetry on the hysteresis part of the previous fit
 
 
@@ -460,7 +461,9 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         Effects chosen in earlier rounds.
     fixed : dict or None
         Their grid parameters (``fn``, ``zeta``, ``d``, ``clock``, ``rate_family``,
-        ``rate_tau``).
+        ``rate_tau``); ``"refine": "creep"`` or ``"dynamics"`` fits that effect's model one step
+        richer (a further lag ``REFINED_CREEP_LAG`` times the longest; one further element of
+        the linear part, :func:`.lti.select_order`).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -513,6 +516,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
     the grid optimum, then refitted with every play column."""
     name = "+".join(effects)
+    # fixed["refine"]: that effect's own model one step richer, the yardstick a second effect
+    # must beat (pimodel.diagnosis.diagnose): a further lag for creep, a further element of the
+    # linear part for dynamics
+    refine = fixed.pop("refine", None)
+    if refine == "creep" and "creep" in effects:
+        taus = tuple(nominal.params["creep_taus"])
+        nominal = replace(nominal, params={**nominal.params,
+                                           "creep_taus": (*taus, REFINED_CREEP_LAG * taus[-1])})
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
     static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only (not
@@ -627,7 +638,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             lambda fn, zeta, els: search([lti_point(fn, zeta, els)])[1], lti_regressors,
             lambda fn, zeta, el: [_lti_block(s, lti_point(fn, zeta, (el,)), nominal,
                                              static)[s.used, 0] for s in train],
-            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed)
+            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed,
+            min_elements=len(fixed.get("lti", ())) + 1 if refine == "dynamics" else 0)
         best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
     k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too

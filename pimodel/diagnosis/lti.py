@@ -540,7 +540,7 @@ def _best_addition(blocks: list, ys: list, column: Callable, chosen: tuple, fmax
 
 def select_order(fit: Callable, regressors: Callable, column: Callable, fn: float, zeta: float,
                  fmax: float, damping_range: tuple[float, float], *,
-                 polish: bool = True) -> tuple[float, float, tuple, list]:
+                 polish: bool = True, min_elements: int = 0) -> tuple[float, float, tuple, list]:
     """Forward selection of the extra elements by the train BIC (module docstring).
 
     Each step screens every kind of element with the base mode held (a rank-one update of the
@@ -566,6 +566,10 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
     polish : bool
         Polish jointly after each step; False: the base mode is held and each element keeps
         its screened parameters (a cheaper reselection).
+    min_elements : int
+        Add elements (the best of each step) up to this many whether or not they lower the
+        train BIC (at most ``MAX_ELEMENTS``): the linear part refined one step further, the
+        yardstick a second effect beside ``dynamics`` must beat (:mod:`.diagnose`).
 
     Returns
     -------
@@ -615,7 +619,8 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
             break
         trial = elements + (found[0],)
         k = lti_k(trial)
-        if not bic(found[1], k) < current:
+        forced = len(elements) < min_elements
+        if not forced and not bic(found[1], k) < current:
             break
         if not polish:
             fn2, zeta2, score = fn, zeta, bic(found[1], k)
@@ -629,7 +634,7 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
         previous = bic(fit(fn2, zeta2, trial[:-1]), lti_k(elements)) if polish else current
         if previous < current:
             fn, zeta, elements, current = fn2, zeta2, trial[:-1], previous
-        if not score < current:
+        if not forced and not score < current:
             break
         fn, zeta, elements, current = fn2, zeta2, trial, score
         trace.append({"structure": ["mode"] + [e[0] for e in elements],
