@@ -1,33 +1,33 @@
 """The sim-to-real gap diagnosis: nominal PI model, where the residual lies, which unmodelled
 effect explains it, how far the gap shrinks on held-out records, and what stays unexplained.
 
-Train records fit every model; validate records only score. The nominal model is the PI
-operator in the conventional parametrisation (plays on a uniform radius grid over half the input
-range, weights and an output offset by least squares, linear in its parameters). The grid is
-refined (20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits
-clean hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
+Train records fit every model; validate records only score. The nominal model is the PI operator
+in the conventional parametrisation (plays on a uniform radius grid over half the input range,
+weights and an output offset by least squares, linear in its parameters). The grid is refined
+(20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits clean
+hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
 ``v[0]``, or at 0 when the train BIC prefers it; records that travel further than half the range
 from ``v[0]`` also try the grid extended to that travel, kept when validate agrees (issue 33,
 :func:`_nominal`). A plain least-squares PI fit is reported beside it as a check
 (``nominal["baseline"]``), with a warning when the nominal is worse. Each candidate effect is
 refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are added greedily:
 each round fits every remaining candidate on train (on top of those already chosen) and scores
-it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by more
-than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the noise
-floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
+it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by
+more than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the
+noise floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
 effect passes in the first round, every pair is fitted jointly and the best pair kept on the
 same terms (two effects can mask each other). A further effect beside those chosen must also
 pass, on the same terms, against each chosen effect's own model refined one step (a further
-creep lag, a further element of the linear part of ``dynamics``: a low-pass or a mode), so
-the misfit of one effect is not named as another (issue 28). Then the choice is revised on the same terms: a
-chosen effect is swapped for an unchosen one while that passes, and an effect that no longer
-passes against the combination without it is dropped (an effect chosen early can stand in for
-one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure delay
-on the records (gain within 10 % of 1 over the lower quarter of the band, :mod:`.delaylike`)
-gives way to ``delay`` when the delay fits validate within 10 % in its place. The ``dynamics``
-candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the train BIC says so,
-a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a level per
-record, :mod:`.drift`) is chosen on validate for every combination.
+creep lag, a further element of the linear part of ``dynamics``: a low-pass or a mode), so the
+misfit of one effect is not named as another (issue 28). Then the choice is revised on the same
+terms: a chosen effect is swapped for an unchosen one while that passes, and an effect that no
+longer passes against the combination without it is dropped (an effect chosen early can stand in
+for one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure
+delay on the records (gain within 10 % of 1 over the lower quarter of the band,
+:mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its place.
+The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the
+train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a
+level per record, :mod:`.drift`) is chosen on validate for every combination.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
