@@ -41,6 +41,11 @@ __all__ = [
 
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
 MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
+# heavily damped points from lower frequencies: a mode in series with a real pole looks like one
+# damped mode near a Butterworth damping over a band well below both (density_stage below
+# 50 Hz: the best single mode sits at 130-250 Hz, damping 0.5-0.8, off the light grid, and the
+# low-pass element of the linear part, module lti, then started from a poor base mode)
+MODE_HEAVY = (tuple(np.geomspace(100.0, 5000.0, 9)), 0.7)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
@@ -552,7 +557,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             grids.append([{"wiener": fixed["wiener"]}] if "wiener" in fixed else
                          [{"fn": fixed["fn"], "zeta": fixed["zeta"],
                            "lti": fixed.get("lti", ())}] if "fn" in fixed else
-                         [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING])
+                         [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING] +
+                         [{"fn": f, "zeta": MODE_HEAVY[1]} for f in MODE_HEAVY[0] if f <= fmax])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
