@@ -87,10 +87,15 @@ def test_density_mode_behind_a_real_pole_is_dynamics_alone(seed):
     """density_stage's mode (120-300 Hz) in series with a real pole (100-250 Hz) under inputs
     below 50 Hz: before issue 28's change these seeds were `delay` or `dynamics` + `delay`."""
     train, validate = density_records(["dynamics"], seed)
-    v = diagnose([train], [validate]).verdict
+    rep = diagnose([train], [validate])
+    v = rep.verdict
     assert v["effects"] == ["dynamics"], v["effects"]
     assert v["gap_after_over_noise"] < 1.5
     assert any(e[0] == "lowpass" for e in v["model"].get("lti_elements", ()))
+    y = rep.model().simulate(validate.v, validate.t)  # the exported model: what was fitted
+    assert np.max(np.abs(y - rep.after[0])) < 1e-9 * np.ptp(validate.y)
+    v_ff = rep.model().inverse().simulate(y)
+    assert np.all(np.isfinite(v_ff)) and np.ptp(v_ff) < 2 * np.ptp(validate.v)
 
 
 @pytest.mark.slow
