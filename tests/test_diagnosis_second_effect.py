@@ -68,14 +68,19 @@ def test_an_effect_the_refined_first_effect_matches_is_refused(seed):
     calls = []
 
     def fit(name, combo_=(), fixed=None):
-        calls.append(fixed["refine"])
+        calls.append(fixed)
         return _model(5), [y + share * misfit]
 
+    held = {"fn": 300.0, "zeta": 0.2, "lti": (("lowpass", 1e-3),), "d": 1.5}
     share = 0.1  # the chosen effect refined one step absorbs it as well: refused
-    assert not _beyond_refinement(combo, ("dynamics",), {"fn": 1.0}, fit, va)
+    assert not _beyond_refinement(combo, ("dynamics",), held, fit, va)
     share = 0.8  # refined, it leaves most of it: the second effect is real
-    assert _beyond_refinement(combo, ("dynamics",), {"fn": 1.0}, fit, va)
-    assert calls == ["dynamics", "dynamics"]
+    assert _beyond_refinement(combo, ("dynamics",), held, fit, va)
+    # the dynamics searched again (its grid not held), one element more; the rest held
+    assert calls == [{"d": 1.5, "lti_min": 2}] * 2
+    calls.clear()
+    assert _beyond_refinement(combo, ("creep",), {}, fit, va)
+    assert calls == [{"refine": "creep"}]
     calls.clear()
     assert _beyond_refinement(combo, ("delay", "asymmetry"), {"d": 1.0}, fit, va)
     assert calls == []  # nothing to refine: the usual test alone

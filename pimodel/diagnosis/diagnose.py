@@ -73,7 +73,7 @@ MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
 NOISE_STOP = 1.5  # no further effect once the validate RMS is within this factor of the noise
 UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
 UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
-REFINED = ("creep", "dynamics")  # effects whose own model a second effect must beat refined
+DYNAMICS_KEYS = ("fn", "zeta", "lti")  # grid keys of dynamics after the hysteresis
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
 INITIAL_STATES = ("rest", "unknown")
 EFFECT_SIGNATURES = {
@@ -709,11 +709,20 @@ def _passes(va, new, old) -> bool:
 
 def _beyond_refinement(new, chosen, fixed, fit, va) -> bool:
     """The second-effect rule: an effect added to ``chosen`` (``new``: its model and validate
-    outputs) must also pass against each chosen effect's own model refined one step
-    (``REFINED``: a further creep lag, a further element of the linear part; the others held at
-    ``fixed``), so a misfit of one effect is not named as another."""
-    for e in (e for e in chosen if e in REFINED):
-        if not _passes(va, new, fit(chosen[-1], chosen[:-1], {**fixed, "refine": e})):
+    outputs) must also pass against each chosen effect's own model refined one step, the
+    others held at ``fixed``: ``creep`` with a further lag; ``dynamics`` after the hysteresis
+    searched again beside the others (its base mode was chosen before they were modelled) with
+    one further element of its linear part. So a misfit of one effect is not named as
+    another."""
+    for e in chosen:
+        if e == "creep":
+            refined = {**fixed, "refine": "creep"}
+        elif e == "dynamics" and "wiener" not in fixed:
+            refined = {**{k: x for k, x in fixed.items() if k not in DYNAMICS_KEYS},
+                       "lti_min": len(fixed.get("lti", ())) + 1}
+        else:
+            continue
+        if not _passes(va, new, fit(chosen[-1], chosen[:-1], refined)):
             return False
     return True
 

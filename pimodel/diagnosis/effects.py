@@ -466,9 +466,9 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         Effects chosen in earlier rounds.
     fixed : dict or None
         Their grid parameters (``fn``, ``zeta``, ``d``, ``clock``, ``rate_family``,
-        ``rate_tau``); ``"refine": "creep"`` or ``"dynamics"`` fits that effect's model one step
-        richer (a further lag ``REFINED_CREEP_LAG`` times the longest; one further element of
-        the linear part, :func:`.lti.select_order`).
+        ``rate_tau``). Two keys make an effect's model richer: ``"refine": "creep"``, a further
+        lag ``REFINED_CREEP_LAG`` times the longest; ``"lti_min": n``, at least ``n`` further
+        elements of the linear part (:func:`.lti.select_order`).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -521,11 +521,11 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
     the grid optimum, then refitted with every play column."""
     name = "+".join(effects)
-    # fixed["refine"]: that effect's own model one step richer, the yardstick a second effect
-    # must beat (pimodel.diagnosis.diagnose): a further lag for creep, a further element of the
-    # linear part for dynamics
-    refine = fixed.pop("refine", None)
-    if refine == "creep" and "creep" in effects:
+    # an effect's own model one step richer, the yardstick a second effect must beat
+    # (pimodel.diagnosis.diagnose): fixed["refine"] = "creep", a further lag;
+    # fixed["lti_min"], at least that many further elements of the linear part
+    lti_min = fixed.pop("lti_min", 0)
+    if fixed.pop("refine", None) == "creep" and "creep" in effects:
         taus = tuple(nominal.params["creep_taus"])
         nominal = replace(nominal, params={**nominal.params,
                                            "creep_taus": (*taus, REFINED_CREEP_LAG * taus[-1])})
@@ -645,7 +645,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             lambda fn, zeta, el: [_lti_block(s, lti_point(fn, zeta, (el,)), nominal,
                                              static)[s.used, 0] for s in train],
             p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed,
-            min_elements=len(fixed.get("lti", ())) + 1 if refine == "dynamics" else 0)
+            min_elements=lti_min)
         best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
     k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too
