@@ -353,7 +353,7 @@ class DiagParams(ctypes.Structure):
                 ("asym", c_int), ("q", c_double), ("c3", c_double), ("center", c_double),
                 ("half", c_double), ("rate_w", _DP), ("dt", c_double),
                 ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
-                ("rate_tau", c_double), ("order", c_size),
+                ("rate_tau", c_double), ("rate_saturation", c_double), ("order", c_size),
                 ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
                 ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
                 ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP),
@@ -419,7 +419,8 @@ class InverseParams(ctypes.Structure):
                 ("asym", c_int), ("q", c_double), ("c3", c_double), ("center", c_double),
                 ("half", c_double), ("rate_w", _DP), ("dt", c_double),
                 ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
-                ("rate_tau", c_double), ("reference_range", c_double), ("ns", c_size),
+                ("rate_tau", c_double), ("rate_saturation", c_double),
+                ("reference_range", c_double), ("ns", c_size),
                 ("sos", _DP), ("latency", c_size), ("frac", c_double), ("npost", c_size),
                 ("post", _DP)]
 

@@ -55,6 +55,7 @@ from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
 from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment, segment_of_rows
+from .gain import gain_note, record_gains
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
@@ -596,7 +597,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         evidence.append({"effect": name, "region": reg,
                          "concentration": regions.get(reg, {}).get("concentration"),
                          "band": band, "band_energy_share": bands.get(band)})
-    unexplained = _unexplained(va, cur_out, before["rms"], after["rms"], noise)
+    unexplained = _unexplained(va, cur_out, before["rms"], after["rms"], noise, out_va)
     alternatives: list[str] = []
     if chosen:  # effects that alone explain the gap about as well as the first one chosen
         alone = {c["effect"]: c["validate"]["rms"] for c in candidates}
@@ -743,12 +744,22 @@ def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):
     return chosen, current, cur_out
 
 
-def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float) -> dict:
+def _unexplained(va, outputs, gap_before: float, gap_after: float, noise: float,
+                 nominal_outputs) -> dict:
     """The part of the validate gap no accepted effect explains: its share of the gap energy
-    before (``(gap_after^2 - noise^2) / gap_before^2``) and where the remaining residual lies."""
+    before (``(gap_after^2 - noise^2) / gap_before^2``) and where the remaining residual lies.
+    A gap that a gain per validate record explains (:func:`.gain.record_gains`, on the chosen
+    model's or the nominal's residual: a drift's out-of-fold levels vary within a record) is
+    unexplained whatever its share, with the gains named in ``gain`` and ``note``."""
     share = max(gap_after**2 - noise**2, 0.0) / max(gap_before**2, 1e-300)
-    present = gap_after > UNEXPLAINED_FACTOR * noise and share > UNEXPLAINED_SHARE
+    above = gap_after > UNEXPLAINED_FACTOR * noise
+    gain = (record_gains(va, outputs, noise) or record_gains(va, nominal_outputs, noise)) \
+        if above else None
+    present = above and (share > UNEXPLAINED_SHARE or gain is not None)
     out: dict = {"present": bool(present), "share": share}
+    if gain is not None:
+        out["gain"] = gain
+        out["note"] = gain_note(gain)
     if present:
         wb = residual_breakdown(va, [s.y - o for s, o in zip(va, outputs, strict=True)])
         out["where"] = [r["region"] for r in wb["regions"][:3]]

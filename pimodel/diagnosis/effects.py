@@ -20,7 +20,16 @@ from .creep import creep_time_constants
 from .drift import DRIFT_VARIANTS, drift_columns, drift_k, out_of_fold_level
 from .filters import lag, mode, mode_coefficients, mode_rows, shift
 from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
-from .rate import RATE_BANDS, RATE_FAMILIES, RATE_TAU_REFINE, RATE_TAU_START, RATE_TAUS
+from .rate import (
+    RATE_BANDS,
+    RATE_FAMILIES,
+    RATE_POLISH_ROUNDS,
+    RATE_SATURATION_REFINE,
+    RATE_SATURATIONS,
+    RATE_TAU_REFINE,
+    RATE_TAU_START,
+    RATE_TAUS,
+)
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
 __all__ = [
@@ -466,9 +475,10 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         Effects chosen in earlier rounds.
     fixed : dict or None
         Their grid parameters (``fn``, ``zeta``, ``d``, ``clock``, ``rate_family``,
-        ``rate_tau``). Two keys make an effect's model richer: ``"refine": "creep"``, a further
-        lag ``REFINED_CREEP_LAG`` times the longest; ``"lti_min": n``, at least ``n`` further
-        elements of the linear part (:func:`.lti.select_order`).
+        ``rate_tau``, ``rate_saturation``). Two keys make an effect's model richer:
+        ``"refine": "creep"``, a further lag ``REFINED_CREEP_LAG`` times the longest;
+        ``"lti_min": n``, at least ``n`` further elements of the linear part
+        (:func:`.lti.select_order`).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -567,9 +577,11 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                          if "clock" in fixed else
                          [{"clock": c} for c in DRIFT_CLOCKS if c != "levels"])
         elif e == "rate":  # the filter is searched after the other grids (below)
-            grids.append([{"rate_family": fixed["rate_family"], "rate_tau": fixed["rate_tau"]}]
+            grids.append([{k_: fixed.get(k_) for k_ in ("rate_family", "rate_tau",
+                                                         "rate_saturation")}]
                          if "rate_tau" in fixed else
-                         [{"rate_family": f, "rate_tau": RATE_TAU_START} for f in RATE_FAMILIES])
+                         [{"rate_family": f, "rate_tau": RATE_TAU_START, "rate_saturation": None}
+                          for f in RATE_FAMILIES])
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
@@ -585,6 +597,20 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             if tau > 0:
                 best = search([{**best[0].params, "rate_tau": tau * f} for f in (1 / step, step)],
                               best)
+        # the saturation of the filtered rate at that filter (module rate), then steps
+        best = search([{**best[0].params, "rate_saturation": s_} for s_ in RATE_SATURATIONS
+                       if s_ is not None], best)
+        for _ in range(RATE_POLISH_ROUNDS):  # then the filter and the saturation in turn
+            before, p_ = best[0], best[0].params
+            if p_["rate_saturation"] is None:
+                break
+            best = search([{**p_, "rate_saturation": p_["rate_saturation"] * f}
+                           for f in (1 / RATE_SATURATION_REFINE, RATE_SATURATION_REFINE)]
+                          + [{**p_, "rate_tau": p_["rate_tau"] * f}
+                             for f in (1 / RATE_TAU_REFINE[-1], RATE_TAU_REFINE[-1])
+                             if p_["rate_tau"] > 0], best)
+            if best[0] is before:
+                break
     if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
         i = int(np.searchsorted(dgrid, best[0].params["d"]))
         lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
@@ -747,10 +773,10 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
         if "rate" in effects:
-            key, which = ("rate", id(s)), (p["rate_tau"], p["rate_family"])
+            which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"))
+            key = ("rate", id(s))
             if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
-                static[key] = (which, np.ascontiguousarray(
-                    s.rate_basis.columns(p["rate_tau"], p["rate_family"]).T), s)
+                static[key] = (which, np.ascontiguousarray(s.rate_basis.columns(*which).T), s)
             parts.append(static[key][1])
         if "drift" in effects:  # the trend column last
             parts.append(drift_columns(s.t, p, static["train"].get(id(s)),
@@ -802,6 +828,7 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["rate_gains"] = extra[i:i + RATE_BANDS].tolist()
             out["rate_family"] = model.params["rate_family"]
             out["rate_time_constant_s"] = model.params["rate_tau"]
+            out["rate_saturation"] = model.params.get("rate_saturation")
             i += RATE_BANDS
     if "drift" in effects:
         out["drift_per_s"] = float(model.coef[-1])

@@ -60,7 +60,8 @@ class NativeInverse:
     ------
     ValueError
         A Wiener model (``dynamics_position = "before"``), more than 128 plays or 64 creep
-        lags, a parameter the C core refuses (named), or one the Python solver refuses.
+        lags, a parameter the C core refuses (named), one the Python solver refuses, or a
+        saturated rate term (``rate_saturation``: the FMU has none).
 
     Examples
     --------
@@ -99,6 +100,7 @@ class NativeInverse:
             keep["rate_w"] = _band_gains(np.asarray(p["rate_gains"], float), n)
             d.rate_family = RATE_FAMILIES.index(p["rate_family"])
             d.rate_tau, d.rate_scale = solver.tau, p["rate_scale"]
+            d.rate_saturation = solver.saturation or 0.0
         sos, _ = _filter(model)
         if sos is not None:
             if sos.shape[0] > MAX_SECTIONS:
@@ -363,6 +365,9 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})
     if "rate_w" in k:
+        if d.rate_saturation > 0.0:
+            raise ValueError(f"params: rate_saturation = {d.rate_saturation:g}; the FMU's rate "
+                             "term is linear (no saturation parameter yet)")
         out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
                     "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
     if d.ns:

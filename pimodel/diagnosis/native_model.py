@@ -57,7 +57,7 @@ from .checks import block_dt, checked_signal
 from .filters import mode_coefficients
 from .limits import MAX_DELAY, MAX_ELEMENTS, MAX_ORDER, NMAX, SECTION
 from .lti import ELEMENT_K, element_coefficients
-from .rate import RATE_FAMILIES, play_bands, rate_params
+from .rate import RATE_FAMILIES, play_bands, rate_params, rate_saturation
 from .wiener import ELEMENT_K as WIENER_K
 
 __all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",
@@ -282,6 +282,7 @@ class NativeModel:
             gains, family, tau = rate_params(p)
             keep["rate_w"] = _band_gains(gains, n)
             d.rate_family, d.rate_tau = RATE_FAMILIES.index(family), tau
+            d.rate_saturation = rate_saturation(p) or 0.0
             d.rate_scale, d.input_range = p["rate_scale"], self.input_range
         lti = None if model.dynamics_before else lti_coefficients(model)
         if lti is not None:
@@ -585,7 +586,8 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
     Raises
     ------
     ValueError
-        More than 128 plays or 64 lags, or a parameter the C core refuses.
+        More than 128 plays or 64 lags, a parameter the C core refuses, or a saturated rate
+        term (``rate_saturation``: the FMU has none).
 
     Examples
     --------
@@ -616,6 +618,9 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})
     if "rate_w" in k:
+        if d.rate_saturation > 0.0:
+            raise ValueError(f"params: rate_saturation = {d.rate_saturation:g}; the FMU's rate "
+                             "term is linear (no saturation parameter yet)")
         out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
                     "rate_family": int(d.rate_family), "rate_tau": d.rate_tau})
     if d.order:

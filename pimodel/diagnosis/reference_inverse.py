@@ -49,7 +49,7 @@ from ..blocks.framework import BlockSettings, signal_labels, stepped_block
 from .checks import block_dt
 from .lti import inverse_sos
 from .monotone import monotone_model
-from .rate import STEP_SHARE, play_bands, rate_params
+from .rate import STEP_SHARE, play_bands, rate_params, rate_saturation, saturated_rate
 from .wiener import inverse_sections
 
 __all__ = ["StaticInverse", "feedforward_block", "inverse_block", "inverse_latency",
@@ -238,6 +238,7 @@ class StaticInverse:
                     self.rw[idx] = g * self.w0[idx]
             self.step_size = STEP_SHARE * self.input_range
             self.tau = tau
+            self.saturation = rate_saturation(p)
             self.a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
             # the fresh rate's source: the inverse of the model without its rate term, in
             # lockstep (a low-passed rate counts every jump: no step rule)
@@ -347,7 +348,8 @@ class StaticInverse:
             dv0 = 0.0 if first else abs(v0 - x[self._v0_prev])
             fresh = dv0 / m.dt / p["rate_scale"] if dv0 <= self.source_step else 0.0
             x[self._v0_prev] = v0
-            rho_k = self.a_rate * rho_f + (1 - self.a_rate) * fresh
+            rho_k = float(saturated_rate(self.a_rate * rho_f + (1 - self.a_rate) * fresh,
+                                         self.saturation))
 
         def F(vs):
             Zc = np.clip(z[None, :], vs[:, None] - r, vs[:, None] + r)
@@ -385,7 +387,8 @@ class StaticInverse:
             rho_f = self.a_rate * rho_f + (1 - self.a_rate) * rho
             gap = vk - z_new
             contact = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
-            memory = np.where(contact, -np.sign(gap) * rho_f, memory)
+            memory = np.where(contact, -np.sign(gap) * saturated_rate(rho_f, self.saturation),
+                              memory)
         x[2] = vk if first or abs(vk - v_prev) > 0.01 * span else 2 * vk - v_prev
         x[0], x[1] = 1.0, vk
         x[self._z] = z_new

@@ -127,6 +127,8 @@ def hints(rep) -> list[str]:
                    f"{un.get('band', '?')}); effects outside the candidates look like this: "
                    "output clipping or a sensor range, an input the records do not hold, a "
                    "sensor gain that changes between records; check the setup there")
+    if un.get("note"):  # a gain per validate record explains the gap (diagnosis.gain)
+        out.append(un["note"])
     model = v.get("model") or {}
     if "drift" in v["effects"] and model.get("drift_variant") == "levels":
         out.append("each validate record sits at a level of its own: was the sensor zeroed "

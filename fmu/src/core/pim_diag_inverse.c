@@ -19,6 +19,12 @@ static inline double dinv_sign(double x)
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
 }
 
+/* the filtered rate as the terms take it: rho / (1 + rho / S) with rate_saturation S > 0 */
+static inline double dinv_saturate(const pim_dinv *d, double rho)
+{
+    return d->rate_saturation > 0.0 ? rho / (1.0 + rho / d->rate_saturation) : rho;
+}
+
 size_t pim_dinv_solver_size(const pim_dinv *d, int rate)
 {
     const size_t base = 3 + d->n + d->m;
@@ -106,6 +112,8 @@ const char *pim_dinv_check(const pim_dinv *d)
             return "rate_family must be 0 (radius) or 1 (weight)";
         if (!(isfinite(d->rate_tau) && d->rate_tau >= 0.0))
             return "rate_tau must be finite and >= 0 s";
+        if (!(isfinite(d->rate_saturation) && d->rate_saturation >= 0.0))
+            return "rate_saturation must be finite and >= 0 (0: linear)";
         if (d->rate_tau == 0.0 && !(isfinite(d->input_range) && d->input_range > 0.0))
             return "input_range must be finite and > 0";
     }
@@ -293,7 +301,7 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
         const double dv0 = first ? 0.0 : fabs(v0 - *v0_prev);
         fresh = d->rate_tau > 0.0 || dv0 <= step_size ? dv0 / d->dt / d->rate_scale : 0.0;
         *v0_prev = v0;
-        c.rho_k = a_rate * *rho_f + (1.0 - a_rate) * fresh;
+        c.rho_k = dinv_saturate(d, a_rate * *rho_f + (1.0 - a_rate) * fresh);
     }
     for (size_t j = 0; j < m; ++j) {
         const double ga = d->lag_g[j] * d->lag_a[j];
@@ -400,7 +408,7 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
         for (size_t i = 0; i < n; ++i) {
             const double gap = vk - z[i];
             if (d->r[i] > 0.0 && fabs(gap) >= d->r[i] * (1.0 - 1e-9))
-                mem[i] = -dinv_sign(gap) * *rho_f;
+                mem[i] = -dinv_sign(gap) * dinv_saturate(d, *rho_f);
         }
     }
     x[2] = first || fabs(vk - v_prev) > 0.01 * span ? vk : 2.0 * vk - v_prev;

@@ -32,7 +32,9 @@
  *
  * (rate terms not on the first sample).  rho_k = a rho_f[k-1] + (1 - a) fresh[k] with fresh
  * the rate of a nested rate-free inverse v0 run on the same ref (|v0[k] - v0[k-1]| / dt /
- * rate_scale, 0 for a jump above PIM_DIAG_STEP_SHARE input_range when rate_tau = 0).  Roots:
+ * rate_scale, 0 for a jump above PIM_DIAG_STEP_SHARE input_range when rate_tau = 0), and rho_k
+ * and the held terms' rate saturated as the model's (rate_saturation S > 0: rho / (1 + rho /
+ * S)).  Roots:
  * between the sorted breakpoints b (z - r, z + r, v[k-1] and 10 span beyond them) F_k is a
  * polynomial (linear, cubic with the asymmetry) interpolated from interior nodes; a breakpoint
  * where |F_k - ref| <= 1e-10 (1 + |ref|) is a root too.  The root nearest the branch guess
@@ -80,6 +82,7 @@ typedef struct {
     double dt, rate_scale, input_range;
     int rate_family;       /* PIM_DIAG_RATE_RADIUS or PIM_DIAG_RATE_WEIGHT */
     double rate_tau;       /* low-pass time constant of the rate [s], >= 0 */
+    double rate_saturation; /* S > 0: the rate enters as rho_f / (1 + rho_f / S); 0: linear */
     double reference_range; /* >= 0: the root rule's scale (0: max(2 r_n, 1)) */
     size_t ns;             /* prefilter sections (0: none) */
     const double *sos;     /* ns rows of 6: b0 b1 b2 a0 a1 a2, a0 = 1 */

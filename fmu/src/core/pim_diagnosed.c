@@ -116,6 +116,8 @@ const char *pim_diag_check(const pim_diag *d)
             return "rate_family must be 0 (radius) or 1 (weight)";
         if (!(isfinite(d->rate_tau) && d->rate_tau >= 0.0))
             return "rate_tau must be finite and >= 0 s";
+        if (!(isfinite(d->rate_saturation) && d->rate_saturation >= 0.0))
+            return "rate_saturation must be finite and >= 0 (0: linear)";
         if (d->rate_tau == 0.0 && !(isfinite(d->input_range) && d->input_range > 0.0))
             return "input_range must be finite and > 0";
     }
@@ -183,7 +185,8 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         } else {
             rho_f = rho;
         }
-        rate[0] = rho_f;
+        rate[0] = rho_f; /* the filter's state; the terms take the saturated rate */
+        if (d->rate_saturation > 0.0) rho_f /= 1.0 + rho_f / d->rate_saturation;
     }
     /* plays, the hysteresis h and the reference h0; the radius family's term of each play in
      * contact (rate.RateBasis: -(v - z_i) rho_f, held after the contact) */

@@ -36,7 +36,8 @@
  * Rate (pimodel.diagnosis.rate): rho[k] = |v[k] - v[k-1]| / dt / rate_scale (rho[0] = 0);
  * tau = rate_tau > 0: rho_f[k] = a rho_f[k-1] + (1 - a) rho[k], a = exp(-dt / tau), from
  * rho_f[-1] = 0; tau = 0: rho_f[k] = rho[k], or 0 when |v[k] - v[k-1]| > PIM_DIAG_STEP_SHARE *
- * input_range (a sampled step has no rate).  Radius family: m_i[k] = -(v[k] - z_i[k]) rho_f[k]
+ * input_range (a sampled step has no rate); rate_saturation S > 0: rho_f[k] in the terms below
+ * is rho_f[k] / (1 + rho_f[k] / S) (the filter's state stays unsaturated).  Radius family: m_i[k] = -(v[k] - z_i[k]) rho_f[k]
  * while play i (r_i > 0) is in contact (|v[k] - z_i[k]| >= r_i (1 - 1e-9)), else m_i[k-1]
  * (m_i = 0 before its first contact): the term held at the play's last contact.
  * A fractional delay part f <= 1e-12 counts as 0 (as pimodel.diagnosis.effects.shift).
@@ -84,6 +85,7 @@ typedef struct {
     double dt, rate_scale, input_range;
     int rate_family;       /* PIM_DIAG_RATE_RADIUS or PIM_DIAG_RATE_WEIGHT */
     double rate_tau;       /* low-pass time constant of the rate [s], >= 0 (0: none) */
+    double rate_saturation; /* S > 0: the rate enters as rho_f / (1 + rho_f / S); 0: linear */
     size_t order;          /* LTI order (0: none) */
     const double *b, *a;   /* b[0..order], a[0..order], a[0] = 1 */
     double delay;          /* d >= 0 [samples] */

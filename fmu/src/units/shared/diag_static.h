@@ -150,6 +150,7 @@ static int unit_check_diag_static(pim_unit *u)
         (d)->input_range = (u)->input_range;                                                    \
         (d)->rate_family = (u)->rate_family;                                                    \
         (d)->rate_tau = (u)->rate_tau;                                                          \
+        (d)->rate_saturation = 0.0; /* the FMUs' rate is linear (fmu_parameters refuses S) */  \
     } while (0)
 
 #endif /* PIM_DIAG_STATIC_H */
