@@ -177,3 +177,29 @@ def test_two_mode_model_exports_to_a_block_and_an_fmu_equal_to_simulate(alt_dyna
     assert ff.latency == 1
     res = control.input_output_response(ff, t[:800], y_d, initial_state=initial_state(ff))
     assert np.max(np.abs(res.outputs[1:] - inv.simulate(y_d)[:-1])) < 1e-9 * np.ptp(rec.v)
+
+
+def test_a_mode_behind_a_real_pole_gets_a_low_pass_element():
+    """A 2 kHz linear stage whose linear part is a mode in series with a real pole (drawn at
+    random, both below 300 Hz) driven by slow ramps and sines: one mode cannot follow it to the
+    noise; the selection adds a low-pass element (in parallel form) and then does."""
+    rng = np.random.default_rng(11)
+    dt = 5e-4
+    fn, zeta, fp = rng.uniform(120, 300), rng.uniform(0.08, 0.3), rng.uniform(100, 250)
+    levels = rng.uniform(-1, 1, 10)
+    ends = zip(levels[:-1], levels[1:], strict=True)
+    v = np.concatenate([np.linspace(a, b, 300) for a, b in ends])
+    t = np.arange(v.size) * dt
+    v = v + 0.3 * np.sin(2 * np.pi * 11 * t)
+    h, noise = 2.0 * v, 1e-3
+    wn, wp = 2 * np.pi * fn, 2 * np.pi * fp
+    sys = cont2discrete((np.polymul([wn**2], [wp]),
+                         np.polymul([1, 2 * zeta * wn, wn**2], [1, wp])), dt, method="zoh")
+    b, a = np.ravel(sys[0]), sys[1]
+    y = h[0] + lfilter(b, a, h - h[0]) + rng.normal(0, noise, v.size)
+    seg = make_segment(t, v, y, [0.0, 0.2])
+    m = fit_effect("dynamics", [seg])
+    kinds = [e[0] for e in m.params["lti_elements"]]
+    assert "lowpass" in kinds, m.params
+    rms = float(np.sqrt(np.mean((m.predict(seg) - y) ** 2)))
+    assert rms < 1.5 * noise, (rms, m.params)

@@ -1,30 +1,33 @@
 """The sim-to-real gap diagnosis: nominal PI model, where the residual lies, which unmodelled
 effect explains it, how far the gap shrinks on held-out records, and what stays unexplained.
 
-Train records fit every model; validate records only score. The nominal model is the PI
-operator in the conventional parametrisation (plays on a uniform radius grid over half the input
-range, weights and an output offset by least squares, linear in its parameters). The grid is
-refined (20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits
-clean hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
+Train records fit every model; validate records only score. The nominal model is the PI operator
+in the conventional parametrisation (plays on a uniform radius grid over half the input range,
+weights and an output offset by least squares, linear in its parameters). The grid is refined
+(20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits clean
+hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
 ``v[0]``, or at 0 when the train BIC prefers it; records that travel further than half the range
 from ``v[0]`` also try the grid extended to that travel, kept when validate agrees (issue 33,
 :func:`_nominal`). A plain least-squares PI fit is reported beside it as a check
 (``nominal["baseline"]``), with a warning when the nominal is worse. Each candidate effect is
 refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are added greedily:
 each round fits every remaining candidate on train (on top of those already chosen) and scores
-it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by more
-than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the noise
-floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
+it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by
+more than 10, cuts the validate RMS by at least 20 %, and the current RMS is above 1.5 times the
+noise floor (:mod:`.noise`: repeated input periods, else a flexible local model). When no single
 effect passes in the first round, every pair is fitted jointly and the best pair kept on the
-same terms (two effects can mask each other). Then the choice is revised on the same terms: a
-chosen effect is swapped for an unchosen one while that passes, and an effect that no longer
-passes against the combination without it is dropped (an effect chosen early can stand in for
-one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure delay
-on the records (gain within 10 % of 1 over the lower quarter of the band, :mod:`.delaylike`)
-gives way to ``delay`` when the delay fits validate within 10 % in its place. The ``dynamics``
-candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the train BIC says so,
-a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a level per
-record, :mod:`.drift`) is chosen on validate for every combination.
+same terms (two effects can mask each other). A further effect beside those chosen must also
+pass, on the same terms, against each chosen effect's own model refined one step (a further
+creep lag, a further element of the linear part of ``dynamics``: a low-pass or a mode), so the
+misfit of one effect is not named as another (issue 28). Then the choice is revised on the same
+terms: a chosen effect is swapped for an unchosen one while that passes, and an effect that no
+longer passes against the combination without it is dropped (an effect chosen early can stand in
+for one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure
+delay on the records (gain within 10 % of 1 over the lower quarter of the band,
+:mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its place.
+The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the
+train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a
+level per record, :mod:`.drift`) is chosen on validate for every combination.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
@@ -72,6 +75,7 @@ NOISE_STOP = 1.5  # no further effect once the validate RMS is within this facto
 SLOW_DEGREE = 3  # the compression's check beside a slow drift: a cubic in time (_slow_rss)
 UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
 UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
+DYNAMICS_KEYS = ("fn", "zeta", "lti")  # grid keys of dynamics after the hysteresis
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
 INITIAL_STATES = ("rest", "unknown")
 EFFECT_SIGNATURES = {
@@ -604,6 +608,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                         best = (dbic, (first, name), m, o)
         if not accepted(best):
             break
+        if chosen and not _beyond_refinement((best[2], best[3]), chosen, fixed, fit, va):
+            break  # the misfit of the effects chosen, not a further effect
         dbic, name, m, o = best
         chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
@@ -692,9 +698,7 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
         return fit(effects[-1], effects[:-1], kept or None)
 
     def passes(new, old):
-        (m, o), (mb, ob) = new, old
-        return (_bic(va, o, m.k) - _bic(va, ob, mb.k) <= -MIN_BIC_DROP
-                and _errors(va, o)["rms"] <= (1 - MIN_RMS_CUT) * _errors(va, ob)["rms"])
+        return _passes(va, new, old)
 
     cur = (current, cur_out)
     for _ in range(len(EFFECTS)):  # swaps, the best first
@@ -724,6 +728,34 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
             break
         chosen, cur = worst[1], worst[2]
     return chosen, cur[0], cur[1]
+
+
+def _passes(va, new, old) -> bool:
+    """Whether the model and validate outputs ``new`` pass against ``old``: the validate BIC
+    lower by ``MIN_BIC_DROP`` and the validate RMS cut by ``MIN_RMS_CUT``."""
+    (m, o), (mb, ob) = new, old
+    return (_bic(va, o, m.k) - _bic(va, ob, mb.k) <= -MIN_BIC_DROP
+            and _errors(va, o)["rms"] <= (1 - MIN_RMS_CUT) * _errors(va, ob)["rms"])
+
+
+def _beyond_refinement(new, chosen, fixed, fit, va) -> bool:
+    """The second-effect rule: an effect added to ``chosen`` (``new``: its model and validate
+    outputs) must also pass against each chosen effect's own model refined one step, the
+    others held at ``fixed``: ``creep`` with a further lag; ``dynamics`` after the hysteresis
+    searched again beside the others (its base mode was chosen before they were modelled) with
+    one further element of its linear part. So a misfit of one effect is not named as
+    another."""
+    for e in chosen:
+        if e == "creep":
+            refined = {**fixed, "refine": "creep"}
+        elif e == "dynamics" and "wiener" not in fixed:
+            refined = {**{k: x for k, x in fixed.items() if k not in DYNAMICS_KEYS},
+                       "lti_min": len(fixed.get("lti", ())) + 1}
+        else:
+            continue
+        if not _passes(va, new, fit(chosen[-1], chosen[:-1], refined)):
+            return False
+    return True
 
 
 def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):

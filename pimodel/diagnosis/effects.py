@@ -9,7 +9,7 @@ parameters to the nominal model (for the information criterion on the validate r
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -59,12 +59,18 @@ __all__ = [
 
 MODE_HZ = tuple(np.geomspace(300.0, 5000.0, 15))
 MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
+# heavily damped points from lower frequencies: a mode in series with a real pole looks like one
+# damped mode near a Butterworth damping over a band well below both (density_stage below
+# 50 Hz: the best single mode sits at 130-250 Hz, damping 0.5-0.8, off the light grid, and the
+# low-pass element of the linear part, module lti, then started from a poor base mode)
+MODE_HEAVY = (tuple(np.geomspace(100.0, 5000.0, 9)), 0.7)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 DRIFT_CLOCKS = DRIFT_VARIANTS  # t - t[0] of each record, t as given, or a level per record
+REFINED_CREEP_LAG = 10.0  # the refined creep's further lag, this factor beyond the longest
 ASYMMETRY_ITERATIONS = 2  # refits of the asymmetry on the hysteresis part of the previous fit
 
 
@@ -478,7 +484,10 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         Effects chosen in earlier rounds.
     fixed : dict or None
         Their grid parameters (``fn``, ``zeta``, ``d``, ``clock``, ``rate_family``,
-        ``rate_tau``, ``rate_saturation``).
+        ``rate_tau``, ``rate_saturation``). Two keys make an effect's model richer:
+        ``"refine": "creep"``, a further lag ``REFINED_CREEP_LAG`` times the longest;
+        ``"lti_min": n``, at least ``n`` further elements of the linear part
+        (:func:`.lti.select_order`).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -531,6 +540,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
     the grid optimum, then refitted with every play column."""
     name = "+".join(effects)
+    # an effect's own model one step richer, the yardstick a second effect must beat
+    # (pimodel.diagnosis.diagnose): fixed["refine"] = "creep", a further lag;
+    # fixed["lti_min"], at least that many further elements of the linear part
+    lti_min = fixed.pop("lti_min", 0)
+    if fixed.pop("refine", None) == "creep" and "creep" in effects:
+        taus = tuple(nominal.params["creep_taus"])
+        nominal = replace(nominal, params={**nominal.params,
+                                           "creep_taus": (*taus, REFINED_CREEP_LAG * taus[-1])})
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
     static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only (not
@@ -559,7 +576,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             grids.append([{"wiener": fixed["wiener"]}] if "wiener" in fixed else
                          [{"fn": fixed["fn"], "zeta": fixed["zeta"],
                            "lti": fixed.get("lti", ())}] if "fn" in fixed else
-                         [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING])
+                         [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING] +
+                         [{"fn": f, "zeta": MODE_HEAVY[1]} for f in MODE_HEAVY[0] if f <= fmax])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
@@ -681,7 +699,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             lambda fn, zeta, els: search([lti_point(fn, zeta, els)])[1], lti_regressors,
             lambda fn, zeta, el: [_lti_block(s, lti_point(fn, zeta, (el,)), nominal,
                                              static)[s.used, 0] for s in train],
-            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed)
+            p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed,
+            min_elements=lti_min)
         best = search([lti_point(fn, zeta, elements)])
     p = best[0].params  # the grid optimum, refitted with every play column
     k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too
