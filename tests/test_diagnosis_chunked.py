@@ -1,6 +1,7 @@
 """The chunked least squares of the diagnosis (pimodel.diagnosis.chunked) equals the full
 least squares, and a diagnosis of long records stays under a memory limit (issue 31)."""
 
+import importlib
 import subprocess
 import sys
 import textwrap
@@ -70,6 +71,28 @@ def test_nominal_fit_over_chunks_equals_full_least_squares(monkeypatch):
     model = fit_nominal([seg])
     assert np.max(np.abs(A @ model.coef - A @ ref)) < 1e-9 * np.ptp(rec.y)
     assert np.max(np.abs(model.predict(seg) - A @ ref)) < 1e-9 * np.ptp(rec.y)
+
+
+@pytest.mark.parametrize("initial_state", ["rest", "unknown"])
+def test_streamed_plain_fit_equals_fit_on_full_play_outputs(monkeypatch, initial_state):
+    # the grid comparison and the baseline fit stream the play outputs (one chunk held at a
+    # time) and equal the nominal fit on the segments that hold them all, masked samples too
+    dg = importlib.import_module("pimodel.diagnosis.diagnose")  # not the function it exports
+
+    monkeypatch.setattr(chunks, "__defaults__", (311,))
+    truth = random_truth(["dynamics"], 5)
+    recs = [truth.record(*excitation(kind, seed=6), 6) for kind in ("train", "validate")]
+    radii = np.linspace(0.0, np.ptp(recs[0].v) / 2, 9)
+    for at_rest in (True, False):
+        segs, coef = dg._plain_fit(recs, radii, initial_state, at_rest)
+        full = dg._segments(recs, radii, initial_state, at_rest)
+        model = fit_nominal(full)
+        scale = np.ptp(recs[0].y)
+        for s, f, o in zip(segs, full, dg._plain_outputs(segs, radii, coef, at_rest),
+                           strict=True):
+            assert s.Z is None and (s.mask is None) == (initial_state != "unknown")
+            assert np.max(np.abs(o - model.predict(f))) < 1e-9 * scale
+        assert np.max(np.abs(coef - model.coef)) < 1e-6 * np.max(np.abs(model.coef))
 
 
 def test_chunks_reject_bad_sizes():

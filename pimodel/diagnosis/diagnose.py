@@ -47,11 +47,20 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
-from .chunked import chunks
+from .chunked import NormalEquations, chunks
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
-from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment, segment_of_rows
+from .effects import (
+    EFFECTS,
+    Model,
+    Segment,
+    fit_effect,
+    fit_nominal,
+    make_segment,
+    play_chunks,
+    segment_of_rows,
+)
 from .noise import measure_noise_floor
 from .rate import RateBasis
 from .where import residual_breakdown, startup_length
@@ -310,14 +319,44 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
                          progress or (lambda message: None))
 
 
+def _mask(r: Record, initial_state: str) -> np.ndarray | None:
+    return np.arange(len(r)) >= startup_length(r.v) if initial_state == "unknown" else None
+
+
 def _segments(records: list[Record], radii, initial_state: str,
               at_rest: bool = True) -> list[Segment]:
+    return [make_segment(r.t, r.v, r.y, radii, _mask(r, initial_state), at_rest=at_rest)
+            for r in records]
+
+
+def _plain_fit(records: list[Record], radii, initial_state: str,
+               at_rest: bool = True) -> tuple[list[Segment], np.ndarray]:
+    """The PI fit (play weights and an offset) that :func:`.effects.fit_nominal` makes, in one
+    pass over the records with one chunk of play outputs at a time (:func:`.effects.play_chunks`
+    into :class:`.chunked.NormalEquations`): nothing of size (samples x plays) is kept. Returns
+    the records as segments without play outputs (``Z`` is None; for :func:`_errors` and
+    :func:`_bic`) and the coefficients."""
+    segs = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in records]
+    ne = NormalEquations(np.size(radii) + 1)
+    for s in segs:
+        for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
+            if s.mask is None:
+                ne.add(rows, s.y[c])
+            else:
+                ne.add(rows[:, s.mask[c]], s.y[c][s.mask[c]])
+    return segs, ne.solve()
+
+
+def _plain_outputs(segs: list[Segment], radii, coef: np.ndarray,
+                   at_rest: bool = True) -> list[np.ndarray]:
+    """The output ``coef @ [z; 1]`` of the PI fit :func:`_plain_fit` at every sample of each
+    segment, a second pass with one chunk of play outputs at a time."""
     out = []
-    for r in records:
-        mask = None
-        if initial_state == "unknown":
-            mask = np.arange(len(r)) >= startup_length(r.v)
-        out.append(make_segment(r.t, r.v, r.y, radii, mask, at_rest=at_rest))
+    for s in segs:
+        o = np.empty(s.v.size)
+        for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
+            o[c] = coef @ rows
+        out.append(o)
     return out
 
 
@@ -357,34 +396,34 @@ def _nominal(train, validate, initial_state):
     half, extended = _grids(train)
     if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
         half, extended = [], []
-    picks = []
+    picks = []  # the grids are compared by fits streamed over the records (_plain_fit)
     for at_rest, grids in ((True, half), (True, extended), (False, _grids(train)[0])):
         best = None
         for radii in grids:
-            tr = _segments(train, radii, initial_state, at_rest)
-            model = fit_nominal(tr)
-            bic = _bic(tr, [model.predict(s) for s in tr], radii.size + 1)
+            segs, coef = _plain_fit(train, radii, initial_state, at_rest)
+            bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1)
             if best is None or bic < best[0]:
-                best = (bic, radii, None, model, at_rest)
-            del tr  # one grid's play outputs at a time (rebuilt for the pick below)
+                best = (bic, radii, coef, at_rest)
         picks.append(best)
     if picks[0] is None:
-        _, radii, _, model, at_rest = picks[2]
+        _, radii, _, at_rest = picks[2]
         tr = _segments(train, radii, initial_state, False)
-        return radii, tr, _segments(validate, radii, initial_state, False), model, False, False
+        return (radii, tr, _segments(validate, radii, initial_state, False), fit_nominal(tr),
+                False, False)
     if picks[1] is not None:  # the extension: kept only when validate agrees
         vbic = []
-        for _, radii, _tr, model, at_rest in picks[:2]:
-            va = _segments(validate, radii, initial_state, at_rest)
-            vbic.append(_bic(va, [model.predict(s) for s in va], radii.size + 1))
+        for _, radii, coef, at_rest in picks[:2]:
+            va = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
+            vbic.append(_bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1))
         if vbic[1] >= vbic[0]:
             picks[1] = None
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
-    _, radii, _, model, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
+    _, radii, _, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
     ext = ext and at_rest
-    tr = _segments(train, radii, initial_state, at_rest)  # again: cheaper than keeping all
-    return radii, tr, _segments(validate, radii, initial_state, at_rest), model, ext, at_rest
+    tr = _segments(train, radii, initial_state, at_rest)  # the pick's play outputs only
+    return (radii, tr, _segments(validate, radii, initial_state, at_rest), fit_nominal(tr), ext,
+            at_rest)
 
 
 def _baseline(train, validate, initial_state) -> dict:
@@ -393,12 +432,11 @@ def _baseline(train, validate, initial_state) -> dict:
     offset, fitted on the same (masked) train samples; its train and validate errors."""
     vmax = max(float(np.max(np.abs(r.v))) for r in train)
     radii = np.linspace(0.0, vmax, BASELINE_PLAYS)
-    tr = _segments(train, radii, initial_state)
-    va = _segments(validate, radii, initial_state)
-    model = fit_nominal(tr)
+    tr, coef = _plain_fit(train, radii, initial_state)  # streamed: no 60 play columns kept
+    va = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
     return {"kind": "PI, plain least squares", "plays": BASELINE_PLAYS, "max_radius": vmax,
-            "train": _errors(tr, [model.predict(s) for s in tr]),
-            "validate": _errors(va, [model.predict(s) for s in va])}
+            "train": _errors(tr, _plain_outputs(tr, radii, coef)),
+            "validate": _errors(va, _plain_outputs(va, radii, coef))}
 
 
 def _compressed(tr, va, nominal: Model):

@@ -9,6 +9,7 @@ parameters to the nominal model (for the information criterion on the validate r
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,6 +35,7 @@ __all__ = [
     "mode_coefficients",
     "mode_rows",
     "Model",
+    "play_chunks",
     "Segment",
     "segment_of_rows",
     "shift",
@@ -174,14 +176,45 @@ def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
     """
     radii = np.asarray(radii, float)
     v = np.asarray(v, float)
-    z0 = float(v[0]) if at_rest else 0.0
-    op = PIOperator(np.ones(radii.size), radii, initial_state=z0)
     rows = np.empty((radii.size + 1, np.size(v)))
-    state = None
-    for c in chunks(rows.shape[1]):  # the plays chunk by chunk, their states carried over
-        Zc = op.play_outputs(v[c], state=state)
-        rows[:-1, c], state = Zc.T, Zc[-1]
+    for c, rc in play_chunks(v, radii, at_rest=at_rest):
+        rows[:-1, c] = rc[:-1]
     return segment_of_rows(t, v, y, rows, mask)
+
+
+def play_chunks(v, radii, *, at_rest: bool = True) -> Iterator[tuple[slice, np.ndarray]]:
+    """The play outputs of ``radii`` chunk by chunk (:func:`~.chunked.chunks`), their states
+    carried over from one chunk to the next, so a pass over a record holds one chunk of them.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        Input ``v[k]``.
+    radii : array_like
+        Play radii [input units], ``n`` of them.
+    at_rest : bool
+        Plays at rest at ``v[0]`` before the first sample (default); False: at 0.
+
+    Returns
+    -------
+    iterator of (slice, numpy.ndarray)
+        The chunk's samples ``c`` and its rows ``[z_1[c]; ...; z_n[c]; 1]``, shape
+        (n + 1, len(c)): the play outputs after each sample and a row of ones (the offset).
+
+    Examples
+    --------
+    >>> [rows.tolist() for _, rows in play_chunks(np.array([0.0, 1.0, 0.5]), [0.5])]
+    [[[0.0, 0.5, 0.5], [1.0, 1.0, 1.0]]]
+    """
+    radii = np.asarray(radii, float)
+    v = np.asarray(v, float)
+    op = PIOperator(np.ones(radii.size), radii, initial_state=float(v[0]) if at_rest else 0.0)
+    state = None
+    for c in chunks(v.size):
+        Zc = op.play_outputs(v[c], state=state)
+        rows = np.empty((radii.size + 1, Zc.shape[0]))
+        rows[:-1], rows[-1], state = Zc.T, 1.0, Zc[-1]
+        yield c, rows
 
 
 def segment_of_rows(t, v, y, rows: np.ndarray, mask=None) -> Segment:
