@@ -8,6 +8,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from scipy.signal import lfilter
 
 from pimodel.diagnosis.chunked import ChunkedQR, NormalEquations, chunks
 from pimodel.diagnosis.effects import fit_nominal, make_segment
@@ -166,3 +167,26 @@ def test_progress_reports_the_stages_and_shows_only_on_a_terminal():
     assert [m for m in messages if m.startswith("candidate")][-1] == "candidate rate (6/6)"
     assert stream.text.count("\r") == len(messages)
     assert "candidate creep (1/6)" in stream.text
+
+
+def test_screened_search_finds_the_mode_of_the_whole_record(monkeypatch):
+    # a record longer than SCREEN_SAMPLES: the mode and order are searched on its first
+    # samples and confirmed on the whole; the fit matches the unscreened one
+    import pimodel.diagnosis.effects as effects
+
+    dt, rng = 1e-4, np.random.default_rng(7)
+    v = np.repeat(rng.uniform(-1, 1, 10), 900)
+    v = v - v[0] + 0.3 * np.sin(2 * np.pi * 7 * np.arange(v.size) * dt)  # from rest at 0
+    b, a = effects.mode_coefficients(700.0, 0.08, dt)
+    y = lfilter(b, a, 2.0 * v) + rng.normal(0, 1e-3, v.size)
+    seg = make_segment(np.arange(v.size) * dt, v, y, [0.0, 0.2])
+    fits = {}
+    for screen in (v.size, 3000):
+        monkeypatch.setattr(effects, "SCREEN_SAMPLES", screen)
+        used = effects._screen([seg], ("dynamics",), {})
+        assert (used[0] is seg) == (screen >= v.size) and used[0].y.size == min(screen, v.size)
+        m = effects.fit_effect("dynamics", [seg])
+        fits[screen] = (m.grid["fn"], float(np.sum((m.predict(seg) - y) ** 2)))
+    assert abs(fits[3000][0] / 700.0 - 1) < 0.03 and abs(fits[v.size][0] / 700.0 - 1) < 0.03
+    assert fits[3000][1] <= 1.05 * fits[v.size][1]
+    assert effects._screen([seg], ("rate",), {}) == [seg]  # per-record bases: never screened

@@ -46,6 +46,8 @@ MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
+SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
+SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 DRIFT_CLOCKS = DRIFT_VARIANTS  # t - t[0] of each record, t as given, or a level per record
@@ -557,10 +559,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     dyn_fixed = "fn" in fixed or "wiener" in fixed
     ncols = SEARCH_COLUMNS if "dynamics" in effects and not dyn_fixed else None
 
+    full, train = train, _screen(train, effects, fixed)  # the searches on the screen
+    tried: list = []  # (train RSS, grid point) of the first search, for the confirmation
+
     def search(points, best=None):
         for p in points:
             model, rss = _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
                               train, p)
+            tried.append((rss, p))
             if best is None or rss < best[1]:
                 best = (model, rss)
         return best
@@ -590,6 +596,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
     best = search(points)
+    grid_tried = sorted(tried, key=lambda rp: rp[0])[:SCREEN_CONFIRM]
     if "rate" in effects and "rate_tau" not in fixed:
         # the rate family and filter (the other grid parameters held): the filter's grid,
         # then geometric steps around the best positive time constant
@@ -662,6 +669,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                                              static)[s.used, 0] for s in train],
             p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed)
         best = search([lti_point(fn, zeta, elements)])
+    if train is not full:  # screened: the searched point against the grid's best, whole
+        train = full
+        best = _confirm(search, k, [best[0].params, *(q for _, q in grid_tried)], train)
     p = best[0].params  # the grid optimum, refitted with every play column
     k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too
     if p.get("wiener"):  # a filter's parameters instead of the base mode's two
@@ -708,6 +718,41 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                                                                            seg.mask)
         model.adjust = with_level
     return model
+
+
+def _screen(train, effects: tuple[str, ...], fixed: dict) -> list:
+    """The train records the searches of :func:`_fit_combo` run on: the first ``SCREEN_SAMPLES``
+    samples of each (:func:`_prefix`) when a record is longer and a mode or a delay is
+    searched (not with the rate's or the drift's per-record columns, nor a filter before the
+    hysteresis held); else ``train`` itself. A search costs a pass over the screen per point;
+    its result is confirmed on the whole records (:func:`_confirm`)."""
+    searched = ("dynamics" in effects and not {"fn", "wiener"} & set(fixed)) or \
+        ("delay" in effects and "d" not in fixed)
+    if not searched or {"rate", "drift"} & set(effects) or "wiener" in fixed or \
+            all(s.y.size <= SCREEN_SAMPLES for s in train):
+        return train
+    return [_prefix(s, SCREEN_SAMPLES) for s in train]
+
+
+def _prefix(s: Segment, m: int) -> Segment:
+    """The first ``m`` samples of ``s`` (its play rows copied; no rate or Wiener basis)."""
+    rows = np.array(s.play_rows(offset=True)[:, :m], order="C")
+    return segment_of_rows(s.t[:m], s.v[:m], s.y[:m], rows,
+                           None if s.mask is None else s.mask[:m])
+
+
+def _confirm(search, k: int, points: list[dict], train) -> tuple:
+    """The point of ``points`` (the screen's searched optimum, then its best grid points)
+    with the lowest BIC on the whole ``train`` records (the linear part's elements counted,
+    ``lti_k``), as ``search`` returns it: (model, train RSS). One fit per point."""
+    n = sum(s.y[s.used].size for s in train)
+    best = None
+    for p in points:
+        model, rss = search([p])
+        bic = n * np.log(max(rss, 1e-300)) + (k + lti_k(p.get("lti", ()))) * np.log(n)
+        if best is None or bic < best[0]:
+            best = (bic, model, rss)
+    return best[1], best[2]
 
 
 def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
