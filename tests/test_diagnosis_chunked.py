@@ -85,7 +85,8 @@ def test_streamed_plain_fit_equals_fit_on_full_play_outputs(monkeypatch, initial
     recs = [truth.record(*excitation(kind, seed=6), 6) for kind in ("train", "validate")]
     radii = np.linspace(0.0, np.ptp(recs[0].v) / 2, 9)
     for at_rest in (True, False):
-        segs, coef = dg._plain_fit(recs, radii, initial_state, at_rest)
+        segs, ne = dg._plain_fit(recs, radii, initial_state, at_rest)
+        coef = ne.solve()
         full = dg._segments(recs, radii, initial_state, at_rest)
         model = fit_nominal(full)
         scale = np.ptp(recs[0].y)

@@ -47,7 +47,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
-from .chunked import NormalEquations, chunks
+from .chunked import NormalEquations
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
@@ -55,9 +55,11 @@ from .effects import (
     EFFECTS,
     Model,
     Segment,
+    base_features,
     fit_effect,
     fit_nominal,
     make_segment,
+    nominal_params,
     play_chunks,
     segment_of_rows,
 )
@@ -73,6 +75,7 @@ __all__ = [
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
 BASELINE_PLAYS = 60  # plays of the plain least-squares baseline (0 to max |v| of train)
+PROJECTED = 32  # principal directions of the play outputs kept beside the nominal's weights
 BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor of the baseline's
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
 MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
@@ -330,12 +333,13 @@ def _segments(records: list[Record], radii, initial_state: str,
 
 
 def _plain_fit(records: list[Record], radii, initial_state: str,
-               at_rest: bool = True) -> tuple[list[Segment], np.ndarray]:
+               at_rest: bool = True) -> tuple[list[Segment], NormalEquations]:
     """The PI fit (play weights and an offset) that :func:`.effects.fit_nominal` makes, in one
     pass over the records with one chunk of play outputs at a time (:func:`.effects.play_chunks`
     into :class:`.chunked.NormalEquations`): nothing of size (samples x plays) is kept. Returns
     the records as segments without play outputs (``Z`` is None; for :func:`_errors` and
-    :func:`_bic`) and the coefficients."""
+    :func:`_bic`) and the normal equations (``solve()`` gives the coefficients, ``G`` the Gram
+    matrix of the plays and the offset on the fitted samples)."""
     segs = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in records]
     ne = NormalEquations(np.size(radii) + 1)
     for s in segs:
@@ -344,7 +348,7 @@ def _plain_fit(records: list[Record], radii, initial_state: str,
                 ne.add(rows, s.y[c])
             else:
                 ne.add(rows[:, s.mask[c]], s.y[c][s.mask[c]])
-    return segs, ne.solve()
+    return segs, ne
 
 
 def _plain_outputs(segs: list[Segment], radii, coef: np.ndarray,
@@ -381,7 +385,7 @@ def _grids(train) -> tuple[list[np.ndarray], list[np.ndarray]]:
 
 
 def _nominal(train, validate, initial_state):
-    """The radius grid with the lowest train BIC and its fitted nominal model.
+    """The radius grid with the lowest train BIC (its nominal: :func:`_nominal_segments`).
 
     The half-range grids and the extended grids (:func:`_grids`) each give the one with the
     lowest train BIC; the extended one is kept only when it also has the lower validate BIC
@@ -389,9 +393,9 @@ def _nominal(train, validate, initial_state):
     start is not at rest they fit that start and mispredict every other record's). The plays
     start at rest at ``v[0]``, or at 0 when that has the lower train BIC (a record cut from
     periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0). Returns
-    the radii, the train and validate segments, the model, whether the grid is extended and
-    whether the plays start at rest at ``v[0]``. With ``initial_state="unknown"`` (the
-    start-up is not fitted) the plays start at 0 on the half-range grids, as before issue 33
+    the radii, whether the grid is extended and whether the plays start at rest at ``v[0]``.
+    With ``initial_state="unknown"`` (the start-up is not fitted) the plays start at 0 on the
+    half-range grids, as before issue 33
     (from ``v[0]`` the shared real record's validate gap was 0.154 um against 0.048 um noise)."""
     half, extended = _grids(train)
     if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
@@ -400,16 +404,14 @@ def _nominal(train, validate, initial_state):
     for at_rest, grids in ((True, half), (True, extended), (False, _grids(train)[0])):
         best = None
         for radii in grids:
-            segs, coef = _plain_fit(train, radii, initial_state, at_rest)
+            segs, ne = _plain_fit(train, radii, initial_state, at_rest)
+            coef = ne.solve()
             bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1)
             if best is None or bic < best[0]:
                 best = (bic, radii, coef, at_rest)
         picks.append(best)
     if picks[0] is None:
-        _, radii, _, at_rest = picks[2]
-        tr = _segments(train, radii, initial_state, False)
-        return (radii, tr, _segments(validate, radii, initial_state, False), fit_nominal(tr),
-                False, False)
+        return picks[2][1], False, False
     if picks[1] is not None:  # the extension: kept only when validate agrees
         vbic = []
         for _, radii, coef, at_rest in picks[:2]:
@@ -420,10 +422,7 @@ def _nominal(train, validate, initial_state):
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
     _, radii, _, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
-    ext = ext and at_rest
-    tr = _segments(train, radii, initial_state, at_rest)  # the pick's play outputs only
-    return (radii, tr, _segments(validate, radii, initial_state, at_rest), fit_nominal(tr), ext,
-            at_rest)
+    return radii, ext and at_rest, at_rest
 
 
 def _baseline(train, validate, initial_state) -> dict:
@@ -432,65 +431,54 @@ def _baseline(train, validate, initial_state) -> dict:
     offset, fitted on the same (masked) train samples; its train and validate errors."""
     vmax = max(float(np.max(np.abs(r.v))) for r in train)
     radii = np.linspace(0.0, vmax, BASELINE_PLAYS)
-    tr, coef = _plain_fit(train, radii, initial_state)  # streamed: no 60 play columns kept
+    tr, ne = _plain_fit(train, radii, initial_state)  # streamed: no 60 play columns kept
+    coef = ne.solve()
     va = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
     return {"kind": "PI, plain least squares", "plays": BASELINE_PLAYS, "max_radius": vmax,
             "train": _errors(tr, _plain_outputs(tr, radii, coef)),
             "validate": _errors(va, _plain_outputs(va, radii, coef))}
 
 
-def _compressed(tr, va, nominal: Model):
-    """Segments whose play columns are replaced by a few combinations (the nominal's own
-    weights, then the leading principal directions of the train play outputs), as few as keep
-    the nominal train RSS within 1 %; the candidates' grid searches filter these columns only.
-    Returns the new segments, the nominal refitted on them (with the full model's
-    ``params``) and the projection ``V`` (play columns = ``Z @ V``; None: not compressed)."""
-    n = tr[0].Z.shape[1]
-    G = sum(_play_gram(s) for s in tr)
-    _, vecs = np.linalg.eigh(G)
-    w = nominal.coef[:n]
-    rss_full = sum(float(np.sum((nominal.predict(s) - s.y)[s.used] ** 2)) for s in tr)
-    for q in (32, n):
-        if q >= n:
-            return tr, va, nominal, None
-        V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :q]))
-        ctr = [_projected(s, V) for s in tr]
+def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool):
+    """The nominal on the chosen grid and the segments the candidates are fitted on, the play
+    outputs streamed (:func:`_plain_fit`): the nominal's train and validate outputs, then its
+    play columns replaced by a few combinations (the nominal's own weights, then the 32 leading
+    principal directions of the train play outputs, from the Gram matrix of the same pass)
+    when they keep the nominal train RSS within 1 %; the candidates' grid searches filter these
+    columns only. The projected rows are built chunk by chunk, so the full (samples x plays)
+    outputs are never held; without a projection (20 plays, or a worse RSS) the segments hold
+    them. Returns the train and validate segments, the nominal fitted on them (with the full
+    model's ``params``), the full nominal, the projection ``V`` (play columns = ``Z @ V``;
+    None: not compressed) and the full nominal's train and validate outputs."""
+    n = radii.size
+    segs, ne = _plain_fit(train, radii, initial_state, at_rest)
+    coef = ne.solve()
+    out_tr = _plain_outputs(segs, radii, coef, at_rest)
+    full = Model("nominal", 0, base_features, coef, nominal_params(coef, out_tr, segs))
+    vsegs = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
+    out_va = _plain_outputs(vsegs, radii, coef, at_rest)
+    if n > PROJECTED:
+        rss_full = sum(float(np.sum((o - s.y)[s.used] ** 2)) for s, o in zip(segs, out_tr,
+                                                                              strict=True))
+        _, vecs = np.linalg.eigh(ne.G[:n, :n])
+        w = coef[:n]
+        V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
+        ctr = [_projected(s, radii, V, at_rest) for s in segs]
         m = fit_nominal(ctr)
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
         if rss <= 1.01 * rss_full:
-            m.params = dict(nominal.params)
-            for s in tr:
-                _drop_plays(s)
-            cva = []
-            for s in va:  # one record's full play outputs at a time
-                cva.append(_projected(s, V))
-                _drop_plays(s)
-            return ctr, cva, m, V
-    return tr, va, nominal, None
+            m.params = dict(full.params)
+            return (ctr, [_projected(s, radii, V, at_rest) for s in vsegs], m, full, V,
+                    out_tr, out_va)
+    return (_segments(train, radii, initial_state, at_rest),
+            _segments(validate, radii, initial_state, at_rest), full, full, None, out_tr, out_va)
 
 
-def _play_gram(s: Segment) -> np.ndarray:
-    """``Z^T Z`` over the fitted samples of ``s``, chunk by chunk."""
-    P = s.play_rows()
-    G = np.zeros((P.shape[0], P.shape[0]))
-    for c in chunks(s.y.size):
-        X = P[:, c] if s.mask is None else P[:, c][:, s.mask[c]]
-        G += X @ X.T
-    return G
-
-
-def _drop_plays(s: Segment) -> None:
-    """Free the play outputs of a segment replaced by its projection (its ``Z`` is None)."""
-    s.__dict__.pop("_rows", None)
-    s.Z = None
-
-
-def _projected(s: Segment, V: np.ndarray) -> Segment:
-    """The segment with play columns ``Z V``, built chunk by chunk as rows."""
+def _projected(s: Segment, radii, V: np.ndarray, at_rest: bool) -> Segment:
+    """The segment with play columns ``Z V``, built chunk by chunk as rows from the input."""
     rows = np.empty((V.shape[1] + 1, s.y.size))
-    P = s.play_rows()
-    for c in chunks(s.y.size):
-        np.matmul(V.T, P[:, c], out=rows[:-1, c])
+    for c, P in play_chunks(s.v, radii, at_rest=at_rest):
+        np.matmul(V.T, P[:-1], out=rows[:-1, c])
     return segment_of_rows(s.t, s.v, s.y, rows, s.mask)
 
 
@@ -505,13 +493,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                              f"({dts[0][1]:g} s); resample the records to one sample time")
     dt = dts[0][1]
     progress("nominal model (radius grids)")
-    radii, tr, va, nominal, extended, at_rest = _nominal(train, validate, initial_state)
+    radii, extended, at_rest = _nominal(train, validate, initial_state)
     n_plays = radii.size
-    out_tr = [nominal.predict(s) for s in tr]
-    out_va = [nominal.predict(s) for s in va]
+    tr, va, nominal, full_nominal, proj, out_tr, out_va = _nominal_segments(
+        train, validate, radii, initial_state, at_rest)
     before = _errors(va, out_va)
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
-                              "weights": nominal.coef[:n_plays], "offset": nominal.coef[n_plays],
+                              "weights": full_nominal.coef[:n_plays],
+                              "offset": full_nominal.coef[n_plays],
                               "grid_sizes_tried": list(GRID_SIZES),
                               "grid_extended": extended,
                               "plays_start": "at rest at v[0]" if at_rest else "at 0"},
@@ -525,8 +514,6 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       "report.nominal['baseline']): the effects are measured against a weak "
                       "nominal", UserWarning, stacklevel=3)
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
-    full_nominal = nominal
-    tr, va, nominal, proj = _compressed(tr, va, nominal)
     segs = tr + va
     # the rate columns from the full play outputs (computed chunk by chunk from the input
     # when needed), weighted as the model will hold them

@@ -35,6 +35,7 @@ __all__ = [
     "mode_coefficients",
     "mode_rows",
     "Model",
+    "nominal_params",
     "play_chunks",
     "Segment",
     "segment_of_rows",
@@ -469,15 +470,22 @@ def fit_nominal(train) -> Model:
     0.0
     """
     model = _fit("nominal", 0, base_features, train)[0]
-    h = np.concatenate([model.predict(s) for s in train])
+    model.params = nominal_params(model.coef, [model.predict(s) for s in train], train)
+    return model
+
+
+def nominal_params(coef: np.ndarray, outputs: list, train) -> dict:
+    """The ``params`` of a nominal model (:func:`fit_nominal`) with coefficients ``coef`` (play
+    weights, then the offset) and outputs ``outputs`` (one array per train record, every
+    sample) on the ``train`` segments (their ``t`` and ``v`` are read)."""
+    h = np.concatenate(outputs)
     rate = np.concatenate([np.abs(np.diff(s.v)) / s.dt for s in train])
     moving = rate[rate > 1e-9 * (float(np.ptp(rate)) or 1.0)]
-    model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
-                    "slope_sum": float(np.sum(model.coef[:-1])),
-                    "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0,
-                    "creep_taus": creep_time_constants(
-                        train[0].dt, max(float(s.t[-1] - s.t[0]) for s in train))}
-    return model
+    return {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
+            "slope_sum": float(np.sum(coef[:-1])),
+            "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0,
+            "creep_taus": creep_time_constants(
+                train[0].dt, max(float(s.t[-1] - s.t[0]) for s in train))}
 
 
 def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None = None,
