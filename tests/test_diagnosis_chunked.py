@@ -97,6 +97,27 @@ def test_streamed_plain_fit_equals_fit_on_full_play_outputs(monkeypatch, initial
         assert np.max(np.abs(coef - model.coef)) < 1e-6 * np.max(np.abs(model.coef))
 
 
+def test_nominal_segments_project_streamed_plays_as_the_full_ones(monkeypatch):
+    # the candidates' segments hold Z V built chunk by chunk from the input, with the nominal
+    # refitted on them; the full nominal's outputs equal those of the full play outputs
+    dg = importlib.import_module("pimodel.diagnosis.diagnose")
+    monkeypatch.setattr(chunks, "__defaults__", (509,))
+    truth = random_truth(["creep"], 8)
+    recs = [truth.record(*excitation(kind, seed=9), 9) for kind in ("train", "validate")]
+    radii = np.linspace(0.0, np.ptp(recs[0].v) / 2, 40)
+    tr, va, nominal, full, V, out_tr, out_va = dg._nominal_segments(
+        recs[:1], recs[1:], radii, "rest", True)
+    assert V is not None and V.shape == (40, dg.PROJECTED + 1)
+    ref = dg._segments(recs, radii, "rest", True)
+    model = fit_nominal(ref[:1])
+    for s, r, o in zip(tr + va, ref, out_tr + out_va, strict=True):
+        scale = np.ptp(r.y)
+        assert np.max(np.abs(s.Z - r.Z @ V)) < 1e-9 * np.max(np.abs(r.Z))
+        assert np.max(np.abs(o - model.predict(r))) < 1e-9 * scale
+    assert np.max(np.abs(nominal.predict(tr[0]) - out_tr[0])) < 0.05 * np.ptp(recs[0].y)
+    assert nominal.params == full.params and set(full.params) == set(model.params)
+
+
 def test_chunks_reject_bad_sizes():
     with pytest.raises(ValueError, match="size"):
         list(chunks(10, 0))
