@@ -475,9 +475,30 @@ def fit_nominal(train) -> Model:
 
 
 def nominal_params(coef: np.ndarray, outputs: list, train) -> dict:
-    """The ``params`` of a nominal model (:func:`fit_nominal`) with coefficients ``coef`` (play
-    weights, then the offset) and outputs ``outputs`` (one array per train record, every
-    sample) on the ``train`` segments (their ``t`` and ``v`` are read)."""
+    """The ``params`` of a nominal model (:func:`fit_nominal`) from its fit.
+
+    Parameters
+    ----------
+    coef : numpy.ndarray
+        Play weights, then the offset.
+    outputs : list of numpy.ndarray
+        The model output on each train record, every sample.
+    train : list of Segment
+        The train records (their ``t`` and ``v`` are read).
+
+    Returns
+    -------
+    dict
+        ``center``, ``half_range``, ``slope_sum``, ``rate_scale``, ``creep_taus`` as
+        :func:`fit_nominal` describes them.
+
+    Examples
+    --------
+    >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.0]), np.zeros(3), [0.0])
+    >>> p = nominal_params(np.array([2.0, 0.0]), [np.array([0.0, 2.0, 0.0])], [seg])
+    >>> p["center"], p["half_range"], p["slope_sum"], p["rate_scale"]
+    (0.6666666666666666, 1.0, 2.0, 1000.0)
+    """
     h = np.concatenate(outputs)
     rate = np.concatenate([np.abs(np.diff(s.v)) / s.dt for s in train])
     moving = rate[rate > 1e-9 * (float(np.ptp(rate)) or 1.0)]
