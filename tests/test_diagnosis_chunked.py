@@ -1,5 +1,7 @@
 """The chunked least squares of the diagnosis (pimodel.diagnosis.chunked) equals the full
-least squares, and a diagnosis of long records stays under a memory limit (issue 31)."""
+least squares, the streamed nominal and baseline fits equal the fits on full play outputs,
+a screened search finds the whole record's mode, and a diagnosis of long records stays under
+a memory limit (issue 31)."""
 
 import importlib
 import subprocess
