@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import bisect
 import csv
+import io
 import warnings
 import zipfile
 from collections.abc import Callable, Mapping
@@ -43,6 +44,7 @@ __all__ = [
 DEFAULT_COLUMNS = ("t", "v", "y")
 SAMPLING_TOLERANCE = 0.01  # largest relative deviation of a sample interval from the median
 CHUNK_ROWS = 1 << 16  # CSV rows parsed per block (bounds the Python objects alive at once)
+FAST_BLOCK_BYTES = 1 << 23  # bytes of a regular CSV file parsed per block by NumPy (8 MiB)
 
 
 class DataError(ValueError):
@@ -430,7 +432,68 @@ def _ends_with_newline(path: Path) -> bool:
         return fh.read(1) in (b"\n", b"\r")
 
 
+def _fast_csv(path: Path) -> tuple[list[str], list[np.ndarray], _Lines] | None:
+    """A regular CSV file read by NumPy's C reader (``numpy.loadtxt``), block by block of
+    bytes: a comma header without a trailing separator, then lines of exactly one number per
+    column, no blank line, a line end after the last. Returns None at the first departure from
+    that (the file is then read by :func:`_parse_csv`, whose messages name the line), so both
+    readers give the same record; memory: the columns plus one block of ``FAST_BLOCK_BYTES``."""
+    with path.open("rb") as fh:
+        first = fh.readline()
+        if not first.endswith(b"\n") or b"," not in first:
+            return None
+        try:
+            text = first.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            return None
+        header = [h.strip() for h in next(csv.reader([text]))]
+        if not all(header) or not _ends_with_newline(path):
+            return None
+        width, size, table = len(header), path.stat().st_size, None
+        rest = b""
+        while True:
+            data = fh.read(FAST_BLOCK_BYTES)
+            buf = rest + data
+            end = buf.rfind(b"\n") + 1 if data else len(buf)
+            block, rest = buf[:end], buf[end:]
+            if block:
+                parsed = _fast_block(block, width)
+                if parsed is None:
+                    return None
+                if table is None:  # rows in the file as the first block has them
+                    table = _Columns(width, int(1.05 * size * len(parsed) / len(block)) + 16)
+                table.add(parsed)
+            if not data:
+                break
+    if table is None:
+        return None
+    lines = _Lines()
+    lines.mark(0, 2)  # no blank line: data row k (0-based) is on line k + 2
+    return header, table.finish(), lines
+
+
+def _fast_block(block: bytes, width: int) -> np.ndarray | None:
+    """Rows of ``width`` numbers from whole lines of bytes (``numpy.loadtxt``, C-parsed), or None
+    when a line is empty or has another number of commas, or a field is not a number."""
+    raw = np.frombuffer(block, np.uint8)
+    ends = np.flatnonzero(raw == 10)
+    per_line = np.diff(np.searchsorted(np.flatnonzero(raw == 44), ends), prepend=0)
+    starts = np.concatenate(([0], ends[:-1] + 1))
+    if np.any(per_line != width - 1) or np.any(ends - starts < 1) or \
+            np.any((ends - starts == 1) & (raw[starts] == 13)):
+        return None
+    try:
+        values = np.loadtxt(io.BytesIO(block), delimiter=",", comments=None, ndmin=2,
+                            dtype=float, encoding="utf-8")
+    except ValueError:
+        return None
+    return values if values.shape == (ends.size, width) else None
+
+
 def _read_csv(path: Path) -> tuple[list[str], list[np.ndarray], _Lines]:
+    fast = _fast_csv(path)
+    if fast is not None:
+        return fast
     try:
         with path.open(newline="", encoding="utf-8-sig") as fh:  # a UTF-8 BOM is accepted
             first = fh.readline()
@@ -528,7 +591,25 @@ def _parse_block(path: Path, block: list[list[str]], block_lines: list[int], hea
                     "numbers")  # pragma: no cover - every row was checked above
 
 
-def _read_npz(path: Path) -> dict[str, np.ndarray]:
+def _npz_shape(npz, key: str) -> tuple[int, ...] | None:
+    """The shape of array ``key`` of an open ``.npz`` from its header alone (nothing else is
+    read); None when it is not a ``.npy`` member of format 1.0 or 2.0 (it is then read whole)."""
+    fmt = np.lib.format
+    if key + ".npy" not in npz.zip.namelist():
+        return None
+    with npz.zip.open(key + ".npy") as fh:
+        version = fmt.read_magic(fh)
+        if version not in ((1, 0), (2, 0)):
+            return None
+        read = fmt.read_array_header_1_0 if version == (1, 0) else fmt.read_array_header_2_0
+        return read(fh)[0]
+
+
+def _read_npz(path: Path, columns: tuple[str, str, str]
+              ) -> tuple[list[str], dict[str, np.ndarray]]:
+    """The names of the arrays and, read one by one, the chosen columns and the arrays of as
+    many elements as the time column (the candidates for ``Record.extra``); other arrays (a
+    long matrix, another record's vectors) are not read."""
     with path.open("rb") as fh:
         magic = fh.read(4)
     if magic[:2] != b"PK":
@@ -538,7 +619,11 @@ def _read_npz(path: Path) -> dict[str, np.ndarray]:
         raise DataError(f"{path}: not a valid .npz file: it {kind}")
     try:
         with np.load(path, allow_pickle=False) as npz:
-            return {k: npz[k] for k in npz.files}
+            shapes = {k: _npz_shape(npz, k) for k in npz.files}
+            n = int(np.prod(shapes[columns[0]])) if shapes.get(columns[0]) else None
+            wanted = [k for k, shape in shapes.items() if k in columns or shape is None
+                      or (len(shape) in (1, 2) and int(np.prod(shape)) == n)]
+            return list(npz.files), {k: npz[k] for k in wanted}  # one column at a time
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, KeyError) as exc:
         raise DataError(f"{path}: corrupt .npz file ({type(exc).__name__}: {exc})") from None
 
@@ -634,8 +719,11 @@ def load_record(path, columns: tuple[str, str, str] = DEFAULT_COLUMNS, *,
     where: Callable[[int], str] = _row
     suffix = path.suffix.lower()
     if suffix in (".npz", ".mat"):
-        data = _read_npz(path) if suffix == ".npz" else _read_mat(path)
-        header = list(data)
+        if suffix == ".npz":
+            header, data = _read_npz(path, columns)
+        else:
+            data = _read_mat(path)
+            header = list(data)
         chosen, extra = _signals(path, data, columns)
     else:
         header, table, lines = _read_csv(path)

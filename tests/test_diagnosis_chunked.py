@@ -1,12 +1,16 @@
 """The chunked least squares of the diagnosis (pimodel.diagnosis.chunked) equals the full
-least squares, and a diagnosis of long records stays under a memory limit (issue 31)."""
+least squares, the streamed nominal and baseline fits equal the fits on full play outputs,
+a screened search finds the whole record's mode, and a diagnosis of long records stays under
+a memory limit (issue 31)."""
 
+import importlib
 import subprocess
 import sys
 import textwrap
 
 import numpy as np
 import pytest
+from scipy.signal import lfilter
 
 from pimodel.diagnosis.chunked import ChunkedQR, NormalEquations, chunks
 from pimodel.diagnosis.effects import fit_nominal, make_segment
@@ -70,6 +74,50 @@ def test_nominal_fit_over_chunks_equals_full_least_squares(monkeypatch):
     model = fit_nominal([seg])
     assert np.max(np.abs(A @ model.coef - A @ ref)) < 1e-9 * np.ptp(rec.y)
     assert np.max(np.abs(model.predict(seg) - A @ ref)) < 1e-9 * np.ptp(rec.y)
+
+
+@pytest.mark.parametrize("initial_state", ["rest", "unknown"])
+def test_streamed_plain_fit_equals_fit_on_full_play_outputs(monkeypatch, initial_state):
+    # the grid comparison and the baseline fit stream the play outputs (one chunk held at a
+    # time) and equal the nominal fit on the segments that hold them all, masked samples too
+    dg = importlib.import_module("pimodel.diagnosis.diagnose")  # not the function it exports
+
+    monkeypatch.setattr(chunks, "__defaults__", (311,))
+    truth = random_truth(["dynamics"], 5)
+    recs = [truth.record(*excitation(kind, seed=6), 6) for kind in ("train", "validate")]
+    radii = np.linspace(0.0, np.ptp(recs[0].v) / 2, 9)
+    for at_rest in (True, False):
+        segs, ne = dg._plain_fit(recs, radii, initial_state, at_rest)
+        coef = ne.solve()
+        full = dg._segments(recs, radii, initial_state, at_rest)
+        model = fit_nominal(full)
+        scale = np.ptp(recs[0].y)
+        for s, f, o in zip(segs, full, dg._plain_outputs(segs, radii, coef, at_rest),
+                           strict=True):
+            assert s.Z is None and (s.mask is None) == (initial_state != "unknown")
+            assert np.max(np.abs(o - model.predict(f))) < 1e-9 * scale
+        assert np.max(np.abs(coef - model.coef)) < 1e-6 * np.max(np.abs(model.coef))
+
+
+def test_nominal_segments_project_streamed_plays_as_the_full_ones(monkeypatch):
+    # the candidates' segments hold Z V built chunk by chunk from the input, with the nominal
+    # refitted on them; the full nominal's outputs equal those of the full play outputs
+    dg = importlib.import_module("pimodel.diagnosis.diagnose")
+    monkeypatch.setattr(chunks, "__defaults__", (509,))
+    truth = random_truth(["creep"], 8)
+    recs = [truth.record(*excitation(kind, seed=9), 9) for kind in ("train", "validate")]
+    radii = np.linspace(0.0, np.ptp(recs[0].v) / 2, 40)
+    tr, va, nominal, full, V, out_tr, out_va = dg._nominal_segments(
+        recs[:1], recs[1:], radii, "rest", True)
+    assert V is not None and V.shape == (40, dg.PROJECTED + 1)
+    ref = dg._segments(recs, radii, "rest", True)
+    model = fit_nominal(ref[:1])
+    for s, r, o in zip(tr + va, ref, out_tr + out_va, strict=True):
+        scale = np.ptp(r.y)
+        assert np.max(np.abs(s.Z - r.Z @ V)) < 1e-9 * np.max(np.abs(r.Z))
+        assert np.max(np.abs(o - model.predict(r))) < 1e-9 * scale
+    assert np.max(np.abs(nominal.predict(tr[0]) - out_tr[0])) < 0.05 * np.ptp(recs[0].y)
+    assert nominal.params == full.params and set(full.params) == set(model.params)
 
 
 def test_chunks_reject_bad_sizes():
@@ -143,3 +191,26 @@ def test_progress_reports_the_stages_and_shows_only_on_a_terminal():
     assert [m for m in messages if m.startswith("candidate")][-1] == "candidate rate (6/6)"
     assert stream.text.count("\r") == len(messages)
     assert "candidate creep (1/6)" in stream.text
+
+
+def test_screened_search_finds_the_mode_of_the_whole_record(monkeypatch):
+    # a record longer than SCREEN_SAMPLES: the mode and order are searched on its first
+    # samples and confirmed on the whole; the fit matches the unscreened one
+    import pimodel.diagnosis.effects as effects
+
+    dt, rng = 1e-4, np.random.default_rng(7)
+    v = np.repeat(rng.uniform(-1, 1, 10), 900)
+    v = v - v[0] + 0.3 * np.sin(2 * np.pi * 7 * np.arange(v.size) * dt)  # from rest at 0
+    b, a = effects.mode_coefficients(700.0, 0.08, dt)
+    y = lfilter(b, a, 2.0 * v) + rng.normal(0, 1e-3, v.size)
+    seg = make_segment(np.arange(v.size) * dt, v, y, [0.0, 0.2])
+    fits = {}
+    for screen in (v.size, 3000):
+        monkeypatch.setattr(effects, "SCREEN_SAMPLES", screen)
+        used = effects._screen([seg], ("dynamics",), {})
+        assert (used[0] is seg) == (screen >= v.size) and used[0].y.size == min(screen, v.size)
+        m = effects.fit_effect("dynamics", [seg])
+        fits[screen] = (m.grid["fn"], float(np.sum((m.predict(seg) - y) ** 2)))
+    assert abs(fits[3000][0] / 700.0 - 1) < 0.03 and abs(fits[v.size][0] / 700.0 - 1) < 0.03
+    assert fits[3000][1] <= 1.05 * fits[v.size][1]
+    assert effects._screen([seg], ("rate",), {}) == [seg]  # per-record bases: never screened

@@ -196,3 +196,49 @@ def test_long_csv_crosses_parse_blocks(tmp_path, monkeypatch):
     path.write_text("\n".join(text) + "\n")
     with pytest.raises(DataError, match=r"line 61 \(data row 60\), column 'v'"):
         load_record(path)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_block_reader_equals_line_reader(tmp_path, monkeypatch, seed):
+    # a regular CSV is read by numpy.loadtxt in blocks of bytes (cut mid-line here), an
+    # irregular one (a blank line, a CRLF file, a stray field) by the line reader: the same
+    # record, to the bit, either way
+    import pimodel.records as records
+
+    rng = np.random.default_rng(seed)
+    monkeypatch.setattr(records, "FAST_BLOCK_BYTES", int(rng.integers(40, 400)))
+    n = int(rng.integers(50, 300))
+    t = np.arange(n) * float(rng.uniform(1e-4, 1e-2))
+    cols = [t, rng.normal(size=n) * 10.0 ** rng.integers(-8, 8, n), rng.normal(size=n)]
+    lines = [",".join(repr(float(c[k])) for c in cols) for k in range(n)]
+    path = tmp_path / "r.csv"
+    path.write_text("t,v,y\n" + "\n".join(lines) + "\n")
+    assert records._fast_csv(path) is not None
+    fast = load_record(path)
+    monkeypatch.setattr(records, "_fast_csv", lambda p: None)
+    slow = load_record(path)
+    for a, b, c in zip((fast.t, fast.v, fast.y), (slow.t, slow.v, slow.y), cols, strict=True):
+        assert np.array_equal(a, b) and np.array_equal(a, c)
+    monkeypatch.undo()
+    k = int(rng.integers(1, n - 1))
+    for text in ("t,v,y\n" + "\n".join(lines[:k] + [""] + lines[k:]) + "\n",
+                 "t,v,y\r\n" + "\r\n".join(lines) + "\r\n"):
+        path.write_text(text, newline="")
+        assert np.array_equal(load_record(path).v, cols[1])
+    path.write_text("t,v,y\n" + "\n".join(lines[:k] + ["1,2"] + lines[k:]) + "\n")
+    with pytest.raises(DataError, match=rf"line {k + 2} \(data row {k + 1}\) has 2 fields"):
+        load_record(path)
+
+
+def test_npz_reads_only_the_columns_and_vectors_of_their_length(tmp_path, monkeypatch):
+    t, v, y = _signals(120)
+    path = tmp_path / "r.npz"
+    np.savez(path, t=t, v=v, y=y, temp=v[:, None], other=np.zeros(7),
+             image=np.zeros((120, 50)))
+    read = []
+    getitem = np.lib.npyio.NpzFile.__getitem__
+    monkeypatch.setattr(np.lib.npyio.NpzFile, "__getitem__",
+                        lambda self, k: read.append(k) or getitem(self, k))
+    rec = load_record(path)
+    assert sorted(read) == ["t", "temp", "v", "y"] and list(rec.extra) == ["temp"]
+    assert np.array_equal(rec.y, y)

@@ -50,11 +50,22 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
-from .chunked import chunks
+from .chunked import NormalEquations
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report
-from .effects import EFFECTS, Model, Segment, fit_effect, fit_nominal, make_segment, segment_of_rows
+from .effects import (
+    EFFECTS,
+    Model,
+    Segment,
+    base_features,
+    fit_effect,
+    fit_nominal,
+    make_segment,
+    nominal_params,
+    play_chunks,
+    segment_of_rows,
+)
 from .gain import gain_note, record_gains
 from .noise import measure_noise_floor
 from .rate import RateBasis
@@ -68,6 +79,7 @@ __all__ = [
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
 BASELINE_PLAYS = 60  # plays of the plain least-squares baseline (0 to max |v| of train)
+PROJECTED = 32  # principal directions of the play outputs kept beside the nominal's weights
 BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor of the baseline's
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
 MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
@@ -316,14 +328,45 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
                          progress or (lambda message: None))
 
 
+def _mask(r: Record, initial_state: str) -> np.ndarray | None:
+    return np.arange(len(r)) >= startup_length(r.v) if initial_state == "unknown" else None
+
+
 def _segments(records: list[Record], radii, initial_state: str,
               at_rest: bool = True) -> list[Segment]:
+    return [make_segment(r.t, r.v, r.y, radii, _mask(r, initial_state), at_rest=at_rest)
+            for r in records]
+
+
+def _plain_fit(records: list[Record], radii, initial_state: str,
+               at_rest: bool = True) -> tuple[list[Segment], NormalEquations]:
+    """The PI fit (play weights and an offset) that :func:`.effects.fit_nominal` makes, in one
+    pass over the records with one chunk of play outputs at a time (:func:`.effects.play_chunks`
+    into :class:`.chunked.NormalEquations`): nothing of size (samples x plays) is kept. Returns
+    the records as segments without play outputs (``Z`` is None; for :func:`_errors` and
+    :func:`_bic`) and the normal equations (``solve()`` gives the coefficients, ``G`` the Gram
+    matrix of the plays and the offset on the fitted samples)."""
+    segs = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in records]
+    ne = NormalEquations(np.size(radii) + 1)
+    for s in segs:
+        for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
+            if s.mask is None:
+                ne.add(rows, s.y[c])
+            else:
+                ne.add(rows[:, s.mask[c]], s.y[c][s.mask[c]])
+    return segs, ne
+
+
+def _plain_outputs(segs: list[Segment], radii, coef: np.ndarray,
+                   at_rest: bool = True) -> list[np.ndarray]:
+    """The output ``coef @ [z; 1]`` of the PI fit :func:`_plain_fit` at every sample of each
+    segment, a second pass with one chunk of play outputs at a time."""
     out = []
-    for r in records:
-        mask = None
-        if initial_state == "unknown":
-            mask = np.arange(len(r)) >= startup_length(r.v)
-        out.append(make_segment(r.t, r.v, r.y, radii, mask, at_rest=at_rest))
+    for s in segs:
+        o = np.empty(s.v.size)
+        for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
+            o[c] = coef @ rows
+        out.append(o)
     return out
 
 
@@ -348,7 +391,7 @@ def _grids(train) -> tuple[list[np.ndarray], list[np.ndarray]]:
 
 
 def _nominal(train, validate, initial_state):
-    """The radius grid with the lowest train BIC and its fitted nominal model.
+    """The radius grid with the lowest train BIC (its nominal: :func:`_nominal_segments`).
 
     The half-range grids and the extended grids (:func:`_grids`) each give the one with the
     lowest train BIC; the extended one is kept only when it also has the lower validate BIC
@@ -356,41 +399,36 @@ def _nominal(train, validate, initial_state):
     start is not at rest they fit that start and mispredict every other record's). The plays
     start at rest at ``v[0]``, or at 0 when that has the lower train BIC (a record cut from
     periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0). Returns
-    the radii, the train and validate segments, the model, whether the grid is extended and
-    whether the plays start at rest at ``v[0]``. With ``initial_state="unknown"`` (the
-    start-up is not fitted) the plays start at 0 on the half-range grids, as before issue 33
+    the radii, whether the grid is extended and whether the plays start at rest at ``v[0]``.
+    With ``initial_state="unknown"`` (the start-up is not fitted) the plays start at 0 on the
+    half-range grids, as before issue 33
     (from ``v[0]`` the shared real record's validate gap was 0.154 um against 0.048 um noise)."""
     half, extended = _grids(train)
     if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
         half, extended = [], []
-    picks = []
+    picks = []  # the grids are compared by fits streamed over the records (_plain_fit)
     for at_rest, grids in ((True, half), (True, extended), (False, _grids(train)[0])):
         best = None
         for radii in grids:
-            tr = _segments(train, radii, initial_state, at_rest)
-            model = fit_nominal(tr)
-            bic = _bic(tr, [model.predict(s) for s in tr], radii.size + 1)
+            segs, ne = _plain_fit(train, radii, initial_state, at_rest)
+            coef = ne.solve()
+            bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1)
             if best is None or bic < best[0]:
-                best = (bic, radii, None, model, at_rest)
-            del tr  # one grid's play outputs at a time (rebuilt for the pick below)
+                best = (bic, radii, coef, at_rest)
         picks.append(best)
     if picks[0] is None:
-        _, radii, _, model, at_rest = picks[2]
-        tr = _segments(train, radii, initial_state, False)
-        return radii, tr, _segments(validate, radii, initial_state, False), model, False, False
+        return picks[2][1], False, False
     if picks[1] is not None:  # the extension: kept only when validate agrees
         vbic = []
-        for _, radii, _tr, model, at_rest in picks[:2]:
-            va = _segments(validate, radii, initial_state, at_rest)
-            vbic.append(_bic(va, [model.predict(s) for s in va], radii.size + 1))
+        for _, radii, coef, at_rest in picks[:2]:
+            va = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
+            vbic.append(_bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1))
         if vbic[1] >= vbic[0]:
             picks[1] = None
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
-    _, radii, _, model, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
-    ext = ext and at_rest
-    tr = _segments(train, radii, initial_state, at_rest)  # again: cheaper than keeping all
-    return radii, tr, _segments(validate, radii, initial_state, at_rest), model, ext, at_rest
+    _, radii, _, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
+    return radii, ext and at_rest, at_rest
 
 
 def _baseline(train, validate, initial_state) -> dict:
@@ -399,65 +437,67 @@ def _baseline(train, validate, initial_state) -> dict:
     offset, fitted on the same (masked) train samples; its train and validate errors."""
     vmax = max(float(np.max(np.abs(r.v))) for r in train)
     radii = np.linspace(0.0, vmax, BASELINE_PLAYS)
-    tr = _segments(train, radii, initial_state)
-    va = _segments(validate, radii, initial_state)
-    model = fit_nominal(tr)
+    tr, ne = _plain_fit(train, radii, initial_state)  # streamed: no 60 play columns kept
+    coef = ne.solve()
+    va = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
     return {"kind": "PI, plain least squares", "plays": BASELINE_PLAYS, "max_radius": vmax,
-            "train": _errors(tr, [model.predict(s) for s in tr]),
-            "validate": _errors(va, [model.predict(s) for s in va])}
+            "train": _errors(tr, _plain_outputs(tr, radii, coef)),
+            "validate": _errors(va, _plain_outputs(va, radii, coef))}
 
 
-def _compressed(tr, va, nominal: Model):
-    """Segments whose play columns are replaced by a few combinations (the nominal's own
-    weights, then the leading principal directions of the train play outputs), as few as keep
-    the nominal train RSS within 1 %, and the RSS beside a slow drift too (:func:`_slow_rss`: a
-    drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can hide
-    directions a drift model needs); the candidates' grid searches filter these columns only.
-    Returns the new segments, the nominal refitted on them (with the full model's
-    ``params``) and the projection ``V`` (play columns = ``Z @ V``; None: not compressed)."""
-    n = tr[0].Z.shape[1]
-    G = sum(_play_gram(s) for s in tr)
-    _, vecs = np.linalg.eigh(G)
-    w = nominal.coef[:n]
-    rss_full = sum(float(np.sum((nominal.predict(s) - s.y)[s.used] ** 2)) for s in tr)
-    slow_full = None
-    for q in (32, n):
-        if q >= n:
-            return tr, va, nominal, None
-        V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :q]))
-        ctr = [_projected(s, V) for s in tr]
+def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool):
+    """The nominal on the chosen grid and the segments the candidates are fitted on, the play
+    outputs streamed (:func:`_plain_fit`): the nominal's train and validate outputs, then its
+    play columns replaced by a few combinations (the nominal's own weights, then the 32 leading
+    principal directions of the train play outputs, from the Gram matrix of the same pass)
+    when they keep the nominal train RSS within 1 %; the candidates' grid searches filter these
+    columns only. The projected rows are built chunk by chunk, so the full (samples x plays)
+    outputs are never held; without a projection (20 plays, or a worse RSS) the segments hold
+    them. Returns the train and validate segments, the nominal fitted on them (with the full
+    model's ``params``), the full nominal, the projection ``V`` (play columns = ``Z @ V``;
+    None: not compressed) and the full nominal's train and validate outputs."""
+    n = radii.size
+    segs, ne = _plain_fit(train, radii, initial_state, at_rest)
+    coef = ne.solve()
+    out_tr = _plain_outputs(segs, radii, coef, at_rest)
+    full = Model("nominal", 0, base_features, coef, nominal_params(coef, out_tr, segs))
+    vsegs = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
+    out_va = _plain_outputs(vsegs, radii, coef, at_rest)
+    if n > PROJECTED:
+        rss_full = sum(float(np.sum((o - s.y)[s.used] ** 2)) for s, o in zip(segs, out_tr,
+                                                                              strict=True))
+        _, vecs = np.linalg.eigh(ne.G[:n, :n])
+        w = coef[:n]
+        V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
+        ctr = [_projected(s, radii, V, at_rest) for s in segs]
         m = fit_nominal(ctr)
         rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
-        if rss <= 1.01 * rss_full:
-            slow_full = _slow_rss(tr) if slow_full is None else slow_full
-        # beside a slow drift, within 1 % plus what the dropped directions fit of the noise
-        n_fit = sum(int(np.sum(s.used)) if s.mask is not None else s.y.size for s in tr)
-        if rss <= 1.01 * rss_full and _slow_rss(tr, V) <= (
-                1.01 + (n - V.shape[1]) / n_fit) * slow_full:
-            m.params = dict(nominal.params)
-            for s in tr:
-                _drop_plays(s)
-            cva = []
-            for s in va:  # one record's full play outputs at a time
-                cva.append(_projected(s, V))
-                _drop_plays(s)
-            return ctr, cva, m, V
-    return tr, va, nominal, None
+        # beside a slow drift too, within 1 % plus what the dropped directions fit of the noise
+        # (a drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can
+        # hide directions a drift model needs)
+        n_fit = sum(int(np.sum(s.used)) for s in segs)
+        if rss <= 1.01 * rss_full and _slow_rss(segs, radii, at_rest, V) <= (
+                1.01 + (n - V.shape[1]) / n_fit) * _slow_rss(segs, radii, at_rest):
+            m.params = dict(full.params)
+            return (ctr, [_projected(s, radii, V, at_rest) for s in vsegs], m, full, V,
+                    out_tr, out_va)
+    return (_segments(train, radii, initial_state, at_rest),
+            _segments(validate, radii, initial_state, at_rest), full, full, None, out_tr, out_va)
 
 
-def _slow_rss(segs: list[Segment], V: np.ndarray | None = None) -> float:
+def _slow_rss(segs: list[Segment], radii, at_rest: bool, V: np.ndarray | None = None) -> float:
     """RSS of the least-squares fit of the fitted samples of ``y`` on the play columns (``Z V``
-    with ``V``), an offset per record and Legendre polynomials of degree 1 to ``SLOW_DEGREE``
-    of the time on the clock the records share (a slow drift), by a QR of the stacked chunks
-    (``[X y]``'s last diagonal entry of ``R`` squared)."""
+    with ``V``; the play outputs streamed from the input, :func:`~.effects.play_chunks`), an
+    offset per record and Legendre polynomials of degree 1 to ``SLOW_DEGREE`` of the time on
+    the clock the records share (a slow drift), by a QR of the stacked chunks (``[X y]``'s last
+    diagonal entry of ``R`` squared)."""
     t0 = min(float(s.t[0]) for s in segs)
     span = max(float(s.t[-1]) for s in segs) - t0 or 1.0
     R = None
     for j, s in enumerate(segs):
-        P = s.play_rows()
-        for c in chunks(s.y.size):
+        for c, P in play_chunks(s.v, radii, at_rest=at_rest):
             x = 2.0 * (s.t[c] - t0) / span - 1.0
-            rows = [P[:, c] if V is None else V.T @ P[:, c],
+            rows = [P[:-1] if V is None else V.T @ P[:-1],
                     np.eye(len(segs))[j][:, None] * np.ones(x.size),
                     np.polynomial.legendre.legvander(x, SLOW_DEGREE)[:, 1:].T, s.y[c][None]]
             M = np.vstack(rows).T
@@ -466,28 +506,11 @@ def _slow_rss(segs: list[Segment], V: np.ndarray | None = None) -> float:
     return float(R[-1, -1] ** 2) if R.shape[0] == R.shape[1] else 0.0
 
 
-def _play_gram(s: Segment) -> np.ndarray:
-    """``Z^T Z`` over the fitted samples of ``s``, chunk by chunk."""
-    P = s.play_rows()
-    G = np.zeros((P.shape[0], P.shape[0]))
-    for c in chunks(s.y.size):
-        X = P[:, c] if s.mask is None else P[:, c][:, s.mask[c]]
-        G += X @ X.T
-    return G
-
-
-def _drop_plays(s: Segment) -> None:
-    """Free the play outputs of a segment replaced by its projection (its ``Z`` is None)."""
-    s.__dict__.pop("_rows", None)
-    s.Z = None
-
-
-def _projected(s: Segment, V: np.ndarray) -> Segment:
-    """The segment with play columns ``Z V``, built chunk by chunk as rows."""
+def _projected(s: Segment, radii, V: np.ndarray, at_rest: bool) -> Segment:
+    """The segment with play columns ``Z V``, built chunk by chunk as rows from the input."""
     rows = np.empty((V.shape[1] + 1, s.y.size))
-    P = s.play_rows()
-    for c in chunks(s.y.size):
-        np.matmul(V.T, P[:, c], out=rows[:-1, c])
+    for c, P in play_chunks(s.v, radii, at_rest=at_rest):
+        np.matmul(V.T, P[:-1], out=rows[:-1, c])
     return segment_of_rows(s.t, s.v, s.y, rows, s.mask)
 
 
@@ -502,13 +525,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                              f"({dts[0][1]:g} s); resample the records to one sample time")
     dt = dts[0][1]
     progress("nominal model (radius grids)")
-    radii, tr, va, nominal, extended, at_rest = _nominal(train, validate, initial_state)
+    radii, extended, at_rest = _nominal(train, validate, initial_state)
     n_plays = radii.size
-    out_tr = [nominal.predict(s) for s in tr]
-    out_va = [nominal.predict(s) for s in va]
+    tr, va, nominal, full_nominal, proj, out_tr, out_va = _nominal_segments(
+        train, validate, radii, initial_state, at_rest)
     before = _errors(va, out_va)
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
-                              "weights": nominal.coef[:n_plays], "offset": nominal.coef[n_plays],
+                              "weights": full_nominal.coef[:n_plays],
+                              "offset": full_nominal.coef[n_plays],
                               "grid_sizes_tried": list(GRID_SIZES),
                               "grid_extended": extended,
                               "plays_start": "at rest at v[0]" if at_rest else "at 0"},
@@ -522,8 +546,6 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       "report.nominal['baseline']): the effects are measured against a weak "
                       "nominal", UserWarning, stacklevel=3)
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
-    full_nominal = nominal
-    tr, va, nominal, proj = _compressed(tr, va, nominal)
     segs = tr + va
     # the rate columns from the full play outputs (computed chunk by chunk from the input
     # when needed), weighted as the model will hold them

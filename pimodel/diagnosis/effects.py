@@ -9,6 +9,7 @@ parameters to the nominal model (for the information criterion on the validate r
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -52,6 +53,8 @@ __all__ = [
     "mode_coefficients",
     "mode_rows",
     "Model",
+    "nominal_params",
+    "play_chunks",
     "Segment",
     "segment_of_rows",
     "shift",
@@ -67,6 +70,8 @@ MODE_HEAVY = (tuple(np.geomspace(100.0, 5000.0, 9)), 0.7)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
+SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
+SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
 DRIFT_CLOCKS = DRIFT_VARIANTS  # t - t[0] of each record, t as given, or a level per record
@@ -198,14 +203,45 @@ def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
     """
     radii = np.asarray(radii, float)
     v = np.asarray(v, float)
-    z0 = float(v[0]) if at_rest else 0.0
-    op = PIOperator(np.ones(radii.size), radii, initial_state=z0)
     rows = np.empty((radii.size + 1, np.size(v)))
-    state = None
-    for c in chunks(rows.shape[1]):  # the plays chunk by chunk, their states carried over
-        Zc = op.play_outputs(v[c], state=state)
-        rows[:-1, c], state = Zc.T, Zc[-1]
+    for c, rc in play_chunks(v, radii, at_rest=at_rest):
+        rows[:-1, c] = rc[:-1]
     return segment_of_rows(t, v, y, rows, mask)
+
+
+def play_chunks(v, radii, *, at_rest: bool = True) -> Iterator[tuple[slice, np.ndarray]]:
+    """The play outputs of ``radii`` chunk by chunk (:func:`~.chunked.chunks`), their states
+    carried over from one chunk to the next, so a pass over a record holds one chunk of them.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        Input ``v[k]``.
+    radii : array_like
+        Play radii [input units], ``n`` of them.
+    at_rest : bool
+        Plays at rest at ``v[0]`` before the first sample (default); False: at 0.
+
+    Returns
+    -------
+    iterator of (slice, numpy.ndarray)
+        The chunk's samples ``c`` and its rows ``[z_1[c]; ...; z_n[c]; 1]``, shape
+        (n + 1, len(c)): the play outputs after each sample and a row of ones (the offset).
+
+    Examples
+    --------
+    >>> [rows.tolist() for _, rows in play_chunks(np.array([0.0, 1.0, 0.5]), [0.5])]
+    [[[0.0, 0.5, 0.5], [1.0, 1.0, 1.0]]]
+    """
+    radii = np.asarray(radii, float)
+    v = np.asarray(v, float)
+    op = PIOperator(np.ones(radii.size), radii, initial_state=float(v[0]) if at_rest else 0.0)
+    state = None
+    for c in chunks(v.size):
+        Zc = op.play_outputs(v[c], state=state)
+        rows = np.empty((radii.size + 1, Zc.shape[0]))
+        rows[:-1], rows[-1], state = Zc.T, 1.0, Zc[-1]
+        yield c, rows
 
 
 def segment_of_rows(t, v, y, rows: np.ndarray, mask=None) -> Segment:
@@ -458,15 +494,43 @@ def fit_nominal(train) -> Model:
     0.0
     """
     model = _fit("nominal", 0, base_features, train)[0]
-    h = np.concatenate([model.predict(s) for s in train])
+    model.params = nominal_params(model.coef, [model.predict(s) for s in train], train)
+    return model
+
+
+def nominal_params(coef: np.ndarray, outputs: list, train) -> dict:
+    """The ``params`` of a nominal model (:func:`fit_nominal`) from its fit.
+
+    Parameters
+    ----------
+    coef : numpy.ndarray
+        Play weights, then the offset.
+    outputs : list of numpy.ndarray
+        The model output on each train record, every sample.
+    train : list of Segment
+        The train records (their ``t`` and ``v`` are read).
+
+    Returns
+    -------
+    dict
+        ``center``, ``half_range``, ``slope_sum``, ``rate_scale``, ``creep_taus`` as
+        :func:`fit_nominal` describes them.
+
+    Examples
+    --------
+    >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.0]), np.zeros(3), [0.0])
+    >>> p = nominal_params(np.array([2.0, 0.0]), [np.array([0.0, 2.0, 0.0])], [seg])
+    >>> p["center"], p["half_range"], p["slope_sum"], p["rate_scale"]
+    (0.6666666666666666, 1.0, 2.0, 1000.0)
+    """
+    h = np.concatenate(outputs)
     rate = np.concatenate([np.abs(np.diff(s.v)) / s.dt for s in train])
     moving = rate[rate > 1e-9 * (float(np.ptp(rate)) or 1.0)]
-    model.params = {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
-                    "slope_sum": float(np.sum(model.coef[:-1])),
-                    "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0,
-                    "creep_taus": creep_time_constants(
-                        train[0].dt, max(float(s.t[-1] - s.t[0]) for s in train))}
-    return model
+    return {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
+            "slope_sum": float(np.sum(coef[:-1])),
+            "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0,
+            "creep_taus": creep_time_constants(
+                train[0].dt, max(float(s.t[-1] - s.t[0]) for s in train))}
 
 
 def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None = None,
@@ -559,10 +623,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     dyn_fixed = "fn" in fixed or "wiener" in fixed
     ncols = SEARCH_COLUMNS if "dynamics" in effects and not dyn_fixed else None
 
+    full, train = train, _screen(train, effects, fixed)  # the searches on the screen
+    tried: list = []  # (train RSS, grid point) of the first search, for the confirmation
+
     def search(points, best=None):
         for p in points:
             model, rss = _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
                               train, p)
+            tried.append((rss, p))
             if best is None or rss < best[1]:
                 best = (model, rss)
         return best
@@ -601,6 +669,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
     best = search(points)
+    grid_tried = sorted(tried, key=lambda rp: rp[0])[:SCREEN_CONFIRM]
     if "rate" in effects and "rate_tau" not in fixed:
         # the rate family and filter (the other grid parameters held): the filter's grid,
         # then geometric steps around the best positive time constant
@@ -702,6 +771,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed,
             min_elements=lti_min)
         best = search([lti_point(fn, zeta, elements)])
+    if train is not full:  # screened: the searched point against the grid's best, whole
+        train = full
+        best = _confirm(search, k, [best[0].params, *(q for _, q in grid_tried)], train)
     p = best[0].params  # the grid optimum, refitted with every play column
     k_all = k + lti_k(p.get("lti", ()))  # the linear part's further elements count too
     if p.get("wiener"):  # a filter's parameters instead of the base mode's two
@@ -748,6 +820,41 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                                                                            seg.mask)
         model.adjust = with_level
     return model
+
+
+def _screen(train, effects: tuple[str, ...], fixed: dict) -> list:
+    """The train records the searches of :func:`_fit_combo` run on: the first ``SCREEN_SAMPLES``
+    samples of each (:func:`_prefix`) when a record is longer and a mode or a delay is
+    searched (not with the rate's or the drift's per-record columns, nor a filter before the
+    hysteresis held); else ``train`` itself. A search costs a pass over the screen per point;
+    its result is confirmed on the whole records (:func:`_confirm`)."""
+    searched = ("dynamics" in effects and not {"fn", "wiener"} & set(fixed)) or \
+        ("delay" in effects and "d" not in fixed)
+    if not searched or {"rate", "drift"} & set(effects) or "wiener" in fixed or \
+            all(s.y.size <= SCREEN_SAMPLES for s in train):
+        return train
+    return [_prefix(s, SCREEN_SAMPLES) for s in train]
+
+
+def _prefix(s: Segment, m: int) -> Segment:
+    """The first ``m`` samples of ``s`` (its play rows copied; no rate or Wiener basis)."""
+    rows = np.array(s.play_rows(offset=True)[:, :m], order="C")
+    return segment_of_rows(s.t[:m], s.v[:m], s.y[:m], rows,
+                           None if s.mask is None else s.mask[:m])
+
+
+def _confirm(search, k: int, points: list[dict], train) -> tuple:
+    """The point of ``points`` (the screen's searched optimum, then its best grid points)
+    with the lowest BIC on the whole ``train`` records (the linear part's elements counted,
+    ``lti_k``), as ``search`` returns it: (model, train RSS). One fit per point."""
+    n = sum(s.y[s.used].size for s in train)
+    best = None
+    for p in points:
+        model, rss = search([p])
+        bic = n * np.log(max(rss, 1e-300)) + (k + lti_k(p.get("lti", ()))) * np.log(n)
+        if best is None or bic < best[0]:
+            best = (bic, model, rss)
+    return best[1], best[2]
 
 
 def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
