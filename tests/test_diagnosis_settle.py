@@ -116,9 +116,7 @@ def test_a_settling_is_named_drift(seed):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [0, pytest.param(1, marks=pytest.mark.xfail(
-    strict=True, reason="issue 28 open: a creep whose lag (1-4 s) falls between the nominal's "
-                        "creep lags gets a settling (settle_levels) added beside it"))])
+@pytest.mark.parametrize("seed", [0, 1])
 def test_creep_is_not_taken_for_a_settling(seed):
     """Creep comes first and no settling is named beside it (a level of the validate record's
     own, ``drift_variant == "levels"``, may still be: see docs/diagnosis.md)."""

@@ -53,7 +53,7 @@ from ..records import Record
 from .chunked import NormalEquations
 from .creep import creep_law
 from .delaylike import is_delay_like
-from .drift import DRIFT_KEYS, drift_variants, level_report
+from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
 from .effects import (
     EFFECTS,
     Model,
@@ -85,6 +85,7 @@ MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
 MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
 NOISE_STOP = 1.5  # no further effect once the validate RMS is within this factor of the noise
 SLOW_DEGREE = 3  # the compression's check beside a slow drift: a cubic in time (_slow_rss)
+SETTLE_BOW_FLOORS = 2.0  # a settling is named only when its bow exceeds this many noise floors
 UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
 UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
 DYNAMICS_KEYS = ("fn", "zeta", "lti")  # grid keys of dynamics after the hysteresis
@@ -475,7 +476,7 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool)
         # beside a slow drift too, within 1 % plus what the dropped directions fit of the noise
         # (a drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can
         # hide directions a drift model needs)
-        n_fit = sum(int(np.sum(s.used)) for s in segs)
+        n_fit = sum(s.y.size if s.mask is None else int(np.sum(s.mask)) for s in segs)
         if rss <= 1.01 * rss_full and _slow_rss(segs, radii, at_rest, V) <= (
                 1.01 + (n - V.shape[1]) / n_fit) * _slow_rss(segs, radii, at_rest):
             m.params = dict(full.params)
@@ -483,6 +484,19 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool)
                     out_tr, out_va)
     return (_segments(train, radii, initial_state, at_rest),
             _segments(validate, radii, initial_state, at_rest), full, full, None, out_tr, out_va)
+
+
+def _flat_settling(m: Model, tr, va, noise: float) -> bool:
+    """Whether ``m`` holds a settling drift whose bow over the records (:func:`.drift.settle_bow`
+    times ``|D|``) stays within ``SETTLE_BOW_FLOORS`` noise floors (the verdict's own threshold
+    for a gap): on these records it is then a straight trend, which the drift's linear variants
+    give with fewer parameters, and its time constant would be read into the noise or into
+    another effect's leftover (a creep lag between the grid's lags)."""
+    g = m.grid or {}
+    if "drift" not in m.name.split("+") or g.get("clock") != "settle":
+        return False
+    bow = settle_bow([s.t for s in (*tr, *va)], g["settle_tau"], g["settle_t0"])
+    return abs(float(m.params["drift_settling"])) * bow < SETTLE_BOW_FLOORS * noise
 
 
 def _slow_rss(segs: list[Segment], radii, at_rest: bool, V: np.ndarray | None = None) -> float:
@@ -578,6 +592,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 _release(m, segs)
             m, o = cache[key]
             score = _bic(va, o, m.k)
+            if _flat_settling(m, tr, va, noise):  # a settling no bow tells from a trend
+                continue
             if best is None or score < best[0]:
                 best = (score, m, o)
         return best[1], best[2]

@@ -61,6 +61,7 @@ __all__ = [
     "level_report",
     "out_of_fold_level",
     "record_levels",
+    "settle_bow",
     "settle_grid",
     "settle_start",
 ]
@@ -218,6 +219,39 @@ def settle_column(t: np.ndarray, tau: float, t0: float) -> np.ndarray:
     [0.0, 0.6321]
     """
     return -np.expm1(-(t - t0) / tau)
+
+
+def settle_bow(times: list[np.ndarray], tau: float, t0: float, points: int = 4096) -> float:
+    """How far a unit settling departs from a straight line over the records' samples: the
+    largest ``|settle_column(t) - (a + b t)|`` with ``a + b t`` its least-squares line on the
+    shared clock (at most ``points`` samples per record, evenly spaced). A settling whose
+    ``|D|`` times this is below the noise floor cannot be told from a trend on these records.
+
+    Parameters
+    ----------
+    times : list of numpy.ndarray
+        Each record's ``t[k]`` [s] on the clock the records share.
+    tau, t0 : float
+        Time constant ``T`` (> 0) and start ``t_s`` [s].
+    points : int
+        Samples per record used at most.
+
+    Returns
+    -------
+    float
+        The bow per unit ``D`` (>= 0; 0 for a straight line).
+
+    Examples
+    --------
+    >>> t = [np.linspace(0.0, 10.0, 101)]
+    >>> settle_bow(t, 2.0, 0.0) > 0.2 > 0.01 > settle_bow(t, 1e3, 0.0)
+    True
+    """
+    t = np.concatenate([np.asarray(x, float)[::max(1, len(x) // points)] for x in times])
+    y = settle_column(t, tau, t0)
+    A = np.column_stack((np.ones_like(t), t - t.mean()))
+    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+    return float(np.max(np.abs(y - A @ coef)))
 
 
 def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
