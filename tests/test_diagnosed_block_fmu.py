@@ -382,9 +382,11 @@ def test_cli_builds_a_model_fmu_that_validates_and_runs_in_the_masters(tmp_path,
 
 @pytest.mark.slow
 def test_real_record_model_as_block_and_fmu(real_record_path, tmp_path):
-    """The models diagnosed on the shared real record (80 signed plays; verdict rate or delay):
-    the C stream equals simulate on the whole validate half, the FMU in the co-simulation
-    master on its first 3000 samples, both to 1e-12."""
+    """The models diagnosed on the shared real record (80 signed plays; verdict a lag: delay,
+    rate or dynamics): the C stream equals simulate on the whole validate half, the FMU in the
+    co-simulation master on its first 3000 samples, both to 1e-12 relative to the output's
+    size (outputs up to about 150 um; an IIR linear part sums its rounding over the record,
+    as in the other tests of this file)."""
     from pimodel import load_record
     from pimodel.diagnosis import diagnose
     from pimodel.fmu.model_fmu import build_model_fmus
@@ -397,11 +399,13 @@ def test_real_record_model_as_block_and_fmu(real_record_path, tmp_path):
     for stem, m in (("augmented", rep.model()), ("nominal", rep.model(augmented=False))):
         rng = 2 * m.radii[-1]
         want = m.simulate(val.v, val.t, input_range=rng)
-        assert np.max(np.abs(stream_simulate(m, val.v, val.t, input_range=rng) - want)) < 1e-12
+        size = max(1.0, float(np.max(np.abs(want))))
+        assert np.max(np.abs(stream_simulate(m, val.v, val.t, input_range=rng) - want)) < (
+            1e-12 * size)
         (fmu,) = build_model_fmus(m, tmp_path, stem=stem)
         v = val.v[:3000]
         got = cosimulate_chain([fmu], v, m.dt)
-        assert np.max(np.abs(got - m.simulate(v, input_range=rng))) < 1e-12
+        assert np.max(np.abs(got - m.simulate(v, input_range=rng))) < 1e-12 * size
     assert rep.model().effects and np.any(rep.model().weights < 0)
 
 

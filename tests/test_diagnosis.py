@@ -112,9 +112,11 @@ def test_real_record_diagnosis(real_record_path):
     rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)])
     v = rep.verdict
     # the real stage is not a clean PI operator: its loop is wider than a static PI's, as a lag
-    # of about 11 ms or rate-dependent hysteresis makes it; one 1 Hz sine cannot tell the two
-    # apart, and the verdict says so
-    assert v["effects"] in (["delay"], ["rate"])
+    # of about 11 ms, rate-dependent hysteresis or a damped linear lag after it makes it; one
+    # 1 Hz sine cannot tell them apart, and the verdict says so (one named, the others as
+    # alternatives; since the linear part may hold a low-pass, issue 28, the damped lag fits
+    # 1 % better on validate than the delay and is named)
+    assert v["effects"] in (["delay"], ["rate"], ["dynamics"])
     assert {"delay", "rate"} <= set(v["effects"] + v["alternatives"])
     delay = next(c for c in rep.candidates if c["effect"] == "delay")
     assert 0.008 < delay["params"]["delay_s"] < 0.016

@@ -5,7 +5,7 @@ The diagnosis fits every candidate *jointly* with the hysteresis weights, in a p
 (:mod:`.effects`): with ``Z`` the play outputs of the radius grid (plays at rest at
 ``z_i[-1] = z_s``, then ``z_i[k] = Gamma_{r_i}[v][k]``; ``z_s = v[0]`` when
 ``plays_start == "v0"``, as the diagnosis' nominal since issue 33, else 0) and
-``h0 = Z w0 + c0`` the reference hysteresis output the effect columns are built from,
+``h0 = Z w0 + c0`` the reference hysteresis output the effect columns are built from::
 
     y[k] = (D Z)[k] w + c                                    hysteresis (weights w, offset c)
          + sum_i g_i (L_i[h0][k] - h0[k])                     creep: lags L_i, tau_i (s)
