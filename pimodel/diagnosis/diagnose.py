@@ -245,9 +245,18 @@ def _errors(segs: list[Segment], outputs) -> dict:
             "max_percent": 100 * mx / rng, "range": rng}
 
 
-def _bic(segs, outputs, k) -> float:
+def _bic(segs, outputs, k, n: int | None = None) -> float:
+    """``N ln(RSS/N) + k ln N`` of the fitted samples; with ``n``: the BIC of ``n`` samples
+    whose mean squared residual is that of ``segs`` (a screen standing for whole records)."""
     r = np.concatenate([(s.y - o)[s.used] for s, o in zip(segs, outputs, strict=True)])
-    return float(r.size * np.log(max(np.mean(r**2), 1e-300)) + k * np.log(r.size))
+    n = r.size if n is None else n
+    return float(n * np.log(max(np.mean(r**2), 1e-300)) + k * np.log(n))
+
+
+def _fitted_samples(records: list[Record], initial_state: str) -> int:
+    """The fitted samples of ``records`` (all, or those after the start-up)."""
+    return sum(len(r) if (m := _mask(r, initial_state)) is None else int(np.sum(m))
+               for r in records)
 
 
 def _check(records: list[Record], role: str) -> None:
@@ -419,13 +428,16 @@ def _nominal(train, validate, initial_state):
     if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
         half, extended = [], []
     picks = []  # the grids are compared by fits streamed over the records (_plain_fit), on
-    # the records' first SCREEN_SAMPLES samples (the grids span the whole train input)
+    # the records' first SCREEN_SAMPLES samples (the grids span the whole train input), by
+    # the BIC of the whole records' sample count (the screen's mean squared residual)
+    n_train = _fitted_samples(train, initial_state)
     for at_rest, grids in ((True, half), (True, extended), (False, _grids(train)[0])):
         best = None
         for radii in grids:
             segs, ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)
             coef = ne.solve()
-            bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1)
+            bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1,
+                       n_train)
             if best is None or bic < best[0]:
                 best = (bic, radii, coef, at_rest)
         picks.append(best)
@@ -435,7 +447,8 @@ def _nominal(train, validate, initial_state):
         vbic = []
         for _, radii, coef, at_rest in picks[:2]:
             va = _bare(validate, initial_state, SCREEN_SAMPLES)
-            vbic.append(_bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1))
+            vbic.append(_bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1,
+                             _fitted_samples(validate, initial_state)))
         if vbic[1] >= vbic[0]:
             picks[1] = None
     ext = picks[1] is not None
