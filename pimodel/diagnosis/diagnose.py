@@ -574,9 +574,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     progress("nominal model (radius grids)")
     radii, extended, at_rest = _nominal(train, validate, initial_state)
     n_plays = radii.size
+    progress(f"nominal model ({radii.size} plays, fitted on the whole records)")
     tr, va, nominal, full_nominal, proj, out_tr, out_va = _nominal_segments(
         train, validate, radii, initial_state, at_rest)
     before = _errors(va, out_va)
+    progress("plain least-squares baseline")
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
                               "weights": full_nominal.coef[:n_plays],
                               "offset": full_nominal.coef[n_plays],
