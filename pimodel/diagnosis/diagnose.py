@@ -501,10 +501,12 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool)
         # beside a slow drift too, within 1 % plus what the dropped directions fit of the noise
         # (a drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can
         # hide directions a drift model needs)
-        n_fit = sum(s.y.size if s.mask is None else int(np.sum(s.mask)) for s in segs)
+        # (on the records' first SCREEN_SAMPLES samples, where the effects are chosen)
+        screen = _bare(train, initial_state, SCREEN_SAMPLES)
+        n_fit = sum(s.y.size if s.mask is None else int(np.sum(s.mask)) for s in screen)
         keep = rss <= 1.01 * rss_full
         if keep:
-            slow_full, slow_projected = _slow_rss(segs, radii, at_rest, V)
+            slow_full, slow_projected = _slow_rss(screen, radii, at_rest, V)
             keep = slow_projected <= (1.01 + (n - V.shape[1]) / n_fit) * slow_full
         if keep:
             m.params = dict(full.params)
