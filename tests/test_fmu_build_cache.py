@@ -169,6 +169,14 @@ def test_caching_off_writes_no_entry(dry_compiler, monkeypatch, tmp_path):
     assert not (tmp_path / "xdg").exists() and not (tmp_path / "home").exists()
 
 
+def test_an_unwritable_cache_only_costs_time(dry_compiler, monkeypatch, tmp_path):
+    blocker = tmp_path / "not_a_folder"
+    blocker.write_text("a file where the cache folder should be")
+    monkeypatch.setenv(ENV_VAR, str(blocker / "cache"))
+    (fmu,) = build_fmus(tmp_path / "out", [UNIT])
+    assert binary(fmu) == b"stand-in" and dry_compiler.runs.count("link") == 1
+
+
 def test_the_core_sources_include_only_the_core_headers():
     """A core object's key covers its source and the core headers (HEADERS); the compiler's
     own dependency list shows that nothing else of the FMU's sources can change it."""

@@ -227,7 +227,8 @@ def cached_file(key: str, out: Path, make: Callable[[], None]) -> bool:
     out : pathlib.Path
         The file to produce.
     make : callable
-        Writes ``out`` (runs the compiler); called on a miss or when caching is off.
+        Writes ``out`` (runs the compiler); called on a miss or when caching is off. A cache
+        that cannot be written is skipped.
 
     Returns
     -------
@@ -250,5 +251,8 @@ def cached_file(key: str, out: Path, make: Callable[[], None]) -> bool:
         return True
     make()
     if folder is not None:
-        write_entry(folder, key, out.read_bytes())
+        try:
+            write_entry(folder, key, out.read_bytes())
+        except OSError:  # an unwritable cache (read-only home, full disk) only costs time
+            pass
     return False
