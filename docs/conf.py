@@ -98,6 +98,7 @@ STRICT_MODULES = [
     "pimodel.experiments.compensation",
     "pimodel.experiments.studies",
     "pimodel.fmu.build",
+    "pimodel.fmu.build_cache",
     "pimodel.fmu.unit",
     "pimodel.fmu.cosim",
     "pimodel.experiments.fmu_comparison",

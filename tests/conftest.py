@@ -28,6 +28,24 @@ def real_record_path() -> Path:
     return REAL_RECORD
 
 
+@pytest.fixture(scope="session", autouse=True)
+def fmu_build_cache(tmp_path_factory, worker_id):
+    """One compile cache (``pimodel.fmu.build_cache``) for every FMU build of this run, in the
+    run's temporary folder (common to the pytest-xdist workers), so that each object and binary
+    is compiled once per run and no run depends on an earlier one. A ``PIMODEL_BUILD_CACHE``
+    set before the run is kept (e.g. a cache kept between CI runs)."""
+    from pimodel.fmu.build_cache import ENV_VAR, cache_dir
+
+    if ENV_VAR in os.environ:
+        yield cache_dir()
+        return
+    base = tmp_path_factory.getbasetemp()
+    folder = (base if worker_id == "master" else base.parent) / "fmu_build_cache"
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(ENV_VAR, str(folder))
+        yield folder
+
+
 @pytest.fixture(scope="session")
 def built_fmus(tmp_path_factory, worker_id) -> Path:
     """Every FMU unit built once per run for FMI 2.0 and 3.0 into one folder (read only: tests

@@ -17,6 +17,8 @@ sources          -- where the C lives: fmu/src/core (numeric core), fmi (glue, f
                     units/<Unit> (each unit's own code); what an FMU compiles
 build            -- build_fmus (compile and package), find_compiler, fmi_headers, fmu_filename
 build_fmus       -- compile and package the FMUs into a folder, re-exported from build
+build_cache      -- the compile cache: each object and binary compiled once per content, flags
+                    and compiler ($PIMODEL_BUILD_CACHE, default ~/.cache/pimodel/build)
 model_fmu        -- build_model_fmus / build_inverse_fmu: one FMU per operator of a model,
                     its parameters as start values; cosimulate_chain
 operators        -- unit_parameters(op): the unit and parameter values of an operator

@@ -16,9 +16,11 @@ import shutil
 import subprocess
 import tempfile
 import zipfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from xml.sax.saxutils import escape
 
+from .build_cache import cache_key, cached_file, compiler_identity
 from .description import LOG_CATEGORIES, PLATFORM, model_description
 from .sources import CORE_SOURCES, GLUE, HEADERS, source_dir, source_files
 from .spec import (
@@ -249,15 +251,7 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
             files = source_files(unit_of(name), fmi_version)
             for f in files:
                 shutil.copy(f, tmp / f.name)
-            so = tmp / f"{name}.so"
-            (tmp / "exports.map").write_text(EXPORTS)
-            cmd = [cc, *CFLAGS, "-I", str(tmp), "-I", str(inc), str(tmp / "model.c"),
-                   *[str(tmp / s) for s in CORE_SOURCES], "-o", str(so), "-lm",
-                   f"-Wl,--version-script={tmp / 'exports.map'}"]
-            proc = subprocess.run(cmd, capture_output=True, text=True)
-            if proc.returncode != 0:
-                raise RuntimeError(f"compiling {name} (FMI {fmi_version}) failed:\n"
-                                   f"{proc.stderr}")
+            so = _compile(cc, tmp, name, files, inc, what=f"{name} (FMI {fmi_version})")
             fmu = out / fmu_filename(name, fmi_version)
             with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
                 z.writestr("modelDescription.xml", model_description(name, fmi_version))
@@ -268,3 +262,45 @@ def build_fmus(out_dir, which=None, *, compiler: str | None = None,
                 z.writestr("documentation/index.html", _documentation(name))
             paths.append(fmu)
     return paths
+
+
+def _run(cmd: list[str], cwd: Path, what: str) -> None:
+    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"compiling {what} failed:\n{proc.stderr}")
+
+
+def _compile(cc: str, tmp: Path, name: str, files: list[Path], inc: Path, what: str) -> Path:
+    """Compile and link the unit whose sources are flat in ``tmp`` into ``tmp/<name>.so``,
+    through the build cache (:mod:`pimodel.fmu.build_cache`): one object per C file (run in
+    ``tmp`` with relative names, so the output does not depend on the folder), keyed on
+    ``CFLAGS``, the compiler and the files the C file can include: a core source its core
+    headers (it includes no other file: ``tests/test_fmu_build_cache.py``), ``model.c``
+    everything else of the FMU's sources and the FMI headers. The link is keyed on the objects'
+    keys. Missing objects compile in parallel, one process per core."""
+    flags, ident = list(CFLAGS), compiler_identity(cc)  # CFLAGS read now: tests may patch it
+    (tmp / "exports.map").write_text(EXPORTS)
+    core = [tmp / h for h in HEADERS]
+    rest = [tmp / "model.c", tmp / "config.h",
+            *[tmp / f.name for f in files if f.name not in CORE_SOURCES],
+            *sorted(inc.glob("*.h"))]
+    units = [("model.c", rest), *[(c, [tmp / c, *core]) for c in CORE_SOURCES]]
+    objects = [(tmp / f"{Path(c).stem}.o", c, cache_key("object", *flags, ident, files=deps))
+               for c, deps in units]
+
+    def compile_object(job: tuple[Path, str, str]) -> bool:
+        obj, c, key = job
+        return cached_file(key, obj, lambda: _run(
+            [cc, *flags, "-I", ".", "-I", str(inc), "-c", c, "-o", obj.name], tmp, what))
+
+    def link() -> None:
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+            list(pool.map(compile_object, objects))
+        _run([cc, *flags, *[obj.name for obj, _, _ in objects], "-o", so.name, "-lm",
+              "-Wl,--version-script=exports.map"], tmp, what)
+
+    so = tmp / f"{name}.so"
+    cached_file(cache_key("shared library", *flags, ident, EXPORTS,
+                          *[key for _, _, key in objects]), so, link)
+    so.chmod(0o755)  # as the linker writes it, also when it came from the cache
+    return so
