@@ -32,12 +32,20 @@ R = np.array([0.0, 0.25, 0.7])
 # half the smallest tolerance (1e-9), within and across the largest (1e-3), and far from both
 OFFSETS = [0.0, 1e-12, -1e-12, 3e-10, -3e-10, 4.9e-10, 5.1e-10, -5.1e-10, 9e-10, 1.1e-9,
            -1.1e-9, 1e-6, 9.9e-4, 1.0e-3, 1.009e-3, 1.011e-3, -1.011e-3, 0.25, 0.5, 0.999999]
+# and offsets of the rule's tolerance at the step's end times these factors, just inside and
+# outside it (beyond the fast count's margin, a relative 1e-6, and the resolution of t / Ts)
+TOL_FACTORS = [0.999, 0.99999, 1.00001, 1.001]
+
+
+def tolerance(x: float) -> float:
+    """The sampling rule's tolerance at sample x (unit_sample_tol)."""
+    return min(1e-9 + x * x * EPS, 1e-3)
 
 
 def end_sample(t_end: float, ts: float) -> int:
     """The sampling rule of pim_unit.h (unit_first_sample) in Python's doubles."""
     x = t_end / ts
-    return math.ceil(x - min(1e-9 + x * x * EPS, 1e-3))
+    return math.ceil(x - tolerance(x))
 
 
 @pytest.fixture(scope="module")
@@ -47,9 +55,10 @@ def fmu(tmp_path_factory):
 
 
 def run(fmu, ts: float, t0: float, seed: int) -> tuple[list, list, list, list]:
-    """Steps of 1-3 samples whose ends sit at OFFSETS (shuffled) from a sample instant, with a
-    random input held over each step; per step the sample counter (from the serialized FMU
-    state), the rule's count, the input and the output."""
+    """Steps of 1-3 samples whose ends sit at OFFSETS samples or TOL_FACTORS tolerances
+    (shuffled) from a sample instant, with a random input held over each step; per step the
+    sample counter (from the serialized FMU state), the rule's count, the input and the
+    output."""
     md = read_model_description(fmu)
     refs = {v.name: v.valueReference for v in md.modelVariables}
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu),
@@ -66,8 +75,11 @@ def run(fmu, ts: float, t0: float, seed: int) -> tuple[list, list, list, list]:
         slave.setReal([refs[f"r[{i + 1}]"] for i in range(R.size)], list(R))
         slave.exitInitializationMode()
         t, k = t0, end_sample(t0, ts)
-        for offset in rng.permutation(OFFSETS * 6):
-            h = (k + int(rng.integers(1, 4)) + offset) * ts - t  # k: the next sample
+        ends = [(x, False) for x in OFFSETS] + [(f, True) for f in TOL_FACTORS]
+        for i in rng.permutation(len(ends) * 6):
+            x, of_tolerance = ends[i % len(ends)]
+            end = k + int(rng.integers(1, 4))  # k: the next sample
+            h = (end + (x * tolerance(end) if of_tolerance else x)) * ts - t
             v = float(rng.uniform(-1.0, 1.0))
             slave.setReal([refs["v"]], [v])
             slave.doStep(t, h)

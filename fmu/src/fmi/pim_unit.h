@@ -237,23 +237,29 @@ static int model_report(const pim_unit *u, char *buf, size_t size)
  * computed by a master (PIM_SAMPLE_TOL plus x^2 eps samples at sample x, what a clock that adds
  * its step x times accumulates; at most 1e-3 samples), so that a communication grid that
  * differs from k*Ts by floating-point rounding never shifts a sample. */
+static double unit_sample_tol(double x)
+{
+    const double tol = PIM_SAMPLE_TOL + x * x * 2.220446049250313e-16;
+    return tol < 1e-3 ? tol : 1e-3;
+}
+
 static double unit_first_sample(const pim_unit *u, double t)
 {
     const double x = t / u->Ts;
-    const double tol = PIM_SAMPLE_TOL + x * x * 2.220446049250313e-16;
-    return ceil(x - (tol < 1e-3 ? tol : 1e-3));
+    return ceil(x - unit_sample_tol(x));
 }
 
 /*
  * The end sample k1 of a doStep ending at t > 0 (unit_first_sample(u, t)), or -1 when it is
  * beyond the counter's range, with the reciprocal u->inv_Ts (unit_derive_time) instead of a
- * division.  x = t * inv_Ts is within 2 eps x of t / Ts (three roundings), so for x < 2^32
- * (error < 2e-6 samples) the result is that of unit_first_sample whenever x lies within
- * PIM_SAMPLE_TOL / 2 above an integer k (result k: the tolerance, >= PIM_SAMPLE_TOL + x^2 eps,
- * covers the half tolerance plus the error) or 1.01e-3 or more above it (result k + 1: the
- * tolerance is at most 1e-3); in the narrow bands between, and beyond 2^32 samples, it asks
- * unit_first_sample.  A master on the FMU's grid (h a multiple of Ts) stays on the fast path
- * while its rounding of the grid is below half the tolerance.
+ * division.  x = t * inv_Ts is within 3.4e-16 x of the rule's t / Ts (three roundings) and the
+ * rule's tolerance within a relative 1e-15 of unit_sample_tol(x), so for x < 2^32 the result
+ * is the rule's whenever x lies at least 1e-15 x + 1e-6 tol below (result k) or above (result
+ * k + 1) an integer k plus the tolerance (a margin that also covers the rounding of the rule's
+ * x - tol).  Most steps end within half the smallest tolerance (1e-9 / 2) above an integer, or
+ * beyond the largest (1e-3) plus the error: two comparisons decide them without the
+ * tolerance.  Only a step end within that margin of the tolerance, or beyond 2^32 samples,
+ * asks unit_first_sample.
  */
 static int64_t unit_end_sample(const pim_unit *u, double t)
 {
@@ -263,6 +269,9 @@ static int64_t unit_end_sample(const pim_unit *u, double t)
         const double frac = x - (double)k;
         if (frac <= 0.5 * PIM_SAMPLE_TOL) return k;
         if (frac >= 1.01e-3) return k + 1;
+        const double tol = unit_sample_tol(x), margin = 1e-15 * x;
+        if (frac <= tol * (1.0 - 1e-6) - margin) return k;
+        if (frac > tol * (1.0 + 1e-6) + margin) return k + 1;
     }
     const double k = unit_first_sample(u, t);
     return k < PIM_MAX_SAMPLE_INDEX ? (int64_t)k : -1;
