@@ -23,7 +23,7 @@ from pimodel.operators import PIOperator
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from fmu_driver import read_field  # noqa: E402  (the state layout's mirror)
+from fmu_driver import edit_field, read_field  # noqa: E402  (the state layout's mirror)
 
 EPS = 2.220446049250313e-16
 P = np.array([0.6, 0.3, 0.2])
@@ -119,3 +119,48 @@ def test_outputs_follow_the_held_inputs_without_a_shifted_sample(fmu):
     want = PIOperator(P, R).simulate(np.array(seq))[last]
     np.testing.assert_allclose(outputs, want, rtol=0, atol=1e-12)
     assert np.ptp(want) > 0.3
+
+
+def test_derived_sampling_fields_are_recomputed_from_a_restored_state(fmu):
+    """1/Ts and the time tolerance are derived, not read: a serialized state whose copies of
+    them are edited (checksum recomputed) resumes bit for bit like the intact one, and a t off
+    by more than the rule's tolerance is still refused."""
+    md = read_model_description(fmu)
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="derived")
+    slave.instantiate()
+    ts, v = 1e-3, np.sin(np.arange(40) / 3.0)
+    try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setReal([refs["Ts"]], [ts])
+        slave.exitInitializationMode()
+        t = 0.0
+        for x in v[:10]:
+            slave.setReal([refs["v"]], [float(x)])
+            slave.doStep(t, 2 * ts)
+            t += 2 * ts
+        state = slave.getFMUstate()
+        blob = slave.serializeFMUstate(state)
+        slave.freeFMUstate(state)
+        assert read_field(blob, "inv_Ts") == 1 / ts and read_field(blob, "t_tol") == 1e-9
+        runs = []
+        for edited in (blob, edit_field(edit_field(blob, "inv_Ts", 0.5), "t_tol", 1e3)):
+            state = slave.deSerializeFMUstate(edited)
+            slave.setFMUstate(state)
+            slave.freeFMUstate(state)
+            t, ys = read_field(edited, "time"), []
+            for x in v[10:]:
+                slave.setReal([refs["v"]], [float(x)])
+                slave.doStep(t, 2 * ts)
+                t += 2 * ts
+                ys.append(slave.getReal([refs["y"]])[0])
+            runs.append(ys)
+            with pytest.raises(Exception, match="status 3"):  # fmi2Error
+                slave.doStep(t + 1e-6, 2 * ts)  # beyond min(1e-9 max(1, t), 1e-3 Ts)
+        assert runs[0] == runs[1] and np.ptp(runs[0]) > 0.1
+        slave.terminate()
+    finally:
+        slave.freeInstance()
+
