@@ -233,16 +233,17 @@ static int model_report(const pim_unit *u, char *buf, size_t size)
 }
 #endif
 
-/* Index of the first sample at or after time t: ceil(t / Ts) up to the rounding of a time
- * computed by a master (PIM_SAMPLE_TOL plus x^2 eps samples at sample x, what a clock that adds
- * its step x times accumulates; at most 1e-3 samples), so that a communication grid that
- * differs from k*Ts by floating-point rounding never shifts a sample. */
+/* The sampling rule's tolerance at sample x, in samples (unit_first_sample). */
 static double unit_sample_tol(double x)
 {
     const double tol = PIM_SAMPLE_TOL + x * x * 2.220446049250313e-16;
     return tol < 1e-3 ? tol : 1e-3;
 }
 
+/* Index of the first sample at or after time t: ceil(t / Ts) up to the rounding of a time
+ * computed by a master (PIM_SAMPLE_TOL plus x^2 eps samples at sample x, what a clock that adds
+ * its step x times accumulates; at most 1e-3 samples), so that a communication grid that
+ * differs from k*Ts by floating-point rounding never shifts a sample. */
 static double unit_first_sample(const pim_unit *u, double t)
 {
     const double x = t / u->Ts;
