@@ -1,11 +1,12 @@
 """Benchmark: PIHysteresis FMU cost per sample from a small C host (dlopen, setReal, doStep,
 getReal per sample) and steps per second through fmpy (FMU2Slave loop in Python), n = 10 plays.
 
-Run: ``.venv/bin/python benchmarks/bench_fmu.py``. Goal (issue 29): under 20 ns per doStep in
-the C host (issue 5: 50 ns). The C host runs REPEATS times; the medians of its wall-clock and
-CPU ns per sample are printed with the machine's load average (a loaded machine inflates the
-wall clock most), beside the same loop calling only the C core's ``pim_pi_step`` (the floor
-that no FMU glue can go below). The Python loop shows what a Python master costs on top.
+Run: ``.venv/bin/python benchmarks/bench_fmu.py``. Goal (issue 29): under 20 ns CPU per
+sample (setReal + doStep + getReal) in the C host (issue 5: 50 ns). The C host runs REPEATS
+times; the medians of its wall-clock and CPU ns per sample are printed with the machine's load
+average (a loaded machine inflates the wall clock most, so the verdict is on CPU time), beside
+the same loop calling only the C core's ``pim_pi_step`` (the floor that no FMU glue can go
+below) and the ratio of the two. The Python loop shows what a Python master costs on top.
 """
 
 from __future__ import annotations
@@ -105,10 +106,10 @@ def main() -> None:
     print(f"PIHysteresis FMU, n = {n} plays")
     print(f"load average {load:.1f} on {os.cpu_count()} CPUs; medians of {REPEATS} runs")
     print(f"C host (dlopen; setReal + doStep + getReal per sample): {ns_c:.1f} ns/sample wall, "
-          f"{cpu_c:.1f} ns CPU ({1e3 / ns_c:.1f} M steps/s); goal < 20 ns -> "
-          f"{'met' if ns_c < 20 else 'NOT met'}")
+          f"{cpu_c:.1f} ns CPU ({1e3 / cpu_c:.1f} M steps/s); goal < 20 ns CPU -> "
+          f"{'met' if cpu_c < 20 else 'NOT met'}")
     print(f"the core's pim_pi_step alone in the same loop: {ns_f:.1f} ns wall, {cpu_f:.1f} ns "
-          f"CPU (the FMU glue adds {cpu_c - cpu_f:.1f} ns CPU)")
+          f"CPU (the FMU glue adds {cpu_c - cpu_f:.1f} ns CPU; FMU / core {cpu_c / cpu_f:.2f})")
     print(f"fmpy FMU2Slave loop in Python: {M / t_py:,.0f} steps/s "
           f"({t_py / M * 1e6:.1f} us/step), {t_py / M * 1e9 / ns_c:.0f}x the C host")
 

@@ -50,7 +50,8 @@ class UnitPrefix(ctypes.Structure):
                 ("in1", ctypes.c_double), ("in2", ctypes.c_double), ("out1", ctypes.c_double),
                 ("out2", ctypes.c_double), ("time", ctypes.c_double),
                 ("k_next", ctypes.c_int64), ("n", ctypes.c_int), ("mode", ctypes.c_int),
-                ("n_plays", ctypes.c_uint64)]
+                ("n_plays", ctypes.c_uint64), ("inv_Ts", ctypes.c_double),
+                ("t_tol", ctypes.c_double)]
 
 
 FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q", "n_plays": "Q"}  # others are doubles

@@ -67,13 +67,7 @@ size_t pim_gpi_run(size_t N, size_t n, const double *p, const double *r, double 
             bad = k + 1;
             break;
         }
-        double w = 0.0;
-        for (size_t i = 0; i < n; ++i) { /* play step, as pim_pi_step */
-            double zi = zs[i] < u + r[i] ? zs[i] : u + r[i];
-            zs[i] = zi > u - r[i] ? zi : u - r[i];
-            w += p[i] * zs[i];
-        }
-        y[k] = envelope(kind_out, c_out, w);
+        y[k] = envelope(kind_out, c_out, pim_pi_step_inline(n, p, r, zs, u));
         if (isnan(y[k])) {
             bad = k + 1;
             break;

@@ -3,21 +3,9 @@
 
 #include <math.h>
 
-/* z = max(lo, min(hi, z)) written with comparisons so that the compiler vectorises it. */
-static inline double pim_clamp(double z, double lo, double hi)
-{
-    z = z < hi ? z : hi;
-    return z > lo ? z : lo;
-}
-
 double pim_pi_step(size_t n, const double *p, const double *r, double *z, double v)
 {
-    double y = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        z[i] = pim_clamp(z[i], v - r[i], v + r[i]);
-        y += p[i] * z[i];
-    }
-    return y;
+    return pim_pi_step_inline(n, p, r, z, v);
 }
 
 void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
@@ -35,11 +23,7 @@ void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
     }
     for (size_t i = 0; i < n; ++i) zl[i] = z[i];
     for (size_t k = 0; k < N; ++k) {
-        const double vk = v[k];
-        for (size_t i = 0; i < n; ++i) zl[i] = pim_clamp(zl[i], vk - r[i], vk + r[i]);
-        double acc = 0.0;
-        for (size_t i = 0; i < n; ++i) acc += p[i] * zl[i];
-        y[k] = acc;
+        y[k] = pim_pi_step_inline(n, p, r, zl, v[k]);
         if (zhist) {
             for (size_t i = 0; i < n; ++i) zhist[k * n + i] = zl[i];
         }

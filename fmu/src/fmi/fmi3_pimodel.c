@@ -184,16 +184,41 @@ fmi3Status fmi3DoStep(fmi3Instance inst, fmi3Float64 t, fmi3Float64 h, fmi3Boole
     }                                                                                         \
     return fmi3OK
 
+/* The Float64 accessors: one value of the main input or output (unit_main_real, what a master
+ * moves every step) straight to its storage, all else through unit_ref, out of line so that
+ * the fast path saves no registers. */
+PIM_NOINLINE static fmi3Status get_float64s(fmi3Instance inst, const fmi3ValueReference vr[],
+                                            size_t nvr, fmi3Float64 values[], size_t nValues)
+{
+    PIM_ACCESS('R', double, 0, values[k] = x[j], (void)0);
+}
+
+PIM_NOINLINE static fmi3Status set_float64s(fmi3Instance inst, const fmi3ValueReference vr[],
+                                            size_t nvr, const fmi3Float64 values[],
+                                            size_t nValues)
+{
+    PIM_ACCESS('R', double, 1, (void)0, x[j] = values[k]);
+}
+
 fmi3Status fmi3GetFloat64(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                           fmi3Float64 values[], size_t nValues)
 {
-    PIM_ACCESS('R', double, 0, values[k] = x[j], (void)0);
+    const double *x = inst && nvr == 1 && nValues >= 1
+                          ? unit_main_real(&((Inst *)inst)->u, vr[0], 0)
+                          : NULL;
+    if (!x) return get_float64s(inst, vr, nvr, values, nValues);
+    values[0] = *x;
+    return fmi3OK;
 }
 
 fmi3Status fmi3SetFloat64(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,
                           const fmi3Float64 values[], size_t nValues)
 {
-    PIM_ACCESS('R', double, 1, (void)0, x[j] = values[k]);
+    double *x = inst && nvr == 1 && nValues >= 1 ? unit_main_real(&((Inst *)inst)->u, vr[0], 1)
+                                                 : NULL;
+    if (!x) return set_float64s(inst, vr, nvr, values, nValues);
+    *x = values[0];
+    return fmi3OK;
 }
 
 fmi3Status fmi3GetInt32(fmi3Instance inst, const fmi3ValueReference vr[], size_t nvr,

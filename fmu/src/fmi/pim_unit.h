@@ -59,6 +59,7 @@
 #ifndef PIM_UNIT_H
 #define PIM_UNIT_H
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdarg.h>
@@ -129,6 +130,9 @@ typedef struct {
     int n, mode;
     /* FMI 3's structural parameter: the size of the per-play arrays (FMI 2: PIM_NMAX) */
     uint64_t n_plays;
+    /* derived from Ts (unit_derive_time): 1 / Ts, so that a doStep counts its samples without
+     * a division, and the tolerance of a doStep's t that needs no further check */
+    double inv_Ts, t_tol;
     /* the unit's own parameters, states and derived quantities */
 #include "fields.h"
     char msg[256]; /* reason of the last failure */
@@ -229,6 +233,13 @@ static int model_report(const pim_unit *u, char *buf, size_t size)
 }
 #endif
 
+/* The sampling rule's tolerance at sample x, in samples (unit_first_sample). */
+static double unit_sample_tol(double x)
+{
+    const double tol = PIM_SAMPLE_TOL + x * x * 2.220446049250313e-16;
+    return tol < 1e-3 ? tol : 1e-3;
+}
+
 /* Index of the first sample at or after time t: ceil(t / Ts) up to the rounding of a time
  * computed by a master (PIM_SAMPLE_TOL plus x^2 eps samples at sample x, what a clock that adds
  * its step x times accumulates; at most 1e-3 samples), so that a communication grid that
@@ -236,8 +247,44 @@ static int model_report(const pim_unit *u, char *buf, size_t size)
 static double unit_first_sample(const pim_unit *u, double t)
 {
     const double x = t / u->Ts;
-    const double tol = PIM_SAMPLE_TOL + x * x * 2.220446049250313e-16;
-    return ceil(x - (tol < 1e-3 ? tol : 1e-3));
+    return ceil(x - unit_sample_tol(x));
+}
+
+/*
+ * The end sample k1 of a doStep ending at t > 0 (unit_first_sample(u, t)), or -1 when it is
+ * beyond the counter's range, with the reciprocal u->inv_Ts (unit_derive_time) instead of a
+ * division.  x = t * inv_Ts is within 3.4e-16 x of the rule's t / Ts (three roundings) and the
+ * rule's tolerance within a relative 1e-15 of unit_sample_tol(x), so for x < 2^32 the result
+ * is the rule's whenever x lies at least 1e-15 x + 1e-6 tol below (result k) or above (result
+ * k + 1) an integer k plus the tolerance (a margin that also covers the rounding of the rule's
+ * x - tol).  Most steps end within half the smallest tolerance (1e-9 / 2) above an integer, or
+ * beyond the largest (1e-3) plus the error: two comparisons decide them without the
+ * tolerance.  Only a step end within that margin of the tolerance, or beyond 2^32 samples,
+ * asks unit_first_sample.
+ */
+static int64_t unit_end_sample(const pim_unit *u, double t)
+{
+    const double x = t * u->inv_Ts;
+    if (x < 4294967296.0) {
+        const int64_t k = (int64_t)x; /* floor: x > 0 */
+        const double frac = x - (double)k;
+        if (frac <= 0.5 * PIM_SAMPLE_TOL) return k;
+        if (frac >= 1.01e-3) return k + 1;
+        const double tol = unit_sample_tol(x), margin = 1e-15 * x;
+        if (frac <= tol * (1.0 - 1e-6) - margin) return k;
+        if (frac > tol * (1.0 + 1e-6) + margin) return k + 1;
+    }
+    const double k = unit_first_sample(u, t);
+    return k < PIM_MAX_SAMPLE_INDEX ? (int64_t)k : -1;
+}
+
+/* What the sampling rule derives from Ts (setup, restored FMU states): the reciprocal of
+ * unit_end_sample and the tolerance within which a doStep's t matches the FMU's time without
+ * further checks (the smallest of the rule's tolerances: 1e-9 s, or 1e-3 Ts). */
+static void unit_derive_time(pim_unit *u)
+{
+    u->inv_Ts = 1.0 / u->Ts;
+    u->t_tol = u->Ts < 1e-6 ? 1e-3 * u->Ts : 1e-9;
 }
 
 static void unit_defaults(pim_unit *u)
@@ -269,6 +316,7 @@ static int unit_start(pim_unit *u, double t0, int stop_defined, double t_stop)
 /* Quantities derived from checked parameters; at setup and for every restored FMU state. */
 static int unit_derive(pim_unit *u)
 {
+    unit_derive_time(u);
     return model_derive(u);
 }
 
@@ -327,6 +375,7 @@ static int unit_setup(pim_unit *u)
         return unit_error(u, "start time %g is beyond the sample counter's range (2^52 samples "
                              "of Ts = %g)", u->time, u->Ts);
     u->k_next = (int64_t)k0;
+    unit_derive_time(u);
     if (model_setup(u) != 0) return -1;
     unit_start_outputs(u);
     return 0;
@@ -368,16 +417,16 @@ static int unit_samples_checked(pim_unit *u, int64_t k1)
     return 0;
 }
 
-/* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above). */
+/* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above).  The usual
+ * step takes a few comparisons: t at the FMU's time within u->t_tol, h finite and > 0, the end
+ * sample from unit_end_sample's fast path; the other cases get the full checks. */
 static int unit_do_step(pim_unit *u, double t, double h)
 {
     if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
-    if (!(h > 0.0) || !isfinite(h))
+    if (!(h > 0.0 && h <= DBL_MAX))
         return unit_error(u, "communication step size h = %g: must be finite and > 0", h);
-    /* u->time is finite and >= 0: only another t needs the checks, and one within the
-     * smallest tolerance (1e-9 s, or 1e-3 Ts) not even the scale of the time */
-    const double dt = fabs(t - u->time);
-    if (dt != 0.0 && !(t >= 0.0 && dt <= (u->Ts < 1e-6 ? 1e-3 * u->Ts : 1e-9))) {
+    /* u->time is finite and >= 0: only a t further away needs the scale of the time */
+    if (!(fabs(t - u->time) <= u->t_tol && t >= 0.0)) {
         if (!isfinite(t) || t < 0.0)
             return unit_error(u, "communication point t = %g: must be finite and >= 0", t);
         const double scale = fabs(u->time) > 1.0 ? fabs(u->time) : 1.0;
@@ -390,29 +439,26 @@ static int unit_do_step(pim_unit *u, double t, double h)
     if (!(t_end > t))
         return unit_error(u, "no progress: t + h == t at t = %g, h = %g (h is below the time "
                              "resolution at t)", t, h);
-    const double k_end = unit_first_sample(u, t_end);
-    if (!(k_end < PIM_MAX_SAMPLE_INDEX))
+    const int64_t k1 = unit_end_sample(u, t_end);
+    if (k1 < 0)
         return unit_error(u, "time t + h = %g is beyond the sample counter's range (2^52 "
                              "samples of Ts = %g)", t_end, u->Ts);
-    const int64_t k1 = (int64_t)k_end;
     if (k1 - u->k_next > PIM_MAX_SUBSTEPS)
         return unit_error(u, "step h = %g spans %lld samples of Ts = %g; at most %lld per doStep "
                              "(use shorter communication steps)", h,
                           (long long)(k1 - u->k_next), u->Ts, PIM_MAX_SUBSTEPS);
-    if (k1 <= u->k_next) {
-        u->time = t_end;
-        return 0;
+    if (k1 > u->k_next) {
+        if (unit_check_inputs(u) != 0) return -1;
+        if (model_step_safe(u)) { /* no sample can overflow: a tight loop, nothing to roll back */
+            int64_t k = u->k_next;
+            do model_sample(u);
+            while (++k < k1);
+            u->k_next = k1;
+        } else if (unit_samples_checked(u, k1) != 0) {
+            return -1;
+        }
+        model_step_done(u);
     }
-    if (unit_check_inputs(u) != 0) return -1;
-    if (model_step_safe(u)) { /* no sample can overflow: a tight loop, nothing to roll back */
-        int64_t k = u->k_next;
-        do model_sample(u);
-        while (++k < k1);
-        u->k_next = k1;
-    } else if (unit_samples_checked(u, k1) != 0) {
-        return -1;
-    }
-    model_step_done(u);
     u->time = t_end;
     return 0;
 }
@@ -471,9 +517,11 @@ static int unit_settable(const pim_unit *u, const pim_var *v)
 /* Error paths out of line, so that the accessors stay small (they run on every get/set). */
 #if defined(__GNUC__)
 #define PIM_COLD __attribute__((noinline, cold))
+#define PIM_NOINLINE __attribute__((noinline))
 #define PIM_HOT_INLINE __attribute__((always_inline)) inline
 #else
 #define PIM_COLD
+#define PIM_NOINLINE
 #define PIM_HOT_INLINE inline
 #endif
 
@@ -526,6 +574,34 @@ static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int el
     return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
 }
 
+/* The value reference of the scalar Real variable stored at `offset` (the main input in1 of
+ * causality input, the main output out1), or -1; from the constant table, so that the
+ * compiler folds it to a number. */
+static PIM_HOT_INLINE long unit_main_vr(size_t offset, pim_causality causality)
+{
+    for (size_t i = 0; i < PIM_NVARS; ++i)
+        if (unit_vars[i].offset == offset && unit_vars[i].type == 'R' && unit_vars[i].size == 1 &&
+            unit_vars[i].causality == causality)
+            return (long)unit_vars[i].vr;
+    return -1;
+}
+
+/*
+ * The accessors' fast path for what a master moves every step: the storage of the main input
+ * in1 (set != 0, in a mode where unit_settable allows an input) or of the main output out1
+ * (set == 0); NULL for any other variable or mode, which then takes unit_ref (the same rules,
+ * and the reasons of a refusal).
+ */
+static PIM_HOT_INLINE double *unit_main_real(pim_unit *u, unsigned vr, int set)
+{
+    if (set)
+        return (long)vr == unit_main_vr(PIM_AT(in1), PIM_INPUT) && u->mode != PIM_TERMINATED &&
+                       u->mode != PIM_CONFIG_MODE
+                   ? &u->in1
+                   : NULL;
+    return (long)vr == unit_main_vr(PIM_AT(out1), PIM_OUTPUT) ? &u->out1 : NULL;
+}
+
 /* ---- FMU state: a checked, versioned byte format ------------------------------------------ */
 
 /*
@@ -541,9 +617,10 @@ static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int el
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 7u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+#define PIM_STATE_VERSION 8u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
                                 prefilter (Wiener); 5: DiagnosedInverse fields, post sections;
-                                6: the common part, then the unit's own fields; 7: n_plays */
+                                6: the common part, then the unit's own fields; 7: n_plays;
+                                8: inv_Ts, t_tol (derived, recomputed on load) */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {

@@ -51,5 +51,5 @@ static void model_sample(pim_unit *u)
     if (u->adaptive)
         u->out1 = pim_adaptive_inverse_step(n, u->p, u->rhat_in, u->z, u->in1);
     else
-        u->out1 = pim_pi_step(n, u->pinv, u->rinv, u->z, u->in1);
+        u->out1 = pim_pi_step_inline(n, u->pinv, u->rinv, u->z, u->in1);
 }

@@ -30,5 +30,5 @@ static int model_step_safe(const pim_unit *u) { return fabs(u->in1) <= u->v_safe
 
 static void model_sample(pim_unit *u)
 {
-    u->out1 = pim_pi_step((size_t)u->n, u->p, u->r, u->z, u->in1);
+    u->out1 = pim_pi_step_inline((size_t)u->n, u->p, u->r, u->z, u->in1);
 }
