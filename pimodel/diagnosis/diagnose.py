@@ -89,6 +89,8 @@ SETTLE_BOW_FLOORS = 2.0  # a settling is named only when its bow exceeds this ma
 UNEXPLAINED_FACTOR = 2.0  # a gap above this factor of the noise floor is not "none"
 UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this share of the gap
 DYNAMICS_KEYS = ("fn", "zeta", "lti")  # grid keys of dynamics after the hysteresis
+LAG_EFFECTS = ("dynamics", "delay")  # two names for one lag: re-decided beside later effects
+LAG_KEYS = (*DYNAMICS_KEYS, "wiener", "d")  # their grid keys
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
 INITIAL_STATES = ("rest", "unknown")
 EFFECT_SIGNATURES = {
@@ -652,6 +654,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         chosen += name if isinstance(name, tuple) else (name,)
         fixed.update(m.grid)
         current, cur_out = m, o
+        chosen, current, cur_out = _research_lag(chosen, (current, cur_out), fixed, fit, va)
     progress("revising the choice")
     chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
                                        (nominal, out_va), noise)
@@ -794,6 +797,32 @@ def _beyond_refinement(new, chosen, fixed, fit, va) -> bool:
         if not _passes(va, new, fit(chosen[-1], chosen[:-1], refined)):
             return False
     return True
+
+
+def _research_lag(chosen, cur, fixed, fit, va):
+    """After an effect is accepted beside others: the lag effect chosen (``dynamics`` or
+    ``delay``, exactly one) searched again with the other effects present, and the other lag
+    effect tried in its place (its own parameters searched with the others held). A lag chosen
+    in an earlier round was chosen with a confounding effect unmodelled (a base mode picked
+    while an asymmetry dominated the gap); the two names are alternatives for one part of the
+    model, so the lowest validate BIC of the three decides (``cur``: the current model and
+    validate outputs). ``fixed`` is updated; returns ``(chosen, model, validate outputs)``."""
+    lags = [e for e in chosen if e in LAG_EFFECTS]
+    if len(chosen) < 2 or len(lags) != 1:
+        return chosen, cur[0], cur[1]
+    kept = {k: x for k, x in fixed.items() if k not in LAG_KEYS}
+    other = next(e for e in LAG_EFFECTS if e != lags[0])
+    best = (_bic(va, cur[1], cur[0].k), chosen, cur)
+    for option in (chosen, tuple(other if e == lags[0] else e for e in chosen)):
+        new = fit(option[-1], option[:-1], dict(kept))
+        score = _bic(va, new[1], new[0].k)
+        if score < best[0]:
+            best = (score, option, new)
+    if best[1] is not chosen or best[2] is not cur:
+        for k in LAG_KEYS:
+            fixed.pop(k, None)
+        fixed.update(best[2][0].grid)
+    return best[1], best[2][0], best[2][1]
 
 
 def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):

@@ -29,7 +29,7 @@ from .drift import (
     settle_start,
 )
 from .filters import lag, mode, mode_coefficients, mode_rows, shift
-from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
+from .lti import BASE_MIN_HZ, describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import (
     RATE_BANDS,
     RATE_FAMILIES,
@@ -740,7 +740,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
         def cost(x):
             p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
-            if p["fn"] > fmax or not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
+            # a mode below BASE_MIN_HZ is a near-singular pole (its columns overflow the
+            # least squares: density seed 0, creep + dynamics, wandered to 1e-6 Hz)
+            if not BASE_MIN_HZ <= p["fn"] <= fmax or \
+                    not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
                 return np.inf
             return _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
                         train, p)[1]
