@@ -551,7 +551,9 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         ``rate_tau``, ``rate_saturation``). Two keys make an effect's model richer:
         ``"refine": "creep"``, a further lag ``REFINED_CREEP_LAG`` times the longest;
         ``"lti_min": n``, at least ``n`` further elements of the linear part
-        (:func:`.lti.select_order`).
+        (:func:`.lti.select_order`). ``"search_all": True``: the mode search with every play
+        column, not the leading ``SEARCH_COLUMNS`` (slower; the diagnosis' re-search of a lag
+        beside a later effect, :func:`pimodel.diagnosis.diagnose._research_lag`).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -608,6 +610,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     # (pimodel.diagnosis.diagnose): fixed["refine"] = "creep", a further lag;
     # fixed["lti_min"], at least that many further elements of the linear part
     lti_min = fixed.pop("lti_min", 0)
+    search_all = fixed.pop("search_all", False)
     if fixed.pop("refine", None) == "creep" and "creep" in effects:
         taus = tuple(nominal.params["creep_taus"])
         nominal = replace(nominal, params={**nominal.params,
@@ -621,7 +624,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     positions: list = []  # train BIC of the dynamics after and before the hysteresis
     # the dynamics held (a base mode, or a filter before the hysteresis: module wiener)
     dyn_fixed = "fn" in fixed or "wiener" in fixed
-    ncols = SEARCH_COLUMNS if "dynamics" in effects and not dyn_fixed else None
+    ncols = SEARCH_COLUMNS if "dynamics" in effects and not dyn_fixed and not search_all \
+        else None
 
     full, train = train, _screen(train, effects, fixed)  # the searches on the screen
     tried: list = []  # (train RSS, grid point) of the first search, for the confirmation
