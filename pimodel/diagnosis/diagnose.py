@@ -24,9 +24,9 @@ chosen earlier (``dynamics`` or ``delay``, one of them) is searched again beside
 lag tried in its place, the lowest validate BIC kept (:func:`_research_lag`). Then the choice is
 revised on the same terms: a chosen effect is swapped for an unchosen one while that passes, and
 an effect that no longer passes against the combination without it is dropped (an effect chosen
-early can stand in for one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure
-delay on the records (gain within 10 % of 1 over the lower quarter of the band,
-:mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its place.
+early can stand in for one that only passes beside a later one). Last, a chosen ``dynamics``
+that acts as a pure delay on the records (gain within 10 % of 1 over the lower quarter of the
+band, :mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its place.
 The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the
 train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a
 level per record, :mod:`.drift`) is chosen on validate for every combination.
