@@ -26,10 +26,10 @@ revised on the same terms: a chosen effect is swapped for an unchosen one while 
 an effect that no longer passes against the combination without it is dropped (an effect chosen
 early can stand in for one that only passes beside a later one). Last, a chosen ``dynamics``
 that acts as a pure delay on the records (gain within 10 % of 1 over the lower quarter of the
-band, :mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its place.
-The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the
-train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a
-level per record, :mod:`.drift`) is chosen on validate for every combination.
+band, :mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its
+place. The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or,
+where the train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock,
+or a level per record, :mod:`.drift`) is chosen on validate for every combination.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
