@@ -69,6 +69,8 @@ MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
 MODE_HEAVY = (tuple(np.geomspace(100.0, 5000.0, 9)), 0.7)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
+MIN_MODE_RATE = 0.05  # the base mode's polish stays above this share of the sample rate or
+# lti.BASE_MIN_HZ, whichever is lower (a 200 Hz record's damped lag sits at 45 Hz)
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
 SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
@@ -640,6 +642,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         return best
 
     fmax = MAX_MODE_NYQUIST * 0.5 / train[0].dt  # a sampled mode must stay below Nyquist
+    fmin = min(BASE_MIN_HZ, MIN_MODE_RATE / train[0].dt)  # the base mode's polish: above
     dgrid = delay_grid(train[0].dt)
     grids: list[list[dict]] = []
     for e in effects:
@@ -744,9 +747,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
         def cost(x):
             p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
-            # a mode below BASE_MIN_HZ is a near-singular pole (its columns overflow the
-            # least squares: density seed 0, creep + dynamics, wandered to 1e-6 Hz)
-            if not BASE_MIN_HZ <= p["fn"] <= fmax or \
+            # a mode far below the sample rate is a near-singular pole (its columns overflow
+            # the least squares: density seed 0, creep + dynamics, wandered to 1e-6 Hz)
+            if not fmin <= p["fn"] <= fmax or \
                     not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
                 return np.inf
             return _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
