@@ -29,7 +29,7 @@ from .drift import (
     settle_start,
 )
 from .filters import lag, mode, mode_coefficients, mode_rows, shift
-from .lti import BASE_MIN_HZ, describe_lti, lti_columns, lti_k, nelder_mead, select_order
+from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import (
     RATE_BANDS,
     RATE_FAMILIES,
@@ -69,8 +69,6 @@ MODE_DAMPING = (0.02, 0.05, 0.1, 0.2)
 MODE_HEAVY = (tuple(np.geomspace(100.0, 5000.0, 9)), 0.7)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
-MIN_MODE_RATE = 0.05  # the base mode's polish stays above this share of the sample rate or
-# lti.BASE_MIN_HZ, whichever is lower (a 200 Hz record's damped lag sits at 45 Hz)
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
 SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
@@ -642,7 +640,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         return best
 
     fmax = MAX_MODE_NYQUIST * 0.5 / train[0].dt  # a sampled mode must stay below Nyquist
-    fmin = min(BASE_MIN_HZ, MIN_MODE_RATE / train[0].dt)  # the base mode's polish: above
+    # the base mode's polish: at least one period within the shortest train record (slower is
+    # a trend, and near-singular: a pair fit ran to 1e-6 Hz and its least squares failed)
+    fmin = 1.0 / min(s.t[-1] - s.t[0] for s in train)
     dgrid = delay_grid(train[0].dt)
     grids: list[list[dict]] = []
     for e in effects:
