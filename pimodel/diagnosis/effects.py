@@ -554,7 +554,10 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         ``"lti_min": n``, at least ``n`` further elements of the linear part
         (:func:`.lti.select_order`). ``"held": True`` with every effect's grid parameters
         given (a fitted model's ``grid``): no search at all, the linear part's elements
-        ``lti`` kept as given (a refit on other records).
+        ``lti`` kept as given (a refit on other records). ``"search_all": True``: the mode
+        search with every play column, not the leading ``SEARCH_COLUMNS`` (slower; the
+        diagnosis' re-search of a lag beside a later effect,
+        :func:`pimodel.diagnosis.diagnose._research_lag`).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -612,6 +615,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     # fixed["lti_min"], at least that many further elements of the linear part
     lti_min = fixed.pop("lti_min", 0)
     held = fixed.pop("held", False)  # every grid parameter as given: no search at all
+    search_all = fixed.pop("search_all", False)
     if fixed.pop("refine", None) == "creep" and "creep" in effects:
         taus = tuple(nominal.params["creep_taus"])
         nominal = replace(nominal, params={**nominal.params,
@@ -625,7 +629,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     positions: list = []  # train BIC of the dynamics after and before the hysteresis
     # the dynamics held (a base mode, or a filter before the hysteresis: module wiener)
     dyn_fixed = "fn" in fixed or "wiener" in fixed
-    ncols = SEARCH_COLUMNS if "dynamics" in effects and not dyn_fixed else None
+    ncols = SEARCH_COLUMNS if "dynamics" in effects and not dyn_fixed and not search_all \
+        else None
 
     full, train = train, _screen(train, effects, fixed)  # the searches on the screen
     tried: list = []  # (train RSS, grid point) of the first search, for the confirmation
@@ -640,6 +645,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         return best
 
     fmax = MAX_MODE_NYQUIST * 0.5 / train[0].dt  # a sampled mode must stay below Nyquist
+    # the base mode's polish: at least one period within the shortest train record (slower is
+    # a trend, and near-singular: a pair fit ran to 1e-6 Hz and its least squares failed)
+    fmin = 1.0 / min(s.t[-1] - s.t[0] for s in train)
     dgrid = delay_grid(train[0].dt)
     grids: list[list[dict]] = []
     for e in effects:
@@ -744,7 +752,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
         def cost(x):
             p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
-            if p["fn"] > fmax or not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
+            # a mode far below the sample rate is a near-singular pole (its columns overflow
+            # the least squares: density seed 0, creep + dynamics, wandered to 1e-6 Hz)
+            if not fmin <= p["fn"] <= fmax or \
+                    not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
                 return np.inf
             return _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
                         train, p)[1]
