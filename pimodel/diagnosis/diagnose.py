@@ -25,7 +25,12 @@ longer passes against the combination without it is dropped (an effect chosen ea
 for one that only passes beside a later one). Last, a chosen ``dynamics`` that acts as a pure
 delay on the records (gain within 10 % of 1 over the lower quarter of the band,
 :mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its place.
-The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the
+When the path so chosen leaves a gap ``unexplained``, the rounds are run again forced to
+start from each of the next ``ALT_STARTS`` candidates (alone or in a pair with each
+other effect), and the path with the lowest validate BIC is kept: a first effect can stand
+in for two others that pass only together (a broad lag for creep and rate-dependent
+hysteresis). The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`)
+or, where the
 train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a
 level per record, :mod:`.drift`) is chosen on validate for every combination.
 
@@ -56,11 +61,13 @@ from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
 from .effects import (
     EFFECTS,
+    SCREEN_SAMPLES,
     Model,
     Segment,
     base_features,
     fit_effect,
     fit_nominal,
+    head_segment,
     make_segment,
     nominal_params,
     play_chunks,
@@ -244,9 +251,18 @@ def _errors(segs: list[Segment], outputs) -> dict:
             "max_percent": 100 * mx / rng, "range": rng}
 
 
-def _bic(segs, outputs, k) -> float:
+def _bic(segs, outputs, k, n: int | None = None) -> float:
+    """``N ln(RSS/N) + k ln N`` of the fitted samples; with ``n``: the BIC of ``n`` samples
+    whose mean squared residual is that of ``segs`` (a screen standing for whole records)."""
     r = np.concatenate([(s.y - o)[s.used] for s, o in zip(segs, outputs, strict=True)])
-    return float(r.size * np.log(max(np.mean(r**2), 1e-300)) + k * np.log(r.size))
+    n = r.size if n is None else n
+    return float(n * np.log(max(np.mean(r**2), 1e-300)) + k * np.log(n))
+
+
+def _fitted_samples(records: list[Record], initial_state: str) -> int:
+    """The fitted samples of ``records`` (all, or those after the start-up)."""
+    return sum(len(r) if (m := _mask(r, initial_state)) is None else int(np.sum(m))
+               for r in records)
 
 
 def _check(records: list[Record], role: str) -> None:
@@ -340,15 +356,24 @@ def _segments(records: list[Record], radii, initial_state: str,
             for r in records]
 
 
+def _bare(records: list[Record], initial_state: str, samples: int | None = None) -> list[Segment]:
+    """The records as segments without play outputs (``Z`` is None), cut to their first
+    ``samples`` samples (None: whole; the start-up mask is that of the whole record)."""
+    cut = slice(samples)
+    return [Segment(r.t[cut], r.v[cut], r.y[cut], None,
+                    None if (m := _mask(r, initial_state)) is None else m[cut]) for r in records]
+
+
 def _plain_fit(records: list[Record], radii, initial_state: str,
-               at_rest: bool = True) -> tuple[list[Segment], NormalEquations]:
+               at_rest: bool = True, samples: int | None = None
+               ) -> tuple[list[Segment], NormalEquations]:
     """The PI fit (play weights and an offset) that :func:`.effects.fit_nominal` makes, in one
     pass over the records with one chunk of play outputs at a time (:func:`.effects.play_chunks`
     into :class:`.chunked.NormalEquations`): nothing of size (samples x plays) is kept. Returns
-    the records as segments without play outputs (``Z`` is None; for :func:`_errors` and
-    :func:`_bic`) and the normal equations (``solve()`` gives the coefficients, ``G`` the Gram
-    matrix of the plays and the offset on the fitted samples)."""
-    segs = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in records]
+    the records as segments without play outputs (:func:`_bare`, their first ``samples``
+    samples; None: whole) and the normal equations (``solve()`` gives the coefficients, ``G``
+    the Gram matrix of the plays and the offset on the fitted samples)."""
+    segs = _bare(records, initial_state, samples)
     ne = NormalEquations(np.size(radii) + 1)
     for s in segs:
         for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
@@ -408,13 +433,17 @@ def _nominal(train, validate, initial_state):
     half, extended = _grids(train)
     if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
         half, extended = [], []
-    picks = []  # the grids are compared by fits streamed over the records (_plain_fit)
+    picks = []  # the grids are compared by fits streamed over the records (_plain_fit), on
+    # the records' first SCREEN_SAMPLES samples (the grids span the whole train input), by
+    # the BIC of the whole records' sample count (the screen's mean squared residual)
+    n_train = _fitted_samples(train, initial_state)
     for at_rest, grids in ((True, half), (True, extended), (False, _grids(train)[0])):
         best = None
         for radii in grids:
-            segs, ne = _plain_fit(train, radii, initial_state, at_rest)
+            segs, ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)
             coef = ne.solve()
-            bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1)
+            bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1,
+                       n_train)
             if best is None or bic < best[0]:
                 best = (bic, radii, coef, at_rest)
         picks.append(best)
@@ -423,8 +452,9 @@ def _nominal(train, validate, initial_state):
     if picks[1] is not None:  # the extension: kept only when validate agrees
         vbic = []
         for _, radii, coef, at_rest in picks[:2]:
-            va = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
-            vbic.append(_bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1))
+            va = _bare(validate, initial_state, SCREEN_SAMPLES)
+            vbic.append(_bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1,
+                             _fitted_samples(validate, initial_state)))
         if vbic[1] >= vbic[0]:
             picks[1] = None
     ext = picks[1] is not None
@@ -441,7 +471,7 @@ def _baseline(train, validate, initial_state) -> dict:
     radii = np.linspace(0.0, vmax, BASELINE_PLAYS)
     tr, ne = _plain_fit(train, radii, initial_state)  # streamed: no 60 play columns kept
     coef = ne.solve()
-    va = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
+    va = _bare(validate, initial_state)
     return {"kind": "PI, plain least squares", "plays": BASELINE_PLAYS, "max_radius": vmax,
             "train": _errors(tr, _plain_outputs(tr, radii, coef)),
             "validate": _errors(va, _plain_outputs(va, radii, coef))}
@@ -463,7 +493,7 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool)
     coef = ne.solve()
     out_tr = _plain_outputs(segs, radii, coef, at_rest)
     full = Model("nominal", 0, base_features, coef, nominal_params(coef, out_tr, segs))
-    vsegs = [Segment(r.t, r.v, r.y, None, _mask(r, initial_state)) for r in validate]
+    vsegs = _bare(validate, initial_state)
     out_va = _plain_outputs(vsegs, radii, coef, at_rest)
     if n > PROJECTED:
         rss_full = sum(float(np.sum((o - s.y)[s.used] ** 2)) for s, o in zip(segs, out_tr,
@@ -477,9 +507,14 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool)
         # beside a slow drift too, within 1 % plus what the dropped directions fit of the noise
         # (a drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can
         # hide directions a drift model needs)
-        n_fit = sum(s.y.size if s.mask is None else int(np.sum(s.mask)) for s in segs)
-        if rss <= 1.01 * rss_full and _slow_rss(segs, radii, at_rest, V) <= (
-                1.01 + (n - V.shape[1]) / n_fit) * _slow_rss(segs, radii, at_rest):
+        # (on the records' first SCREEN_SAMPLES samples, where the effects are chosen)
+        screen = _bare(train, initial_state, SCREEN_SAMPLES)
+        n_fit = sum(s.y.size if s.mask is None else int(np.sum(s.mask)) for s in screen)
+        keep = rss <= 1.01 * rss_full
+        if keep:
+            slow_full, slow_projected = _slow_rss(screen, radii, at_rest, V)
+            keep = slow_projected <= (1.01 + (n - V.shape[1]) / n_fit) * slow_full
+        if keep:
             m.params = dict(full.params)
             return (ctr, [_projected(s, radii, V, at_rest) for s in vsegs], m, full, V,
                     out_tr, out_va)
@@ -500,25 +535,30 @@ def _flat_settling(m: Model, tr, va, noise: float) -> bool:
     return abs(float(m.params["drift_settling"])) * bow < SETTLE_BOW_FLOORS * noise
 
 
-def _slow_rss(segs: list[Segment], radii, at_rest: bool, V: np.ndarray | None = None) -> float:
-    """RSS of the least-squares fit of the fitted samples of ``y`` on the play columns (``Z V``
-    with ``V``; the play outputs streamed from the input, :func:`~.effects.play_chunks`), an
+def _slow_rss(segs: list[Segment], radii, at_rest: bool, V: np.ndarray) -> tuple[float, float]:
+    """RSS of the least-squares fits of the fitted samples of ``y`` on the play columns (``Z``,
+    then ``Z V``; the play outputs streamed from the input, :func:`~.effects.play_chunks`), an
     offset per record and Legendre polynomials of degree 1 to ``SLOW_DEGREE`` of the time on
-    the clock the records share (a slow drift), by a QR of the stacked chunks (``[X y]``'s last
-    diagonal entry of ``R`` squared)."""
+    the clock the records share (a slow drift), in one pass: a QR of the stacked chunks of
+    ``[Z, offsets, polynomials, y]``, then of ``R T`` with ``T = diag(V, I)`` (``X T = Q (R T)``,
+    so that factor is the projected fit's). Each RSS is its factor's last diagonal entry
+    squared (0 with fewer fitted samples than columns)."""
     t0 = min(float(s.t[0]) for s in segs)
     span = max(float(s.t[-1]) for s in segs) - t0 or 1.0
     R = None
     for j, s in enumerate(segs):
         for c, P in play_chunks(s.v, radii, at_rest=at_rest):
             x = 2.0 * (s.t[c] - t0) / span - 1.0
-            rows = [P[:-1] if V is None else V.T @ P[:-1],
-                    np.eye(len(segs))[j][:, None] * np.ones(x.size),
+            rows = [P[:-1], np.eye(len(segs))[j][:, None] * np.ones(x.size),
                     np.polynomial.legendre.legvander(x, SLOW_DEGREE)[:, 1:].T, s.y[c][None]]
             M = np.vstack(rows).T
             M = M if s.mask is None else M[s.mask[c]]
             R = np.linalg.qr(M if R is None else np.vstack((R, M)), mode="r")
-    return float(R[-1, -1] ** 2) if R.shape[0] == R.shape[1] else 0.0
+    n, rest = V.shape[0], R.shape[1] - V.shape[0]
+    T = np.zeros((R.shape[1], V.shape[1] + rest))
+    T[:n, :V.shape[1]], T[n:, V.shape[1]:] = V, np.eye(rest)
+    Rp = np.linalg.qr(R @ T, mode="r")
+    return tuple(float(F[-1, -1] ** 2) if F.shape[0] == F.shape[1] else 0.0 for F in (R, Rp))
 
 
 def _projected(s: Segment, radii, V: np.ndarray, at_rest: bool) -> Segment:
@@ -542,9 +582,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     progress("nominal model (radius grids)")
     radii, extended, at_rest = _nominal(train, validate, initial_state)
     n_plays = radii.size
+    progress(f"nominal model ({radii.size} plays, fitted on the whole records)")
     tr, va, nominal, full_nominal, proj, out_tr, out_va = _nominal_segments(
         train, validate, radii, initial_state, at_rest)
     before = _errors(va, out_va)
+    progress("plain least-squares baseline")
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
                               "weights": full_nominal.coef[:n_plays],
                               "offset": full_nominal.coef[n_plays],
@@ -561,18 +603,28 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       "report.nominal['baseline']): the effects are measured against a weak "
                       "nominal", UserWarning, stacklevel=3)
     where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
+    progress("noise floor")
+    noise_info = measure_noise_floor([(s.v, s.y) for s in tr + va], out_tr + out_va)
+    noise = noise_info["value"]
+    # records longer than SCREEN_SAMPLES: every search and comparison below runs on their
+    # first SCREEN_SAMPLES samples; the chosen model is refitted on the whole (_whole_fit)
+    whole = (tr, va, out_va)
+    screened = any(s.y.size > SCREEN_SAMPLES for s in tr + va)
+    if screened:
+        tr, va = ([head_segment(s, SCREEN_SAMPLES) for s in segs_] for segs_ in (tr, va))
+        out_va = [o[:SCREEN_SAMPLES] for o in out_va]
     segs = tr + va
     # the rate columns from the full play outputs (computed chunk by chunk from the input
-    # when needed), weighted as the model will hold them
+    # when needed), weighted as the model will hold them; the step rule on the whole input
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
-    for s in segs:
+    pairs = [(w, w) for w in whole[0] + whole[1]]  # (segment, its whole record)
+    if screened:
+        pairs += list(zip(segs, whole[0] + whole[1], strict=True))
+    for s, w in pairs:
         s.rate_basis = RateBasis(None, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref,
-                                 at_rest=at_rest)
+                                 input_range=float(np.ptp(w.v)), at_rest=at_rest)
         s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt,  # dynamics before the plays
                                      at_rest=at_rest)
-    progress("noise floor")
-    noise_info = measure_noise_floor([(s.v, s.y) for s in segs], out_tr + out_va)
-    noise = noise_info["value"]
 
     cache: dict = {}
 
@@ -666,8 +718,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return chosen, fixed, current, cur_out
 
     chosen, fixed, current, cur_out = choose()
-    if chosen and _unexplained(va, cur_out, before["rms"], _errors(va, cur_out)["rms"],
-                               noise, out_va)["present"]:
+    if chosen and _unexplained(va, cur_out, _errors(va, out_va)["rms"],
+                               _errors(va, cur_out)["rms"], noise, out_va)["present"]:
         # a gap left unexplained after the greedy path: the first effect may stand in for
         # two others that only pass together (a broad lag for creep and rate); paths that
         # start from the next candidates alone are tried, the lowest validate BIC kept
@@ -678,6 +730,17 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if path[0] and score < best[0] - MIN_BIC_DROP:
                 best = (score, path)
         chosen, fixed, current, cur_out = best[1]
+    screen = None
+    if screened:  # the choice, refitted on the whole records; the verdict's figures whole
+        progress("the chosen model on the whole records")
+        tr, va, out_va = whole
+        if chosen:
+            current, cur_out = _whole_fit(chosen, current, tr, va, nominal)
+        else:
+            current, cur_out = nominal, out_va
+        screen = {"samples": SCREEN_SAMPLES,
+                  "confirmed": bool(not chosen or _passes(va, (current, cur_out),
+                                                          (nominal, out_va)))}
     after = _errors(va, cur_out)
     regions = {r["region"]: r for r in where["regions"]}
     bands = {b["band"]: b["energy_share"] for b in where["spectrum"]}
@@ -704,6 +767,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
                "unexplained": unexplained, "alternatives": alternatives,
                "model": current.params, "evidence": evidence}
+    if screen is not None:
+        verdict["screen"] = screen
     if "creep" in chosen:
         verdict["creep_law"] = _creep_law(current.params)
     fitted = {"radii": radii, "projection": proj, "nominal": full_nominal,
@@ -717,6 +782,18 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
               else "zero"}
     return DiagnosisReport(nominal_json, where, candidates, verdict, va, out_va, cur_out,
                            fitted)
+
+
+def _whole_fit(chosen: tuple, screened: Model, tr, va, nominal: Model) -> tuple:
+    """The model ``screened`` (chosen on the records' first samples) refitted on the whole
+    train records, every grid parameter held (``"held"``: no search, the linear part's order
+    too), and its outputs on the whole validate records. Keeps the screen's reports its refit
+    does not make (the structures tried, the validate levels)."""
+    m = fit_effect(chosen[-1], tr, chosen[:-1], {**screened.grid, "held": True}, nominal)
+    m.params = {**screened.params, **m.params, **level_report(m, va, tr)}
+    out = [m.predict(s) for s in va]
+    _release(m, tr + va)
+    return m, out
 
 
 def _creep_law(params: dict) -> dict | None:

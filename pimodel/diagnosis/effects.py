@@ -47,6 +47,7 @@ __all__ = [
     "delay_grid",
     "fit_effect",
     "fit_nominal",
+    "head_segment",
     "lag",
     "make_segment",
     "mode",
@@ -551,7 +552,9 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         ``rate_tau``, ``rate_saturation``). Two keys make an effect's model richer:
         ``"refine": "creep"``, a further lag ``REFINED_CREEP_LAG`` times the longest;
         ``"lti_min": n``, at least ``n`` further elements of the linear part
-        (:func:`.lti.select_order`).
+        (:func:`.lti.select_order`). ``"held": True`` with every effect's grid parameters
+        given (a fitted model's ``grid``): no search at all, the linear part's elements
+        ``lti`` kept as given (a refit on other records).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -608,6 +611,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     # (pimodel.diagnosis.diagnose): fixed["refine"] = "creep", a further lag;
     # fixed["lti_min"], at least that many further elements of the linear part
     lti_min = fixed.pop("lti_min", 0)
+    held = fixed.pop("held", False)  # every grid parameter as given: no search at all
     if fixed.pop("refine", None) == "creep" and "creep" in effects:
         taus = tuple(nominal.params["creep_taus"])
         nominal = replace(nominal, params={**nominal.params,
@@ -751,7 +755,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         if r.fun < best[1]:
             best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
                           best)
-    if "dynamics" in effects and "wiener" not in fixed:
+    if "dynamics" in effects and "wiener" not in fixed and not held:
         # the order of the linear part: further modes, a low-pass, a direct term (module lti);
         # chosen again beside effects added later (the base mode held, no polish)
         p0 = {**best[0].params, "lti": ()}
@@ -824,7 +828,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
 
 def _screen(train, effects: tuple[str, ...], fixed: dict) -> list:
     """The train records the searches of :func:`_fit_combo` run on: the first ``SCREEN_SAMPLES``
-    samples of each (:func:`_prefix`) when a record is longer and a mode or a delay is
+    samples of each (:func:`head_segment`) when a record is longer and a mode or a delay is
     searched (not with the rate's or the drift's per-record columns, nor a filter before the
     hysteresis held); else ``train`` itself. A search costs a pass over the screen per point;
     its result is confirmed on the whole records (:func:`_confirm`)."""
@@ -833,11 +837,33 @@ def _screen(train, effects: tuple[str, ...], fixed: dict) -> list:
     if not searched or {"rate", "drift"} & set(effects) or "wiener" in fixed or \
             all(s.y.size <= SCREEN_SAMPLES for s in train):
         return train
-    return [_prefix(s, SCREEN_SAMPLES) for s in train]
+    return [head_segment(s, SCREEN_SAMPLES) for s in train]
 
 
-def _prefix(s: Segment, m: int) -> Segment:
-    """The first ``m`` samples of ``s`` (its play rows copied; no rate or Wiener basis)."""
+def head_segment(s: Segment, m: int) -> Segment:
+    """The first ``m`` samples of ``s`` (its play rows copied; no rate or Wiener basis).
+
+    Parameters
+    ----------
+    s : Segment
+        The record.
+    m : int
+        Samples kept.
+
+    Returns
+    -------
+    Segment
+        Samples ``0..m-1`` of ``t``, ``v``, ``y``, the play rows and the mask; every filter of
+        the candidates starts from the same state on it as on ``s``, so its columns are the
+        first ``m`` samples of ``s``'s.
+
+    Examples
+    --------
+    >>> seg = make_segment(np.arange(4) * 1e-3, np.array([0.0, 1.0, 0.5, 0.0]), np.zeros(4),
+    ...                    [0.5])
+    >>> head_segment(seg, 2).Z.tolist()
+    [[0.0], [0.5]]
+    """
     rows = np.array(s.play_rows(offset=True)[:, :m], order="C")
     return segment_of_rows(s.t[:m], s.v[:m], s.y[:m], rows,
                            None if s.mask is None else s.mask[:m])
