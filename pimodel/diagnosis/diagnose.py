@@ -30,9 +30,8 @@ start from each of the next ``ALT_STARTS`` candidates (alone or in a pair with e
 other effect), and the path with the lowest validate BIC is kept: a first effect can stand
 in for two others that pass only together (a broad lag for creep and rate-dependent
 hysteresis). The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`)
-or, where the
-train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a
-level per record, :mod:`.drift`) is chosen on validate for every combination.
+or, where the train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its
+clock, or a level per record, :mod:`.drift`) is chosen on validate for every combination.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
