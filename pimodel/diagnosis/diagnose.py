@@ -27,7 +27,11 @@ an effect that no longer passes against the combination without it is dropped (a
 early can stand in for one that only passes beside a later one). Last, a chosen ``dynamics``
 that acts as a pure delay on the records (gain within 10 % of 1 over the lower quarter of the
 band, :mod:`.delaylike`) gives way to ``delay`` when the delay fits validate within 10 % in its
-place. The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or,
+place. When the path so chosen leaves a gap ``unexplained``, the rounds are run again forced to
+start from each of the next ``ALT_STARTS`` candidates (alone or in a pair with each
+other effect), and the path with the lowest validate BIC is kept: a first effect can stand
+in for two others that pass only together (a broad lag for creep and rate-dependent
+hysteresis). The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or,
 where the train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock,
 or a level per record, :mod:`.drift`) is chosen on validate for every combination.
 
@@ -95,6 +99,7 @@ UNEXPLAINED_SHARE = 0.10  # ... and is "unexplained" when its excess is this sha
 DYNAMICS_KEYS = ("fn", "zeta", "lti")  # grid keys of dynamics after the hysteresis
 LAG_EFFECTS = ("dynamics", "delay")  # two names for one lag: re-decided beside later effects
 LAG_KEYS = (*DYNAMICS_KEYS, "wiener", "d")  # their grid keys
+ALT_STARTS = 2  # greedy paths from the next candidates tried when a gap is left unexplained
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
 INITIAL_STATES = ("rest", "unknown")
 EFFECT_SIGNATURES = {
@@ -661,53 +666,75 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                            "delta_bic": _bic(va, o, m.k) - _bic(va, out_va, 0)})
     candidates.sort(key=lambda c: c["delta_bic"])
 
-    chosen: tuple[str, ...] = ()
-    fixed: dict = {}
-    current: Model = nominal
-    cur_out = out_va
-    for round_ in range(max_effects):
-        progress(f"combinations, round {round_ + 1}")
-        rms_now = _errors(va, cur_out)["rms"]
-        if rms_now <= NOISE_STOP * noise:
-            break
-        best = None
-        for name in EFFECTS:
-            if name in chosen:
-                continue
-            m, o = fit(name, chosen, dict(fixed) if chosen else None)
-            dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
-            if best is None or dbic < best[0]:
-                best = (dbic, name, m, o)
-        if best is None:
-            break
+    def choose(start=None):
+        """The greedy rounds, the revision and the delay preference; ``start`` forces
+        the first round's effect. Returns ``(chosen, fixed, model, validate outputs)``."""
+        chosen: tuple[str, ...] = ()
+        fixed: dict = {}
+        current: Model = nominal
+        cur_out = out_va
+        for round_ in range(max_effects):
+            progress(f"combinations, round {round_ + 1}")
+            rms_now = _errors(va, cur_out)["rms"]
+            if rms_now <= NOISE_STOP * noise:
+                break
+            best = None
+            for name in EFFECTS if chosen or start is None else (start,):
+                if name in chosen:
+                    continue
+                m, o = fit(name, chosen, dict(fixed) if chosen else None)
+                dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
+                if best is None or dbic < best[0]:
+                    best = (dbic, name, m, o)
+            if best is None:
+                break
 
-        def accepted(b_, rms_now=rms_now):
-            return b_[0] <= -MIN_BIC_DROP and _errors(va, b_[3])["rms"] <= (1 - MIN_RMS_CUT) * \
-                rms_now
+            def accepted(b_, rms_now=rms_now):
+                return b_[0] <= -MIN_BIC_DROP and \
+                    _errors(va, b_[3])["rms"] <= (1 - MIN_RMS_CUT) * rms_now
 
-        if not accepted(best) and not chosen and max_effects >= 2:
-            # two effects can mask each other (a drift confounds an asymmetry fitted alone):
-            # when no single effect passes in the first round, try every pair jointly
-            rest = [e for e in EFFECTS if e not in chosen]
-            for i, first in enumerate(rest):
-                for name in rest[i + 1:]:
-                    m, o = fit(name, (*chosen, first), dict(fixed) if chosen else None)
-                    dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
-                    if dbic < best[0]:
-                        best = (dbic, (first, name), m, o)
-        if not accepted(best):
-            break
-        if chosen and not _beyond_refinement((best[2], best[3]), chosen, fixed, fit, va):
-            break  # the misfit of the effects chosen, not a further effect
-        dbic, name, m, o = best
-        chosen += name if isinstance(name, tuple) else (name,)
-        fixed.update(m.grid)
-        current, cur_out = m, o
-        chosen, current, cur_out = _research_lag(chosen, (current, cur_out), fixed, fit, va)
-    progress("revising the choice")
-    chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
-                                       (nominal, out_va), noise)
-    chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
+            if not chosen and max_effects >= 2 and (start is not None or not accepted(best)):
+                # two effects can mask each other (a drift confounds an asymmetry fitted alone):
+                # when no single effect passes in the first round, try every pair jointly (a
+                # forced start: every pair with it)
+                rest = [e for e in EFFECTS if e not in chosen]
+                for i, first in enumerate(rest):
+                    for name in rest[i + 1:]:
+                        if start is not None and start not in (first, name):
+                            continue
+                        m, o = fit(name, (*chosen, first), dict(fixed) if chosen else None)
+                        dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
+                        if dbic < best[0]:
+                            best = (dbic, (first, name), m, o)
+            if not accepted(best):
+                break
+            if chosen and not _beyond_refinement((best[2], best[3]), chosen, fixed, fit, va):
+                break  # the misfit of the effects chosen, not a further effect
+            dbic, name, m, o = best
+            chosen += name if isinstance(name, tuple) else (name,)
+            fixed.update(m.grid)
+            current, cur_out = m, o
+            chosen, current, cur_out = _research_lag(chosen, (current, cur_out), fixed,
+                                                     fit, va)
+        progress("revising the choice")
+        chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
+                                           (nominal, out_va), noise)
+        chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
+        return chosen, fixed, current, cur_out
+
+    chosen, fixed, current, cur_out = choose()
+    if chosen and _unexplained(va, cur_out, _errors(va, out_va)["rms"],
+                               _errors(va, cur_out)["rms"], noise, out_va)["present"]:
+        # a gap left unexplained after the greedy path: the first effect may stand in for
+        # two others that only pass together (a broad lag for creep and rate); paths that
+        # start from the next candidates alone are tried, the lowest validate BIC kept
+        best = (_bic(va, cur_out, current.k), (chosen, fixed, current, cur_out))
+        for c in [c["effect"] for c in candidates if c["effect"] != chosen[0]][:ALT_STARTS]:
+            path = choose(c)
+            score = _bic(va, path[3], path[2].k)
+            if path[0] and score < best[0] - MIN_BIC_DROP:
+                best = (score, path)
+        chosen, fixed, current, cur_out = best[1]
     screen = None
     if screened:  # the choice, refitted on the whole records; the verdict's figures whole
         progress("the chosen model on the whole records")
