@@ -264,6 +264,9 @@ lib.pim_play_solve.argtypes = [c_size, F64, F64, F64, c_double]
 lib.pim_rdpi_run.restype = None
 lib.pim_rdpi_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64, F64,
                              F64, F64]
+lib.pim_rdpi_sat_run.restype = None
+lib.pim_rdpi_sat_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double,
+                                 c_double, F64, F64, F64, F64]
 lib.pim_rdpi_inverse_run.restype = c_int
 lib.pim_rdpi_inverse_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64,
                                      F64, F64, F64]
@@ -293,6 +296,15 @@ def rdpi_run(p: np.ndarray, alpha: np.ndarray, beta: float, lam: float, Ts: floa
     """Rate-dependent PI run; ``z`` (n) and ``hist`` (v[k-1], rate[k]) updated in place."""
     y = np.empty(v.shape[0])
     lib.pim_rdpi_run(v.shape[0], p.shape[0], p, alpha, beta, lam, Ts, z, hist, v, y)
+    return y
+
+
+def rdpi_sat_run(p: np.ndarray, alpha: np.ndarray, beta: float, sat: float, lam: float,
+                 Ts: float, z: np.ndarray, hist: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rate-dependent PI run with a saturating radius growth (``sat`` <= 0: none); ``z`` (n)
+    and ``hist`` (v[k-1], rate[k]) updated in place."""
+    y = np.empty(v.shape[0])
+    lib.pim_rdpi_sat_run(v.shape[0], p.shape[0], p, alpha, beta, sat, lam, Ts, z, hist, v, y)
     return y
 
 

@@ -68,7 +68,7 @@ from .effects import (
 )
 from .gain import gain_note, record_gains
 from .noise import measure_noise_floor
-from .rate import RateBasis
+from .rate import RateBasis, rate_shapes
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
 
@@ -581,9 +581,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
         best = None
-        for var in drift_variants((*combo, name), len(va)):
+        shapes = rate_shapes((*combo, name), fixed_ or {})
+        for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
+                           for r in shapes):
             fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},
-                  **var}
+                  **var, **shape}
             key = (combo, name, tuple(sorted(fx.items())))
             if key not in cache:
                 m = fit_effect(name, tr, combo, fx, nominal)

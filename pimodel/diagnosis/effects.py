@@ -33,12 +33,15 @@ from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import (
     RATE_BANDS,
     RATE_FAMILIES,
+    RATE_GROWTH_REFINE,
+    RATE_GROWTHS,
     RATE_POLISH_ROUNDS,
     RATE_SATURATION_REFINE,
     RATE_SATURATIONS,
     RATE_TAU_REFINE,
     RATE_TAU_START,
     RATE_TAUS,
+    SCALED,
 )
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
@@ -612,7 +615,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         taus = tuple(nominal.params["creep_taus"])
         nominal = replace(nominal, params={**nominal.params,
                                            "creep_taus": (*taus, REFINED_CREEP_LAG * taus[-1])})
+    scaled = fixed.pop("rate_shape", None) == SCALED  # the rate's exact shape (module rate)
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
+    k += int(scaled or fixed.get("rate_family") == SCALED)  # its growth G
     static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
@@ -661,7 +666,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                          [{"clock": c} for c in DRIFT_CLOCKS if c not in ("levels", "settle")])
         elif e == "rate":  # the filter is searched after the other grids (below)
             grids.append([{k_: fixed.get(k_) for k_ in ("rate_family", "rate_tau",
-                                                         "rate_saturation")}]
+                                                         "rate_saturation", "rate_growth")}]
                          if "rate_tau" in fixed else
                          [{"rate_family": f, "rate_tau": RATE_TAU_START, "rate_saturation": None}
                           for f in RATE_FAMILIES])
@@ -695,6 +700,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                              if p_["rate_tau"] > 0], best)
             if best[0] is before:
                 break
+        if scaled:
+            best = _search_scaled(search, best[0].params)
     if best[0].params.get("clock") == "settle" and "settle_tau" not in fixed:
         # the settling time constant (the other grid parameters held): its grid, then
         # continuously in log T between the grid neighbours of the best point
@@ -868,6 +875,27 @@ def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
     return ref
 
 
+def _search_scaled(search, start: dict):
+    """The rate's exact shape (family ``SCALED``, module rate) from the first-order optimum
+    ``start``: its filter (at least ``RATE_TAUS[1]``) and ``S``, ``G`` on ``RATE_GROWTHS``, then
+    ``G``, ``S`` and the filter by steps in turn while the train residual falls."""
+    p0 = {**start, "rate_family": SCALED, "rate_tau": max(start["rate_tau"], RATE_TAUS[1])}
+    best = search([{**p0, "rate_growth": g} for g in RATE_GROWTHS])
+    for _ in range(2 * RATE_POLISH_ROUNDS):
+        before, p_ = best[0], best[0].params
+        sat = p_["rate_saturation"]
+        best = search([{**p_, "rate_growth": p_["rate_growth"] * f}
+                       for f in (1 / RATE_GROWTH_REFINE, RATE_GROWTH_REFINE)]
+                      + [{**p_, "rate_saturation": sat * f}
+                         for f in (1 / RATE_SATURATION_REFINE, RATE_SATURATION_REFINE)
+                         if sat is not None]
+                      + [{**p_, "rate_tau": p_["rate_tau"] * f}
+                         for f in (1 / RATE_TAU_REFINE[-1], RATE_TAU_REFINE[-1])], best)
+        if best[0] is before:
+            break
+    return best
+
+
 def _combo_k(effects, nominal: Model) -> int:
     return sum({"creep": len(nominal.params["creep_taus"]), "dynamics": 2, "delay": 1,
                 "asymmetry": 2, "drift": 1, "rate": RATE_BANDS + 2}[e] for e in effects)
@@ -909,7 +937,8 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
         if "rate" in effects:
-            which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"))
+            which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"),
+                     p.get("rate_growth"))
             key = ("rate", id(s))
             if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
                 static[key] = (which, np.ascontiguousarray(s.rate_basis.columns(*which).T), s)
@@ -965,6 +994,8 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["rate_family"] = model.params["rate_family"]
             out["rate_time_constant_s"] = model.params["rate_tau"]
             out["rate_saturation"] = model.params.get("rate_saturation")
+            if model.params["rate_family"] == SCALED:
+                out["rate_growth"] = model.params["rate_growth"]
             i += RATE_BANDS
     if "drift" in effects and model.params["clock"] == "settle":  # on the shared clock
         out.update({"drift_per_s": 0.0, "drift_clock": "absolute",

@@ -104,7 +104,7 @@ from .lti import approximate_inverse, lti_columns
 from .monotone import monotone_model
 from .native_inverse import NativeInverse, inverse_block
 from .native_model import diagnosed_block
-from .rate import rate_columns, rate_params, rate_saturation
+from .rate import rate_columns, rate_growth, rate_params, rate_saturation
 from .reference_inverse import solve_static
 from .wiener import inverse_prefilter, prefilter
 
@@ -308,7 +308,8 @@ class DiagnosedModel:
             gains, family, tau = rate_params(p)
             R = rate_columns(Z, self.radii, v, self.dt, p["rate_scale"], self.reference_weights,
                              tau, family, gains.size, input_range=input_range,
-                             saturation=rate_saturation(p))
+                             saturation=rate_saturation(p), growth=rate_growth(p),
+                             at_rest=self.plays_start == "v0")
             y = y + R @ gains
         if "drift" in e:
             y_meas = None if measured is None else checked_signal(measured, "measured")

@@ -38,6 +38,24 @@ among them); then ``S`` by the steps ``RATE_SATURATION_REFINE`` and
 ``tau`` by the finest of ``RATE_TAU_REFINE``, both tried in each of up to ``RATE_POLISH_ROUNDS``
 rounds while the train residual falls (the two trade against each other: a longer filter
 lowers the peaks the saturation bounds).
+
+The first-order form follows each nominal play's contact; when the radii grow by tens of
+percent a play whose radius grew meets its boundary later than the nominal play does, and the
+columns cannot follow (measured on ``pimodel.stages.density_stage``, radii growing by 30-60 %:
+seed 0 leaves 8.3 noise floors with the stage's own filter and ``S``). The exact shape,
+family ``SCALED`` (``"scaled"``), runs the plays themselves with radii scaled per sample,
+
+    ``rho_i[k] = r_i (1 + g(s[k]))``, ``g(s) = G s / (1 + s / S)`` (``S`` None: ``G s``),
+    ``s[k] = a s[k-1] + (1 - a) |v[k-1] - v[k-2]| / dt / rate_scale``, ``a = exp(-dt / tau)``,
+
+strictly causal (``s[k]`` from ``v[..k-1]``: the radii of sample ``k`` are fixed before
+``v[k]``, as in :mod:`pimodel.operators.rate_dependent`, whose C core runs them), and takes
+as band columns ``D_b[k] = sum_{i in b} w0_i (zs_i[k] - z_i[k])``, the scaled plays' band
+output less the nominal plays' (one gain each, fitted with the weights: gains of 1 give the
+reference hysteresis with scaled radii). ``G``, ``S`` and ``tau > 0`` are nonlinear: a grid
+(``RATE_GROWTHS`` at the first-order form's filter and ``S``), then each in turn by steps
+(``RATE_GROWTH_REFINE``, ``RATE_SATURATION_REFINE``, the finest of ``RATE_TAU_REFINE``)
+while the train residual falls.
 """
 
 from __future__ import annotations
@@ -45,6 +63,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
+from .. import _native
 from ..operators.pi import PIOperator
 from .chunked import chunks
 
@@ -57,23 +76,32 @@ STEP_SHARE = 0.05  # without a filter, a one-sample jump above this share of the
 RATE_SATURATIONS = (None, 4.0, 2.0, 1.0, 0.5)  # S [-]: rho_f / (1 + rho_f / S), None: linear
 RATE_SATURATION_REFINE = 2**0.25  # then steps of S (1/4 octave) and of the filter (1/8 decade)
 RATE_POLISH_ROUNDS = 4  # ... in turn, while the train residual falls
+SCALED = "scaled"  # the exact shape: plays whose radii scale with the rate (module docstring)
+RATE_GROWTHS = (0.1, 0.2, 0.4, 0.8, 1.6)  # G [-] of the scaled shape's grid
+RATE_GROWTH_REFINE = 2**0.25  # then G, S and the filter in turn (1/4 octave, 1/8 decade)
 
 __all__ = [
     "RATE_BANDS",
     "RATE_FAMILIES",
+    "RATE_GROWTHS",
+    "RATE_GROWTH_REFINE",
     "RATE_POLISH_ROUNDS",
     "RATE_SATURATIONS",
     "RATE_SATURATION_REFINE",
     "RATE_TAUS",
     "RATE_TAU_REFINE",
     "RateBasis",
+    "SCALED",
     "filtered_rate",
     "input_rate",
     "play_bands",
     "rate_columns",
+    "rate_growth",
     "rate_params",
     "rate_saturation",
+    "rate_shapes",
     "saturated_rate",
+    "scaled_play_sums",
 ]
 
 
@@ -284,17 +312,20 @@ class RateBasis:
         """
         return input_rate(self.v, self.dt, self.rate_scale, tau, self.input_range)
 
-    def columns(self, tau: float, family: str, saturation: float | None = None) -> np.ndarray:
+    def columns(self, tau: float, family: str, saturation: float | None = None,
+                growth: float | None = None) -> np.ndarray:
         """The columns of ``family`` for the filter ``tau`` and the saturation ``S`` (memoised).
 
         Parameters
         ----------
         tau : float
             Time constant of the low-pass [s].
-        family : {"radius", "weight"}
-            Radii or weights growing with the rate (module docstring).
+        family : {"radius", "weight", "scaled"}
+            Radii or weights growing with the rate, or the exact shape (module docstring).
         saturation : float or None
             ``S`` of :func:`saturated_rate` (None: none).
+        growth : float or None
+            ``G`` of the ``"scaled"`` family (required there, ignored otherwise).
 
         Returns
         -------
@@ -304,7 +335,7 @@ class RateBasis:
         Raises
         ------
         ValueError
-            An unknown ``family``.
+            An unknown ``family``; the ``"scaled"`` family without ``growth`` or ``tau > 0``.
 
         Examples
         --------
@@ -313,20 +344,19 @@ class RateBasis:
         >>> basis.columns(1.0, "weight").round(4).tolist()  # 2 v rho_f
         [[0.0], [0.0126], [0.0346], [0.0127]]
         """
-        if family not in RATE_FAMILIES:
-            raise ValueError(f"family: expected one of {RATE_FAMILIES}, got {family!r}")
-        key = (float(tau), family, saturation)
+        if family not in (*RATE_FAMILIES, SCALED):
+            raise ValueError(f"family: expected one of {(*RATE_FAMILIES, SCALED)}, got "
+                             f"{family!r}")
+        key = (float(tau), family, saturation, growth if family == SCALED else None)
         if key not in self._cache:
+            if family == SCALED:
+                cols = self._scaled_columns(key[0], saturation, growth)
+                self._cache.clear()
+                self._cache[key] = cols
+                return cols
             rho = saturated_rate(self.rate(key[0]), saturation)
             if family == "weight":
-                if self._weighted is None:
-                    member = np.zeros((self.radii.size, len(self.bands)))
-                    for b, g in enumerate(self.bands):
-                        member[g, b] = self.weights[g]
-                    self._weighted = np.empty((self.v.size, member.shape[1]))
-                    for c, Zc in self._play_chunks():
-                        self._weighted[c] = Zc @ member
-                cols = rho[:, None] * self._weighted
+                cols = rho[:, None] * self._band_sums()
             else:
                 cols = self._radius_columns(rho)
             self._cache.clear()  # the latest only: a search asks for each filter once
@@ -347,6 +377,27 @@ class RateBasis:
         """
         self._cache.clear()
         self._weighted = None
+
+    def _band_sums(self) -> np.ndarray:
+        """Band sums ``sum_{i in b} w0_i z_i[k]`` of the nominal plays (built on first use)."""
+        if self._weighted is None:
+            member = np.zeros((self.radii.size, len(self.bands)))
+            for b, g in enumerate(self.bands):
+                member[g, b] = self.weights[g]
+            self._weighted = np.empty((self.v.size, member.shape[1]))
+            for c, Zc in self._play_chunks():
+                self._weighted[c] = Zc @ member
+        return self._weighted
+
+    def _scaled_columns(self, tau: float, saturation: float | None,
+                        growth: float | None) -> np.ndarray:
+        """``D_b``: the scaled plays' band outputs less the nominal plays' (module docstring)."""
+        if growth is None or not np.isfinite(growth):
+            raise ValueError(f"growth: the {SCALED!r} family needs a finite G, got {growth!r}")
+        z0 = float(self.v[0]) if self.at_rest else 0.0
+        scaled = scaled_play_sums(self.v, self.radii, self.weights, self.bands, self.dt,
+                                  self.rate_scale, tau, saturation, growth, z0)
+        return scaled - self._band_sums()
 
     def _play_chunks(self):
         """``(slice, Z[slice])`` over the record, the plays computed chunk by chunk (their
@@ -387,10 +438,80 @@ class RateBasis:
         return out
 
 
+def scaled_play_sums(v: np.ndarray, radii, weights, bands, dt: float, rate_scale: float,
+                     tau: float, saturation: float | None, growth: float,
+                     z0: float = 0.0) -> np.ndarray:
+    """Band outputs ``sum_{i in b} w_i zs_i[k]`` of plays whose radii scale with the rate.
+
+    ``zs_i[k] = min(max(zs_i[k-1], v[k] - rho_i[k]), v[k] + rho_i[k])``, ``zs_i[-1] = z0``,
+    ``rho_i[k] = r_i (1 + G s[k] / (1 + s[k] / S))``, ``s[k]`` the strictly causal filtered
+    rate of the module docstring (``s[0] = s[1] = 0``); run by the C core
+    (``pim_rdpi_sat_run``, :mod:`pimodel.operators.rate_dependent`).
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        Input ``v[k]``.
+    radii, weights : array_like
+        Play radii ``r_i`` [input units] and weights ``w_i``.
+    bands : list of numpy.ndarray
+        Play indices of each band (:func:`play_bands`).
+    dt : float
+        Sample time [s].
+    rate_scale : float
+        Input rate [input units / s] that makes ``s = 1``.
+    tau : float
+        Time constant of the rate's low-pass [s], ``> 0``.
+    saturation : float or None
+        ``S`` [-] (None: ``g = G s``).
+    growth : float
+        ``G`` [-].
+    z0 : float
+        Play states before ``v[0]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N, len(bands)); row ``k`` depends on ``v[0..k]``.
+
+    Raises
+    ------
+    ValueError
+        ``tau`` not finite and > 0, ``rate_scale`` not > 0, ``saturation`` not None or > 0.
+
+    Examples
+    --------
+    >>> v = np.r_[np.linspace(0.0, 1.0, 11), np.full(3, 1.0)]  # a ramp at 0.1/s, then a hold
+    >>> b = [np.array([0])]
+    >>> y = scaled_play_sums(v, [0.2], [1.0], b, 1.0, 0.1, 1e-9, None, 0.5)
+    >>> round(float(v[10] - y[10, 0]), 6)  # the radius grew by G s = 0.5 at the rate 1
+    0.3
+    """
+    if not (np.isfinite(tau) and tau > 0):
+        raise ValueError(f"tau: the {SCALED!r} family needs a finite time constant > 0 [s], "
+                         f"got {tau!r}")
+    if not rate_scale > 0:
+        raise ValueError(f"rate_scale: expected > 0, got {rate_scale!r}")
+    saturated_rate(np.zeros(1), saturation)  # checks S
+
+    v = np.ascontiguousarray(v, float)
+    r, w = np.asarray(radii, float), np.asarray(weights, float)
+    lam = float(np.exp(-dt / tau))
+    out = np.empty((v.size, len(bands)))
+    for b, g in enumerate(bands):
+        z = np.full(g.size, z0)
+        hist = np.array([v[0], 0.0])
+        out[:, b] = _native.rdpi_sat_run(np.ascontiguousarray(w[g]), np.ascontiguousarray(r[g]),
+                                         growth / rate_scale,
+                                         0.0 if saturation is None else saturation * rate_scale,
+                                         lam, dt, z, hist, v)
+    return out
+
+
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,
                  tau: float, family: str, bands: int = RATE_BANDS, *,
-                 input_range: float | None = None,
-                 saturation: float | None = None) -> np.ndarray:
+                 input_range: float | None = None, saturation: float | None = None,
+                 growth: float | None = None, at_rest: bool = False) -> np.ndarray:
     """The rate candidate's columns of one record (module docstring), for one family and filter.
 
     Parameters
@@ -417,6 +538,10 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
         The range of the step rule (default ``ptp(v)``).
     saturation : float or None
         ``S`` of :func:`saturated_rate` (None: none).
+    growth : float or None
+        ``G`` of the ``"scaled"`` family.
+    at_rest : bool
+        The ``"scaled"`` family's plays start at ``v[0]`` (as ``Z``'s); False: at 0.
 
     Returns
     -------
@@ -431,8 +556,8 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
     >>> R[[10, 20, 40, 41, 80], 0].round(6).tolist()  # no contact yet, contact, then held
     [0.0, -0.5, -0.5, -0.5, -0.5]
     """
-    return RateBasis(Z, radii, v, dt, rate_scale, weights, bands,
-                     input_range=input_range).columns(tau, family, saturation)
+    return RateBasis(Z, radii, v, dt, rate_scale, weights, bands, input_range=input_range,
+                     at_rest=at_rest).columns(tau, family, saturation, growth)
 
 
 def rate_params(p: dict) -> tuple[np.ndarray, str, float]:
@@ -466,9 +591,9 @@ def rate_params(p: dict) -> tuple[np.ndarray, str, float]:
     missing = [k for k in ("rate_gains", "rate_family", "rate_time_constant_s") if k not in p]
     if missing:
         raise ValueError(f"params: the rate effect needs {missing}")
-    if p["rate_family"] not in RATE_FAMILIES:
-        raise ValueError(f"params: rate_family expected one of {RATE_FAMILIES}, got "
-                         f"{p['rate_family']!r}")
+    if p["rate_family"] not in (*RATE_FAMILIES, SCALED):
+        raise ValueError(f"params: rate_family expected one of {(*RATE_FAMILIES, SCALED)}, "
+                         f"got {p['rate_family']!r}")
     return (np.asarray(p["rate_gains"], float), str(p["rate_family"]),
             float(p["rate_time_constant_s"]))
 
@@ -503,3 +628,61 @@ def rate_saturation(p: dict) -> float | None:
         raise ValueError(f"params: rate_saturation expected None or a finite number > 0, got "
                          f"{s!r}")
     return float(s)
+
+
+def rate_growth(p: dict) -> float | None:
+    """The growth ``G`` of a model's ``"scaled"`` rate shape; None for the first-order families.
+
+    Parameters
+    ----------
+    p : dict
+        The model's ``params``.
+
+    Returns
+    -------
+    float or None
+
+    Raises
+    ------
+    ValueError
+        The ``"scaled"`` family without a finite ``rate_growth``.
+
+    Examples
+    --------
+    >>> rate_growth({"rate_family": "scaled", "rate_growth": 0.4})
+    0.4
+    """
+    if p.get("rate_family") != SCALED:
+        return None
+    g = p.get("rate_growth")
+    if not (isinstance(g, (int, float)) and np.isfinite(g)):
+        raise ValueError(f"params: rate_family 'scaled' needs a finite rate_growth, got {g!r}")
+    return float(g)
+
+
+def rate_shapes(effects, fixed: dict) -> list[dict]:
+    """The rate shapes a diagnosis scores on validate (by BIC) whenever ``effects`` hold a rate
+    not yet fitted: the first-order form and the exact one (``{"rate_shape": "scaled"}``);
+    ``[{}]`` without a rate or with its parameters held in ``fixed`` (from earlier rounds).
+
+    Parameters
+    ----------
+    effects : tuple of str
+        The effects of the model being fitted.
+    fixed : dict
+        Grid parameters held from earlier rounds.
+
+    Returns
+    -------
+    list of dict
+
+    Examples
+    --------
+    >>> rate_shapes(("rate",), {})
+    [{}, {'rate_shape': 'scaled'}]
+    >>> rate_shapes(("creep", "rate"), {"rate_tau": 0.01}), rate_shapes(("creep",), {})
+    ([{}], [{}])
+    """
+    if "rate" not in effects or "rate_tau" in fixed:
+        return [{}]
+    return [{}, {"rate_shape": SCALED}]
