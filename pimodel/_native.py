@@ -434,7 +434,7 @@ class InverseParams(ctypes.Structure):
                 ("half", c_double), ("rate_w", _DP), ("dt", c_double),
                 ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
                 ("rate_tau", c_double), ("rate_saturation", c_double),
-                ("reference_range", c_double), ("ns", c_size),
+                ("rate_growth", c_double), ("reference_range", c_double), ("ns", c_size),
                 ("sos", _DP), ("latency", c_size), ("frac", c_double), ("npost", c_size),
                 ("post", _DP)]
 
