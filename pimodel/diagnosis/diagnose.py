@@ -566,7 +566,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
     for s in segs:
         s.rate_basis = RateBasis(None, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref,
-                                 at_rest=at_rest)
+                                 at_rest=at_rest, projection=proj)
         s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt,  # dynamics before the plays
                                      at_rest=at_rest)
     progress("noise floor")

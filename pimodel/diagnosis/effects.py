@@ -617,7 +617,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                                            "creep_taus": (*taus, REFINED_CREEP_LAG * taus[-1])})
     scaled = fixed.pop("rate_shape", None) == SCALED  # the rate's exact shape (module rate)
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
-    k += int(scaled or fixed.get("rate_family") == SCALED)  # its growth G
+    if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
+        k -= RATE_BANDS - 1
     static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
@@ -923,6 +924,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
 
     def rows(s: Segment) -> tuple[np.ndarray, np.ndarray]:  # the play rows, then the others
         Z = s.play_rows(ncols)
+        scaled = "rate" in effects and p["rate_family"] == SCALED
+        if scaled:  # the exact shape's plays in place of the nominal ones (module rate)
+            Z = s.rate_basis.scaled_rows(p["rate_tau"], p["rate_saturation"], p["rate_growth"])
         if p.get("wiener"):  # the linear part before the hysteresis (module wiener)
             Z = s.wiener_basis.columns(p["wiener"], ncols).T  # rows, kept C-contiguous
         elif "dynamics" in effects:  # filter the play rows
@@ -936,9 +940,8 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         parts = [Z, static_rows(s)]
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
-        if "rate" in effects:
-            which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"),
-                     p.get("rate_growth"))
+        if "rate" in effects and not scaled:
+            which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"))
             key = ("rate", id(s))
             if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
                 static[key] = (which, np.ascontiguousarray(s.rate_basis.columns(*which).T), s)
@@ -990,13 +993,14 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2
         elif e == "rate":
-            out["rate_gains"] = extra[i:i + RATE_BANDS].tolist()
+            scaled = model.params["rate_family"] == SCALED  # one gain of 1 (module rate)
+            out["rate_gains"] = [1.0] if scaled else extra[i:i + RATE_BANDS].tolist()
             out["rate_family"] = model.params["rate_family"]
             out["rate_time_constant_s"] = model.params["rate_tau"]
             out["rate_saturation"] = model.params.get("rate_saturation")
-            if model.params["rate_family"] == SCALED:
+            if scaled:
                 out["rate_growth"] = model.params["rate_growth"]
-            i += RATE_BANDS
+            i += 0 if scaled else RATE_BANDS
     if "drift" in effects and model.params["clock"] == "settle":  # on the shared clock
         out.update({"drift_per_s": 0.0, "drift_clock": "absolute",
                     "drift_variant": "settle_levels" if "levels" in model.params else "settle",

@@ -49,13 +49,15 @@ family ``SCALED`` (``"scaled"``), runs the plays themselves with radii scaled pe
     ``s[k] = a s[k-1] + (1 - a) |v[k-1] - v[k-2]| / dt / rate_scale``, ``a = exp(-dt / tau)``,
 
 strictly causal (``s[k]`` from ``v[..k-1]``: the radii of sample ``k`` are fixed before
-``v[k]``, as in :mod:`pimodel.operators.rate_dependent`, whose C core runs them), and takes
-as band columns ``D_b[k] = sum_{i in b} w0_i (zs_i[k] - z_i[k])``, the scaled plays' band
-output less the nominal plays' (one gain each, fitted with the weights: gains of 1 give the
-reference hysteresis with scaled radii). ``G``, ``S`` and ``tau > 0`` are nonlinear: a grid
-(``RATE_GROWTHS`` at the first-order form's filter and ``S``), then each in turn by steps
-(``RATE_GROWTH_REFINE``, ``RATE_SATURATION_REFINE``, the finest of ``RATE_TAU_REFINE``)
-while the train residual falls.
+``v[k]``, as in :mod:`pimodel.operators.rate_dependent`, whose C core runs them,
+:func:`scaled_plays`). The weights are fitted by least squares on these plays in place of the
+nominal ones (the hysteresis is ``sum_i w_i zs_i``; as an effect term beside the plays, the
+model's ``sum_i g_b w_i (zs_i - z_i)`` with one gain ``g = 1``). ``G``, ``S`` and
+``tau > 0`` are nonlinear: a grid (``RATE_GROWTHS`` at the first-order form's filter and
+``S``), then each in turn by steps (``RATE_GROWTH_REFINE``, ``RATE_SATURATION_REFINE``, the
+finest of ``RATE_TAU_REFINE``) while the train residual falls. The shape is offered beside
+the first-order one and chosen by validate BIC (:func:`rate_shapes`), not with dynamics or a
+delay (their columns filter or shift the nominal plays).
 """
 
 from __future__ import annotations
@@ -103,7 +105,7 @@ __all__ = [
     "rate_saturation",
     "rate_shapes",
     "saturated_rate",
-    "scaled_play_sums",
+    "scaled_plays",
 ]
 
 
@@ -269,6 +271,9 @@ class RateBasis:
         With ``Z`` None: the plays at rest at ``v[0]`` before the first sample (the
         nominal's start, :func:`~pimodel.diagnosis.effects.make_segment`); False (default):
         at 0.
+    projection : numpy.ndarray or None
+        ``V`` (n, q) when the fits' play columns are ``Z V`` (the diagnosis' compression):
+        :meth:`scaled_rows` are then projected the same way; None: the plays as they are.
 
     Examples
     --------
@@ -283,8 +288,9 @@ class RateBasis:
 
     def __init__(self, Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
                  weights, bands: int = RATE_BANDS, *, input_range: float | None = None,
-                 at_rest: bool = False):
+                 at_rest: bool = False, projection: np.ndarray | None = None):
         self.Z, self.radii, self.at_rest = Z, np.asarray(radii, float), at_rest
+        self.projection = projection
         self.v, self.dt, self.rate_scale, self.input_range = v, dt, rate_scale, input_range
         self.bands = play_bands(self.radii.size, bands)
         self.weights = np.asarray(weights, float)
@@ -314,20 +320,17 @@ class RateBasis:
         """
         return input_rate(self.v, self.dt, self.rate_scale, tau, self.input_range)
 
-    def columns(self, tau: float, family: str, saturation: float | None = None,
-                growth: float | None = None) -> np.ndarray:
+    def columns(self, tau: float, family: str, saturation: float | None = None) -> np.ndarray:
         """The columns of ``family`` for the filter ``tau`` and the saturation ``S`` (memoised).
 
         Parameters
         ----------
         tau : float
             Time constant of the low-pass [s].
-        family : {"radius", "weight", "scaled"}
-            Radii or weights growing with the rate, or the exact shape (module docstring).
+        family : {"radius", "weight"}
+            Radii or weights growing with the rate (module docstring).
         saturation : float or None
             ``S`` of :func:`saturated_rate` (None: none).
-        growth : float or None
-            ``G`` of the ``"scaled"`` family (required there, ignored otherwise).
 
         Returns
         -------
@@ -337,7 +340,7 @@ class RateBasis:
         Raises
         ------
         ValueError
-            An unknown ``family``; the ``"scaled"`` family without ``growth`` or ``tau > 0``.
+            An unknown ``family``.
 
         Examples
         --------
@@ -346,16 +349,10 @@ class RateBasis:
         >>> basis.columns(1.0, "weight").round(4).tolist()  # 2 v rho_f
         [[0.0], [0.0126], [0.0346], [0.0127]]
         """
-        if family not in (*RATE_FAMILIES, SCALED):
-            raise ValueError(f"family: expected one of {(*RATE_FAMILIES, SCALED)}, got "
-                             f"{family!r}")
-        key = (float(tau), family, saturation, growth if family == SCALED else None)
+        if family not in RATE_FAMILIES:
+            raise ValueError(f"family: expected one of {RATE_FAMILIES}, got {family!r}")
+        key = (float(tau), family, saturation)
         if key not in self._cache:
-            if family == SCALED:
-                cols = self._scaled_columns(key[0], saturation, growth)
-                self._cache.clear()
-                self._cache[key] = cols
-                return cols
             rho = saturated_rate(self.rate(key[0]), saturation)
             if family == "weight":
                 cols = rho[:, None] * self._band_sums()
@@ -391,15 +388,37 @@ class RateBasis:
                 self._weighted[c] = Zc @ member
         return self._weighted
 
-    def _scaled_columns(self, tau: float, saturation: float | None,
-                        growth: float | None) -> np.ndarray:
-        """``D_b``: the scaled plays' band outputs less the nominal plays' (module docstring)."""
-        if growth is None or not np.isfinite(growth):
-            raise ValueError(f"growth: the {SCALED!r} family needs a finite G, got {growth!r}")
-        z0 = float(self.v[0]) if self.at_rest else 0.0
-        scaled = scaled_play_sums(self.v, self.radii, self.weights, self.bands, self.dt,
-                                  self.rate_scale, tau, saturation, growth, z0)
-        return scaled - self._band_sums()
+    def scaled_rows(self, tau: float, saturation: float | None, growth: float) -> np.ndarray:
+        """The plays of the exact shape as rows (:func:`scaled_plays`, at rest as the nominal's
+        plays; memoised, the latest only).
+
+        Parameters
+        ----------
+        tau, saturation, growth : float
+            The filter [s] (> 0), ``S`` (or None) and ``G``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, N), or (q, N) with a ``projection``; C-contiguous.
+
+        Examples
+        --------
+        >>> v = np.r_[np.linspace(0.0, 1.0, 11), np.full(3, 1.0)]
+        >>> basis = RateBasis(None, [0.0, 0.2], v, 1.0, 0.1, [1.0, 1.0], at_rest=True)
+        >>> basis.scaled_rows(1e-9, None, 0.5)[:, 10].round(6).tolist()  # radius 0.2 -> 0.3
+        [1.0, 0.7]
+        """
+        key = ("scaled", float(tau), saturation, float(growth))
+        if key not in self._cache:
+            z0 = float(self.v[0]) if self.at_rest else 0.0
+            Zs = scaled_plays(self.v, self.radii, self.dt, self.rate_scale, tau, saturation,
+                              growth, z0)
+            rows = np.ascontiguousarray((Zs if self.projection is None else
+                                         Zs @ self.projection).T)
+            self._cache.clear()
+            self._cache[key] = rows
+        return self._cache[key]
 
     def _play_chunks(self):
         """``(slice, Z[slice])`` over the record, the plays computed chunk by chunk (their
@@ -440,24 +459,21 @@ class RateBasis:
         return out
 
 
-def scaled_play_sums(v: np.ndarray, radii, weights, bands, dt: float, rate_scale: float,
-                     tau: float, saturation: float | None, growth: float,
-                     z0: float = 0.0) -> np.ndarray:
-    """Band outputs ``sum_{i in b} w_i zs_i[k]`` of plays whose radii scale with the rate.
+def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
+                 saturation: float | None, growth: float, z0: float = 0.0) -> np.ndarray:
+    """Outputs ``zs_i[k]`` of plays whose radii scale with the rate (the exact shape).
 
     ``zs_i[k] = min(max(zs_i[k-1], v[k] - rho_i[k]), v[k] + rho_i[k])``, ``zs_i[-1] = z0``,
     ``rho_i[k] = r_i (1 + G s[k] / (1 + s[k] / S))``, ``s[k]`` the strictly causal filtered
     rate of the module docstring (``s[0] = s[1] = 0``); run by the C core
-    (``pim_rdpi_sat_run``, :mod:`pimodel.operators.rate_dependent`).
+    (``pim_rdpi_sat_run``, as :mod:`pimodel.operators.rate_dependent`), one play at a time.
 
     Parameters
     ----------
     v : numpy.ndarray
         Input ``v[k]``.
-    radii, weights : array_like
-        Play radii ``r_i`` [input units] and weights ``w_i``.
-    bands : list of numpy.ndarray
-        Play indices of each band (:func:`play_bands`).
+    radii : array_like
+        Play radii ``r_i`` [input units].
     dt : float
         Sample time [s].
     rate_scale : float
@@ -474,19 +490,19 @@ def scaled_play_sums(v: np.ndarray, radii, weights, bands, dt: float, rate_scale
     Returns
     -------
     numpy.ndarray
-        Shape (N, len(bands)); row ``k`` depends on ``v[0..k]``.
+        Shape (N, n); row ``k`` depends on ``v[0..k]``.
 
     Raises
     ------
     ValueError
-        ``tau`` not finite and > 0, ``rate_scale`` not > 0, ``saturation`` not None or > 0.
+        ``tau`` not finite and > 0, ``rate_scale`` not > 0, ``saturation`` not None or > 0,
+        ``growth`` not finite.
 
     Examples
     --------
     >>> v = np.r_[np.linspace(0.0, 1.0, 11), np.full(3, 1.0)]  # a ramp at 0.1/s, then a hold
-    >>> b = [np.array([0])]
-    >>> y = scaled_play_sums(v, [0.2], [1.0], b, 1.0, 0.1, 1e-9, None, 0.5)
-    >>> round(float(v[10] - y[10, 0]), 6)  # the radius grew by G s = 0.5 at the rate 1
+    >>> zs = scaled_plays(v, [0.2], 1.0, 0.1, 1e-9, None, 0.5)
+    >>> round(float(v[10] - zs[10, 0]), 6)  # the radius grew by G s = 0.5 at the rate 1
     0.3
     """
     if not (np.isfinite(tau) and tau > 0):
@@ -494,26 +510,26 @@ def scaled_play_sums(v: np.ndarray, radii, weights, bands, dt: float, rate_scale
                          f"got {tau!r}")
     if not rate_scale > 0:
         raise ValueError(f"rate_scale: expected > 0, got {rate_scale!r}")
+    if not np.isfinite(growth):
+        raise ValueError(f"growth: expected a finite G, got {growth!r}")
     saturated_rate(np.zeros(1), saturation)  # checks S
-
     v = np.ascontiguousarray(v, float)
-    r, w = np.asarray(radii, float), np.asarray(weights, float)
+    r = np.asarray(radii, float)
     lam = float(np.exp(-dt / tau))
-    out = np.empty((v.size, len(bands)))
-    for b, g in enumerate(bands):
-        z = np.full(g.size, z0)
-        hist = np.array([v[0], 0.0])
-        out[:, b] = _native.rdpi_sat_run(np.ascontiguousarray(w[g]), np.ascontiguousarray(r[g]),
-                                         growth / rate_scale,
-                                         0.0 if saturation is None else saturation * rate_scale,
-                                         lam, dt, z, hist, v)
+    sat = 0.0 if saturation is None else saturation * rate_scale
+    out = np.empty((v.size, r.size))
+    one = np.ones(1)
+    for i in range(r.size):
+        z, hist = np.full(1, z0), np.array([v[0], 0.0])
+        out[:, i] = _native.rdpi_sat_run(one, r[i:i + 1].copy(), growth / rate_scale, sat, lam,
+                                         dt, z, hist, v)
     return out
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,
                  tau: float, family: str, bands: int = RATE_BANDS, *,
-                 input_range: float | None = None, saturation: float | None = None,
-                 growth: float | None = None, at_rest: bool = False) -> np.ndarray:
+                 input_range: float | None = None,
+                 saturation: float | None = None) -> np.ndarray:
     """The rate candidate's columns of one record (module docstring), for one family and filter.
 
     Parameters
@@ -540,10 +556,6 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
         The range of the step rule (default ``ptp(v)``).
     saturation : float or None
         ``S`` of :func:`saturated_rate` (None: none).
-    growth : float or None
-        ``G`` of the ``"scaled"`` family.
-    at_rest : bool
-        The ``"scaled"`` family's plays start at ``v[0]`` (as ``Z``'s); False: at 0.
 
     Returns
     -------
@@ -558,8 +570,8 @@ def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: flo
     >>> R[[10, 20, 40, 41, 80], 0].round(6).tolist()  # no contact yet, contact, then held
     [0.0, -0.5, -0.5, -0.5, -0.5]
     """
-    return RateBasis(Z, radii, v, dt, rate_scale, weights, bands, input_range=input_range,
-                     at_rest=at_rest).columns(tau, family, saturation, growth)
+    return RateBasis(Z, radii, v, dt, rate_scale, weights, bands,
+                     input_range=input_range).columns(tau, family, saturation)
 
 
 def rate_params(p: dict) -> tuple[np.ndarray, str, float]:
@@ -665,7 +677,8 @@ def rate_growth(p: dict) -> float | None:
 def rate_shapes(effects, fixed: dict) -> list[dict]:
     """The rate shapes a diagnosis scores on validate (by BIC) whenever ``effects`` hold a rate
     not yet fitted: the first-order form and the exact one (``{"rate_shape": "scaled"}``);
-    ``[{}]`` without a rate or with its parameters held in ``fixed`` (from earlier rounds).
+    ``[{}]`` without a rate, with its parameters held in ``fixed`` (from earlier rounds) or
+    beside dynamics or a delay.
 
     Parameters
     ----------
@@ -685,6 +698,6 @@ def rate_shapes(effects, fixed: dict) -> list[dict]:
     >>> rate_shapes(("creep", "rate"), {"rate_tau": 0.01}), rate_shapes(("creep",), {})
     ([{}], [{}])
     """
-    if "rate" not in effects or "rate_tau" in fixed:
+    if "rate" not in effects or "rate_tau" in fixed or {"dynamics", "delay"} & set(effects):
         return [{}]
     return [{}, {"rate_shape": SCALED}]

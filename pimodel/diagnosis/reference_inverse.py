@@ -244,6 +244,8 @@ class StaticInverse:
             for g, idx in zip(gains, play_bands(n, gains.size), strict=True):
                 if family == "radius":
                     self.rg[idx] = g * r[idx]
+                elif family == SCALED:  # the scaled plays carry the weights w
+                    self.rw[idx] = g * self.w[idx]
                 else:
                     self.rw[idx] = g * self.w0[idx]
             self.step_size = STEP_SHARE * self.input_range

@@ -181,7 +181,7 @@ static double dinv_F(const dinv_ctx *c, double v)
         h0 += d->w0[i] * zc;
         if (c->zs) {
             const double zsc = dinv_clamp(c->zs[i], v - c->rs[i], v + c->rs[i]);
-            rad += (zsc - zc) * (d->rate_w[i] * d->w0[i]);
+            rad += (zsc - zc) * (d->rate_w[i] * d->w[i]);
         } else if (rate && radius) {
             const double gap = v - zc;
             const int touch = r > 0.0 && fabs(gap) >= r * (1.0 - 1e-9);

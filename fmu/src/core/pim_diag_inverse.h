@@ -30,7 +30,7 @@
  *            + sum_i g_i r_i (contact_i(v) ? -sign(v - Z_i) rho_k : m_i)   rate, radius family
  *            + rho_k sum_i g_i w0_i Z_i                                     rate, weight family
  *
- *            + sum_i g_i w0_i (clip(zs_i[k-1], v - rs_i, v + rs_i) - Z_i)   scaled family
+ *            + sum_i g_i w_i (clip(zs_i[k-1], v - rs_i, v + rs_i) - Z_i)    scaled family
  *
  * (rate terms not on the first sample; the scaled family's is 0 there, its plays zs starting
  * with z).  The scaled family is exact: its radii rs_i = r_i (1 + g(s[k])) follow the rate of

@@ -187,7 +187,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     double scaled_term = 0.0;
     if (scaled) {
         double p[PIM_DIAG_MAX_PLAYS], hist[2] = {x[1], rate[0]}, ys = 0.0;
-        for (size_t i = 0; i < n; ++i) p[i] = d->rate_w[i] * d->w0[i];
+        for (size_t i = 0; i < n; ++i) p[i] = d->rate_w[i] * d->w[i];
         pim_rdpi_sat_run(1, n, p, d->r, d->rate_growth / d->rate_scale,
                          d->rate_saturation * d->rate_scale, exp(-d->dt / d->rate_tau), d->dt,
                          mem, hist, &v, &ys);
@@ -227,7 +227,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         }
     }
     h0 += d->c0;
-    for (size_t i = 0; scaled && i < n; ++i) scaled_term -= d->rate_w[i] * (d->w0[i] * z[i]);
+    for (size_t i = 0; scaled && i < n; ++i) scaled_term -= d->rate_w[i] * (d->w[i] * z[i]);
     /* a prefilter (Wiener model): h from the plays zf of the filtered input x_f instead */
     if (d->nw) {
         const size_t m = PIM_DIAG_SECTION, o = PIM_DIAG_SECTION - 1;

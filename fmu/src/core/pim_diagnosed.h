@@ -43,8 +43,8 @@
  * (rate_family 2, the exact shape): plays zs_i of radii r_i (1 + G s[k] / (1 + s[k] / S))
  * (S = 0: G s[k]), s[k] the strictly causal filtered rate of pim_rdpi_sat_run
  * (pim_rate_dependent.h, normalised: s[k] = a s[k-1] + (1 - a) |v[k-1] - v[k-2]| / dt /
- * rate_scale, rate_tau > 0), zs_i[-1] = z_i[-1], and the term sum_i g_i w0_i (zs_i[k] -
- * z_i[k]).  Radius family: m_i[k] = -(v[k] - z_i[k]) rho_f[k]
+ * rate_scale, rate_tau > 0), zs_i[-1] = z_i[-1], and the term sum_i g_i w_i (zs_i[k] -
+ * z_i[k]) (the weights w: the hysteresis is that of the scaled plays).  Radius family: m_i[k] = -(v[k] - z_i[k]) rho_f[k]
  * while play i (r_i > 0) is in contact (|v[k] - z_i[k]| >= r_i (1 - 1e-9)), else m_i[k-1]
  * (m_i = 0 before its first contact): the term held at the play's last contact.
  * A fractional delay part f <= 1e-12 counts as 0 (as pimodel.diagnosis.effects.shift).
