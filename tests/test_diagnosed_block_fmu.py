@@ -59,6 +59,7 @@ CASES = {
     "drift_settle": ("drift",),
     "delay_whole": ("delay",),
     "rate_saturated": ("rate",),
+    "rate_scaled": ("rate",),
     "all": tuple(EFFECT_PARAMS),
 }
 
@@ -79,6 +80,9 @@ def model(case: str) -> DiagnosedModel:
         params["delay_samples"] = 4
     if case == "rate_saturated":  # the filtered rate through rho / (1 + rho / S)
         params.update({"rate_time_constant_s": 3e-3, "rate_saturation": 0.4})
+    if case == "rate_scaled":  # the exact shape: plays whose radii scale with the rate
+        params.update({"rate_family": "scaled", "rate_gains": [1.0], "rate_growth": 0.5,
+                       "rate_time_constant_s": 3e-3, "rate_saturation": 0.4})
     if case in RATE_VARIANTS:
         params["rate_family"], params["rate_time_constant_s"] = RATE_VARIANTS[case]
     return DiagnosedModel(RADII, [1.2, -0.4, 0.8, -0.3, 0.25], 0.3, dt=DT, effects=effects,
@@ -224,7 +228,8 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
-                                  "delay_whole", "rate", "rate_saturated", *RATE_VARIANTS])
+                                  "delay_whole", "rate", "rate_saturated", "rate_scaled",
+                                  *RATE_VARIANTS])
 def test_unit_equals_simulate(fmus, fmi, case):
     """The generic unit with the model's values (FMU time k Ts from 0: the drift clocks read
     t = k Ts)."""

@@ -36,6 +36,7 @@ from .rate import (
     RATE_GROWTH_REFINE,
     RATE_GROWTHS,
     RATE_POLISH_ROUNDS,
+    RATE_SCALED_EVALS,
     RATE_SATURATION_REFINE,
     RATE_SATURATIONS,
     RATE_TAU_REFINE,
@@ -878,23 +879,27 @@ def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
 
 def _search_scaled(search, start: dict):
     """The rate's exact shape (family ``SCALED``, module rate) from the first-order optimum
-    ``start``: its filter (at least ``RATE_TAUS[1]``) and ``S``, ``G`` on ``RATE_GROWTHS``, then
-    ``G``, ``S`` and the filter by steps in turn while the train residual falls."""
+    ``start``: its filter (at least ``RATE_TAUS[1]``), ``G`` on ``RATE_GROWTHS`` times ``S``
+    at half, once and twice the first-order ``S`` (1 when linear), then ``G``, ``S`` and the
+    filter together by a Nelder-Mead polish in their logarithms (``G`` and ``S`` trade
+    against each other along a valley that steps of one at a time do not follow)."""
+    s0 = start["rate_saturation"] or 1.0
     p0 = {**start, "rate_family": SCALED, "rate_tau": max(start["rate_tau"], RATE_TAUS[1])}
-    best = search([{**p0, "rate_growth": g} for g in RATE_GROWTHS])
-    for _ in range(2 * RATE_POLISH_ROUNDS):
-        before, p_ = best[0], best[0].params
-        sat = p_["rate_saturation"]
-        best = search([{**p_, "rate_growth": p_["rate_growth"] * f}
-                       for f in (1 / RATE_GROWTH_REFINE, RATE_GROWTH_REFINE)]
-                      + [{**p_, "rate_saturation": sat * f}
-                         for f in (1 / RATE_SATURATION_REFINE, RATE_SATURATION_REFINE)
-                         if sat is not None]
-                      + [{**p_, "rate_tau": p_["rate_tau"] * f}
-                         for f in (1 / RATE_TAU_REFINE[-1], RATE_TAU_REFINE[-1])], best)
-        if best[0] is before:
-            break
-    return best
+    best = search([{**p0, "rate_growth": g, "rate_saturation": s0 * f}
+                   for g in RATE_GROWTHS for f in (0.5, 1.0, 2.0)])
+
+    def point(x):
+        return {**p0, "rate_growth": float(np.exp(x[0])), "rate_saturation": float(np.exp(x[1])),
+                "rate_tau": float(np.exp(x[2]))}
+
+    q = best[0].params
+    x0 = np.log([q["rate_growth"], q["rate_saturation"], q["rate_tau"]])
+    step = np.log(RATE_GROWTH_REFINE)
+    r = nelder_mead(lambda x: search([point(x)])[1], x0,
+                    initial_simplex=[x0, x0 + [step, 0, 0], x0 + [0, step, 0],
+                                     x0 + [0, 0, step]],
+                    xatol=1e-3, fatol=1e-9 * best[1], maxfev=RATE_SCALED_EVALS)
+    return search([point(r.x)], best) if r.fun < best[1] else best
 
 
 def _combo_k(effects, nominal: Model) -> int:

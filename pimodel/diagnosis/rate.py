@@ -53,9 +53,9 @@ strictly causal (``s[k]`` from ``v[..k-1]``: the radii of sample ``k`` are fixed
 :func:`scaled_plays`). The weights are fitted by least squares on these plays in place of the
 nominal ones (the hysteresis is ``sum_i w_i zs_i``; as an effect term beside the plays, the
 model's ``sum_i g_b w_i (zs_i - z_i)`` with one gain ``g = 1``). ``G``, ``S`` and
-``tau > 0`` are nonlinear: a grid (``RATE_GROWTHS`` at the first-order form's filter and
-``S``), then each in turn by steps (``RATE_GROWTH_REFINE``, ``RATE_SATURATION_REFINE``, the
-finest of ``RATE_TAU_REFINE``) while the train residual falls. The shape is offered beside
+``tau > 0`` are nonlinear: a grid (``RATE_GROWTHS`` times half, once and twice the
+first-order form's ``S``, at its filter), then the three together by a Nelder-Mead polish in
+their logarithms (at most ``RATE_SCALED_EVALS`` fits; ``G`` and ``S`` trade along a valley). The shape is offered beside
 the first-order one and chosen by validate BIC (:func:`rate_shapes`), not with dynamics or a
 delay (their columns filter or shift the nominal plays).
 """
@@ -81,7 +81,8 @@ RATE_POLISH_ROUNDS = 4  # ... in turn, while the train residual falls
 SCALED = "scaled"  # the exact shape: plays whose radii scale with the rate (module docstring)
 FAMILY_CODES = (*RATE_FAMILIES, SCALED)  # rate_family of the C core (pim_diagnosed.h): 0, 1, 2
 RATE_GROWTHS = (0.1, 0.2, 0.4, 0.8, 1.6)  # G [-] of the scaled shape's grid
-RATE_GROWTH_REFINE = 2**0.25  # then G, S and the filter in turn (1/4 octave, 1/8 decade)
+RATE_GROWTH_REFINE = 2**0.25  # then G, S and the filter polished (first steps: 1/4 octave)
+RATE_SCALED_EVALS = 60  # ... by at most this many fits (Nelder-Mead in log G, log S, log tau)
 
 __all__ = [
     "FAMILY_CODES",
@@ -91,6 +92,7 @@ __all__ = [
     "RATE_GROWTH_REFINE",
     "RATE_POLISH_ROUNDS",
     "RATE_SATURATIONS",
+    "RATE_SCALED_EVALS",
     "RATE_SATURATION_REFINE",
     "RATE_TAUS",
     "RATE_TAU_REFINE",
