@@ -361,8 +361,8 @@ MODELS: dict[str, dict] = {
 _INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset", "n_lags",
                    "creep_gain", "creep_tau", "asymmetry_quadratic", "asymmetry_cubic",
                    "center", "half_range", "rate_band_gain", "rate_scale", "rate_family",
-                   "rate_tau", "rate_saturation", "rate_growth", "input_range", "p_hi", "r_hi", "w0_hi",
-                   "rate_band_gain_hi"}
+                   "rate_tau", "rate_saturation", "rate_growth", "input_range", "p_hi", "r_hi",
+                   "w0_hi", "rate_band_gain_hi"}
 MODELS["DiagnosedInverse"] = {
     "id": 9,
     "description": "The causal feedforward of a diagnosed model: the prefilter (the dynamics' "
