@@ -1,5 +1,6 @@
 """The ``rate`` candidate: hysteresis whose play radii or weights depend on a low-passed input
-rate, to first order, as columns that are linear in their gains.
+rate, to first order as columns that are linear in their gains, or exactly as plays whose
+radii scale with the rate (the ``"scaled"`` shape, below).
 
 A rate-dependent PI model (as :class:`pimodel.operators.rate_dependent.RateDependentPI`,
 generalised) has radii ``r_i (1 + a_b rho_f[k])`` or weights ``w_i (1 + c_b rho_f[k])`` for the
