@@ -296,7 +296,10 @@ def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
      ({"n_lags": 65}, "parameter n_lags = 65 out of range"),
      ({"half_range": -1.0}, "parameter half_range = -1: must be finite and > 0"),
      ({"rate_scale": 0.0}, "parameter rate_scale = 0"),
-     ({"rate_family": 2}, "parameter rate_family = 2 out of range: 0 radius, 1 weight"),
+     ({"rate_family": 3}, "parameter rate_family = 3 out of range: 0 radius, 1 weight, 2 scaled"),
+     ({"rate_family": 2}, "parameter rate_tau = 0: the scaled rate family (rate_family 2) needs "
+                          "rate_tau > 0 s"),
+     ({"rate_growth": float("nan")}, "parameter rate_growth = nan: must be finite"),
      ({"rate_tau": -0.001}, "parameter rate_tau = -0.001: must be finite and >= 0 s"),
      ({"rate_tau": float("nan")}, "parameter rate_tau = nan: must be finite and >= 0 s"),
      ({"rate_saturation": -0.5}, "parameter rate_saturation = -0.5: must be finite and >= 0"),

@@ -312,7 +312,7 @@ class DiagnosedModel:
         if "asymmetry" in e:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-        if "rate" in e and p["rate_family"] == SCALED:  # sum_i g_b w_i (zs_i - z_i)
+        if "rate" in e and p.get("rate_family") == SCALED:  # sum_i g_b w_i (zs_i - z_i)
             gains, _, tau = rate_params(p)
             Zs = scaled_plays(v, self.radii, self.dt, p["rate_scale"], tau, rate_saturation(p),
                               rate_growth(p), float(v[0]) if self.plays_start == "v0" else 0.0)
