@@ -264,6 +264,9 @@ lib.pim_play_solve.argtypes = [c_size, F64, F64, F64, c_double]
 lib.pim_rdpi_run.restype = None
 lib.pim_rdpi_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64, F64,
                              F64, F64]
+lib.pim_rdpi_sat_run.restype = None
+lib.pim_rdpi_sat_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double,
+                                 c_double, F64, F64, F64, F64]
 lib.pim_rdpi_inverse_run.restype = c_int
 lib.pim_rdpi_inverse_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64,
                                      F64, F64, F64]
@@ -293,6 +296,15 @@ def rdpi_run(p: np.ndarray, alpha: np.ndarray, beta: float, lam: float, Ts: floa
     """Rate-dependent PI run; ``z`` (n) and ``hist`` (v[k-1], rate[k]) updated in place."""
     y = np.empty(v.shape[0])
     lib.pim_rdpi_run(v.shape[0], p.shape[0], p, alpha, beta, lam, Ts, z, hist, v, y)
+    return y
+
+
+def rdpi_sat_run(p: np.ndarray, alpha: np.ndarray, beta: float, sat: float, lam: float,
+                 Ts: float, z: np.ndarray, hist: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rate-dependent PI run with a saturating radius growth (``sat`` <= 0: none); ``z`` (n)
+    and ``hist`` (v[k-1], rate[k]) updated in place."""
+    y = np.empty(v.shape[0])
+    lib.pim_rdpi_sat_run(v.shape[0], p.shape[0], p, alpha, beta, sat, lam, Ts, z, hist, v, y)
     return y
 
 
@@ -353,7 +365,8 @@ class DiagParams(ctypes.Structure):
                 ("asym", c_int), ("q", c_double), ("c3", c_double), ("center", c_double),
                 ("half", c_double), ("rate_w", _DP), ("dt", c_double),
                 ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
-                ("rate_tau", c_double), ("rate_saturation", c_double), ("order", c_size),
+                ("rate_tau", c_double), ("rate_saturation", c_double),
+                ("rate_growth", c_double), ("order", c_size),
                 ("b", _DP), ("a", _DP), ("delay", c_double), ("drift_clock", c_int),
                 ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
                 ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP),
@@ -421,7 +434,7 @@ class InverseParams(ctypes.Structure):
                 ("half", c_double), ("rate_w", _DP), ("dt", c_double),
                 ("rate_scale", c_double), ("input_range", c_double), ("rate_family", c_int),
                 ("rate_tau", c_double), ("rate_saturation", c_double),
-                ("reference_range", c_double), ("ns", c_size),
+                ("rate_growth", c_double), ("reference_range", c_double), ("ns", c_size),
                 ("sos", _DP), ("latency", c_size), ("frac", c_double), ("npost", c_size),
                 ("post", _DP)]
 

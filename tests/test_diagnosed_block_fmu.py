@@ -59,6 +59,7 @@ CASES = {
     "drift_settle": ("drift",),
     "delay_whole": ("delay",),
     "rate_saturated": ("rate",),
+    "rate_scaled": ("rate",),
     "all": tuple(EFFECT_PARAMS),
 }
 
@@ -79,6 +80,9 @@ def model(case: str) -> DiagnosedModel:
         params["delay_samples"] = 4
     if case == "rate_saturated":  # the filtered rate through rho / (1 + rho / S)
         params.update({"rate_time_constant_s": 3e-3, "rate_saturation": 0.4})
+    if case == "rate_scaled":  # the exact shape: plays whose radii scale with the rate
+        params.update({"rate_family": "scaled", "rate_gains": [1.0], "rate_growth": 0.5,
+                       "rate_time_constant_s": 3e-3, "rate_saturation": 0.4})
     if case in RATE_VARIANTS:
         params["rate_family"], params["rate_time_constant_s"] = RATE_VARIANTS[case]
     return DiagnosedModel(RADII, [1.2, -0.4, 0.8, -0.3, 0.25], 0.3, dt=DT, effects=effects,
@@ -224,7 +228,8 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
-                                  "delay_whole", "rate", "rate_saturated", *RATE_VARIANTS])
+                                  "delay_whole", "rate", "rate_saturated", "rate_scaled",
+                                  *RATE_VARIANTS])
 def test_unit_equals_simulate(fmus, fmi, case):
     """The generic unit with the model's values (FMU time k Ts from 0: the drift clocks read
     t = k Ts)."""
@@ -291,7 +296,10 @@ def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
      ({"n_lags": 65}, "parameter n_lags = 65 out of range"),
      ({"half_range": -1.0}, "parameter half_range = -1: must be finite and > 0"),
      ({"rate_scale": 0.0}, "parameter rate_scale = 0"),
-     ({"rate_family": 2}, "parameter rate_family = 2 out of range: 0 radius, 1 weight"),
+     ({"rate_family": 3}, "parameter rate_family = 3 out of range: 0 radius, 1 weight, 2 scaled"),
+     ({"rate_family": 2}, "parameter rate_tau = 0: the scaled rate family (rate_family 2) needs "
+                          "rate_tau > 0 s"),
+     ({"rate_growth": float("nan")}, "parameter rate_growth = nan: must be finite"),
      ({"rate_tau": -0.001}, "parameter rate_tau = -0.001: must be finite and >= 0 s"),
      ({"rate_tau": float("nan")}, "parameter rate_tau = nan: must be finite and >= 0 s"),
      ({"rate_saturation": -0.5}, "parameter rate_saturation = -0.5: must be finite and >= 0"),

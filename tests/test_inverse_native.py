@@ -62,6 +62,10 @@ CASES = {
                                          "rate_gains": [0.05, 0.02]}),
     "rate_weight": (("rate",), {"rate_family": "weight"}),
     "rate_weight_filtered": (("rate",), WEIGHT_FILTERED),
+    # the exact shape: plays whose radii scale with the rate before the sample (exact inverse)
+    "rate_scaled_creep": (("rate", "creep"), {"rate_family": "scaled", "rate_gains": [1.0],
+                                              "rate_time_constant_s": 5e-3,
+                                              "rate_saturation": 1.0, "rate_growth": 0.4}),
     "static_all": (("creep", "asymmetry", "rate"), {}),
     "dynamics": (("dynamics",), {}),
     "dynamics_direct": (("dynamics",), {"lti_elements": [["direct"]], "lti_gains": [0.1]}),

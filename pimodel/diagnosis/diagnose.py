@@ -76,7 +76,7 @@ from .effects import (
 )
 from .gain import gain_note, record_gains
 from .noise import measure_noise_floor
-from .rate import RateBasis
+from .rate import RateBasis, rate_shapes
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
 
@@ -625,7 +625,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         pairs += list(zip(segs, whole[0] + whole[1], strict=True))
     for s, w in pairs:
         s.rate_basis = RateBasis(None, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref,
-                                 input_range=float(np.ptp(w.v)), at_rest=at_rest)
+                                 input_range=float(np.ptp(w.v)), at_rest=at_rest,
+                                 projection=proj)
         s.wiener_basis = WienerBasis(s.v, radii, proj, s.dt,  # dynamics before the plays
                                      at_rest=at_rest)
 
@@ -637,9 +638,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
         best = None
-        for var in drift_variants((*combo, name), len(va)):
+        shapes = rate_shapes((*combo, name), fixed_ or {})
+        for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
+                           for r in shapes):
             fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},
-                  **var}
+                  **var, **shape}
             key = (combo, name, tuple(sorted(fx.items())))
             if key not in cache:
                 m = fit_effect(name, tr, combo, fx, nominal)

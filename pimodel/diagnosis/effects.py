@@ -33,12 +33,16 @@ from .lti import describe_lti, lti_columns, lti_k, nelder_mead, select_order
 from .rate import (
     RATE_BANDS,
     RATE_FAMILIES,
+    RATE_GROWTH_REFINE,
+    RATE_GROWTHS,
     RATE_POLISH_ROUNDS,
     RATE_SATURATION_REFINE,
     RATE_SATURATIONS,
+    RATE_SCALED_EVALS,
     RATE_TAU_REFINE,
     RATE_TAU_START,
     RATE_TAUS,
+    SCALED,
 )
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
@@ -620,7 +624,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
         taus = tuple(nominal.params["creep_taus"])
         nominal = replace(nominal, params={**nominal.params,
                                            "creep_taus": (*taus, REFINED_CREEP_LAG * taus[-1])})
+    scaled = fixed.pop("rate_shape", None) == SCALED  # the rate's exact shape (module rate)
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
+    if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
+        k -= RATE_BANDS - 1
     static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
@@ -673,7 +680,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                          [{"clock": c} for c in DRIFT_CLOCKS if c not in ("levels", "settle")])
         elif e == "rate":  # the filter is searched after the other grids (below)
             grids.append([{k_: fixed.get(k_) for k_ in ("rate_family", "rate_tau",
-                                                         "rate_saturation")}]
+                                                         "rate_saturation", "rate_growth")}]
                          if "rate_tau" in fixed else
                          [{"rate_family": f, "rate_tau": RATE_TAU_START, "rate_saturation": None}
                           for f in RATE_FAMILIES])
@@ -707,6 +714,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                              if p_["rate_tau"] > 0], best)
             if best[0] is before:
                 break
+        if scaled:
+            best = _search_scaled(search, best[0].params)
     if best[0].params.get("clock") == "settle" and "settle_tau" not in fixed:
         # the settling time constant (the other grid parameters held): its grid, then
         # continuously in log T between the grid neighbours of the best point
@@ -905,6 +914,31 @@ def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
     return ref
 
 
+def _search_scaled(search, start: dict):
+    """The rate's exact shape (family ``SCALED``, module rate) from the first-order optimum
+    ``start``: its filter (at least ``RATE_TAUS[1]``), ``G`` on ``RATE_GROWTHS`` times ``S``
+    at half, once and twice the first-order ``S`` (1 when linear), then ``G``, ``S`` and the
+    filter together by a Nelder-Mead polish in their logarithms (``G`` and ``S`` trade
+    against each other along a valley that steps of one at a time do not follow)."""
+    s0 = start["rate_saturation"] or 1.0
+    p0 = {**start, "rate_family": SCALED, "rate_tau": max(start["rate_tau"], RATE_TAUS[1])}
+    best = search([{**p0, "rate_growth": g, "rate_saturation": s0 * f}
+                   for g in RATE_GROWTHS for f in (0.5, 1.0, 2.0)])
+
+    def point(x):
+        return {**p0, "rate_growth": float(np.exp(x[0])), "rate_saturation": float(np.exp(x[1])),
+                "rate_tau": float(np.exp(x[2]))}
+
+    q = best[0].params
+    x0 = np.log([q["rate_growth"], q["rate_saturation"], q["rate_tau"]])
+    step = np.log(RATE_GROWTH_REFINE)
+    r = nelder_mead(lambda x: search([point(x)])[1], x0,
+                    initial_simplex=[x0, x0 + [step, 0, 0], x0 + [0, step, 0],
+                                     x0 + [0, 0, step]],
+                    xatol=1e-3, fatol=1e-9 * best[1], maxfev=RATE_SCALED_EVALS)
+    return search([point(r.x)], best) if r.fun < best[1] else best
+
+
 def _combo_k(effects, nominal: Model) -> int:
     return sum({"creep": len(nominal.params["creep_taus"]), "dynamics": 2, "delay": 1,
                 "asymmetry": 2, "drift": 1, "rate": RATE_BANDS + 2}[e] for e in effects)
@@ -932,6 +966,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
 
     def rows(s: Segment) -> tuple[np.ndarray, np.ndarray]:  # the play rows, then the others
         Z = s.play_rows(ncols)
+        scaled = "rate" in effects and p["rate_family"] == SCALED
+        if scaled:  # the exact shape's plays in place of the nominal ones (module rate)
+            Z = s.rate_basis.scaled_rows(p["rate_tau"], p["rate_saturation"], p["rate_growth"])
         if p.get("wiener"):  # the linear part before the hysteresis (module wiener)
             Z = s.wiener_basis.columns(p["wiener"], ncols).T  # rows, kept C-contiguous
         elif "dynamics" in effects:  # filter the play rows
@@ -945,7 +982,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         parts = [Z, static_rows(s)]
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
-        if "rate" in effects:
+        if "rate" in effects and not scaled:
             which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"))
             key = ("rate", id(s))
             if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
@@ -998,11 +1035,14 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2
         elif e == "rate":
-            out["rate_gains"] = extra[i:i + RATE_BANDS].tolist()
+            scaled = model.params["rate_family"] == SCALED  # one gain of 1 (module rate)
+            out["rate_gains"] = [1.0] if scaled else extra[i:i + RATE_BANDS].tolist()
             out["rate_family"] = model.params["rate_family"]
             out["rate_time_constant_s"] = model.params["rate_tau"]
             out["rate_saturation"] = model.params.get("rate_saturation")
-            i += RATE_BANDS
+            if scaled:
+                out["rate_growth"] = model.params["rate_growth"]
+            i += 0 if scaled else RATE_BANDS
     if "drift" in effects and model.params["clock"] == "settle":  # on the shared clock
         out.update({"drift_per_s": 0.0, "drift_clock": "absolute",
                     "drift_variant": "settle_levels" if "levels" in model.params else "settle",

@@ -104,7 +104,15 @@ from .lti import approximate_inverse, lti_columns
 from .monotone import monotone_model
 from .native_inverse import NativeInverse, inverse_block
 from .native_model import diagnosed_block
-from .rate import rate_columns, rate_params, rate_saturation
+from .rate import (
+    SCALED,
+    play_bands,
+    rate_columns,
+    rate_growth,
+    rate_params,
+    rate_saturation,
+    scaled_plays,
+)
 from .reference_inverse import solve_static
 from .wiener import inverse_prefilter, prefilter
 
@@ -304,7 +312,14 @@ class DiagnosedModel:
         if "asymmetry" in e:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-        if "rate" in e:
+        if "rate" in e and p.get("rate_family") == SCALED:  # sum_i g_b w_i (zs_i - z_i)
+            gains, _, tau = rate_params(p)
+            Zs = scaled_plays(v, self.radii, self.dt, p["rate_scale"], tau, rate_saturation(p),
+                              rate_growth(p), float(v[0]) if self.plays_start == "v0" else 0.0)
+            per_play = np.repeat(gains, [b.size for b in play_bands(self.radii.size,
+                                                                     gains.size)])
+            y = y + (Zs - Z) @ (self.weights * per_play)
+        elif "rate" in e:
             gains, family, tau = rate_params(p)
             R = rate_columns(Z, self.radii, v, self.dt, p["rate_scale"], self.reference_weights,
                              tau, family, gains.size, input_range=input_range,

@@ -36,7 +36,7 @@ from ..blocks.framework import labelled_values, signal_labels
 from .checks import checked_signal
 from .limits import MAX_LATENCY, MAX_SECTIONS, NMAX
 from .native_model import _band_gains
-from .rate import RATE_FAMILIES
+from .rate import FAMILY_CODES
 from .reference_inverse import StaticInverse, _delay, _filter, feedforward_block, inverse_latency
 from .wiener import inverse_sections
 
@@ -97,7 +97,8 @@ class NativeInverse:
             d.center, d.half = p["center"], p["half_range"]
         if solver.rate:
             keep["rate_w"] = _band_gains(np.asarray(p["rate_gains"], float), n)
-            d.rate_family = RATE_FAMILIES.index(p["rate_family"])
+            d.rate_family = FAMILY_CODES.index(p["rate_family"])
+            d.rate_growth = solver.growth or 0.0
             d.rate_tau, d.rate_scale = solver.tau, p["rate_scale"]
             d.rate_saturation = solver.saturation or 0.0
         sos, _ = _filter(model)
@@ -366,7 +367,8 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
     if "rate_w" in k:
         out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
                     "rate_family": int(d.rate_family), "rate_tau": d.rate_tau,
-                    "rate_saturation": d.rate_saturation})
+                    "rate_saturation": d.rate_saturation,
+                    **({"rate_growth": d.rate_growth} if d.rate_family == 2 else {})})
     if d.ns:
         out.update({"n_sections": int(d.ns), **arr("section", k["sos"].ravel())})
     if d.npost:

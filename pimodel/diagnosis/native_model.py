@@ -59,7 +59,7 @@ from .checks import block_dt, checked_signal
 from .filters import mode_coefficients
 from .limits import MAX_DELAY, MAX_ELEMENTS, MAX_ORDER, NMAX, SECTION
 from .lti import ELEMENT_K, element_coefficients
-from .rate import RATE_FAMILIES, play_bands, rate_params, rate_saturation
+from .rate import FAMILY_CODES, play_bands, rate_growth, rate_params, rate_saturation
 from .wiener import ELEMENT_K as WIENER_K
 
 __all__ = ["NativeModel", "diagnosed_block", "element_sections", "fmu_parameters",
@@ -283,8 +283,9 @@ class NativeModel:
         if "rate" in e:
             gains, family, tau = rate_params(p)
             keep["rate_w"] = _band_gains(gains, n)
-            d.rate_family, d.rate_tau = RATE_FAMILIES.index(family), tau
+            d.rate_family, d.rate_tau = FAMILY_CODES.index(family), tau
             d.rate_saturation = rate_saturation(p) or 0.0
+            d.rate_growth = rate_growth(p) or 0.0
             d.rate_scale, d.input_range = p["rate_scale"], self.input_range
         lti = None if model.dynamics_before else lti_coefficients(model)
         if lti is not None:
@@ -469,7 +470,8 @@ def state_labels(model) -> list[str]:
     nbuf = int(math.floor(d.delay)) + 2 if d.delay > 0 else 0
     rate = []
     if d.rate_w:
-        rate = ["rho_f"] + (signal_labels("m", n) if d.rate_family == 0 else [])
+        rate = (["rho_f"] + signal_labels("m", n) if d.rate_family == 0 else
+                ["rate"] + signal_labels("zs", n) if d.rate_family == 2 else ["rho_f"])
     return (["started", "v_prev", "t_start", "head"] + signal_labels("z", n)
             + rate + signal_labels("L", d.m)
             + signal_labels("s", d.order) + signal_labels("e", 2 * (d.ne + 1) if d.ne else 0)
@@ -624,7 +626,8 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
     if "rate_w" in k:
         out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
                     "rate_family": int(d.rate_family), "rate_tau": d.rate_tau,
-                    "rate_saturation": d.rate_saturation})
+                    "rate_saturation": d.rate_saturation,
+                    **({"rate_growth": d.rate_growth} if d.rate_family == 2 else {})})
     if d.order:
         out.update({"lti_order": int(d.order), **arr("lti_b", k["b"]), **arr("lti_a", k["a"])})
     if d.ne:

@@ -1,5 +1,6 @@
 """The ``rate`` candidate: hysteresis whose play radii or weights depend on a low-passed input
-rate, to first order, as columns that are linear in their gains.
+rate, to first order as columns that are linear in their gains, or exactly as plays whose
+radii scale with the rate (the ``"scaled"`` shape, below).
 
 A rate-dependent PI model (as :class:`pimodel.operators.rate_dependent.RateDependentPI`,
 generalised) has radii ``r_i (1 + a_b rho_f[k])`` or weights ``w_i (1 + c_b rho_f[k])`` for the
@@ -38,6 +39,27 @@ among them); then ``S`` by the steps ``RATE_SATURATION_REFINE`` and
 ``tau`` by the finest of ``RATE_TAU_REFINE``, both tried in each of up to ``RATE_POLISH_ROUNDS``
 rounds while the train residual falls (the two trade against each other: a longer filter
 lowers the peaks the saturation bounds).
+
+The first-order form follows each nominal play's contact; when the radii grow by tens of
+percent a play whose radius grew meets its boundary later than the nominal play does, and the
+columns cannot follow (measured on ``pimodel.stages.density_stage``, radii growing by 30-60 %:
+seed 0 leaves 8.3 noise floors with the stage's own filter and ``S``). The exact shape,
+family ``SCALED`` (``"scaled"``), runs the plays themselves with radii scaled per sample,
+
+    ``rho_i[k] = r_i (1 + g(s[k]))``, ``g(s) = G s / (1 + s / S)`` (``S`` None: ``G s``),
+    ``s[k] = a s[k-1] + (1 - a) |v[k-1] - v[k-2]| / dt / rate_scale``, ``a = exp(-dt / tau)``,
+
+strictly causal (``s[k]`` from ``v[..k-1]``: the radii of sample ``k`` are fixed before
+``v[k]``, as in :mod:`pimodel.operators.rate_dependent`, whose C core runs them,
+:func:`scaled_plays`). The weights are fitted by least squares on these plays in place of the
+nominal ones (the hysteresis is ``sum_i w_i zs_i``; as an effect term beside the plays, the
+model's ``sum_i g_b w_i (zs_i - z_i)`` with one gain ``g = 1``). ``G``, ``S`` and
+``tau > 0`` are nonlinear: a grid (``RATE_GROWTHS`` times half, once and twice the
+first-order form's ``S``, at its filter), then the three together by a Nelder-Mead polish in
+their logarithms (at most ``RATE_SCALED_EVALS`` fits; ``G`` and ``S`` trade along a valley).
+The shape is offered beside the first-order one and chosen by validate BIC
+(:func:`rate_shapes`), not with dynamics or a delay (their columns filter or shift the
+nominal plays).
 """
 
 from __future__ import annotations
@@ -45,6 +67,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
+from .. import _native
 from ..operators.pi import PIOperator
 from .chunked import chunks
 
@@ -57,23 +80,36 @@ STEP_SHARE = 0.05  # without a filter, a one-sample jump above this share of the
 RATE_SATURATIONS = (None, 4.0, 2.0, 1.0, 0.5)  # S [-]: rho_f / (1 + rho_f / S), None: linear
 RATE_SATURATION_REFINE = 2**0.25  # then steps of S (1/4 octave) and of the filter (1/8 decade)
 RATE_POLISH_ROUNDS = 4  # ... in turn, while the train residual falls
+SCALED = "scaled"  # the exact shape: plays whose radii scale with the rate (module docstring)
+FAMILY_CODES = (*RATE_FAMILIES, SCALED)  # rate_family of the C core (pim_diagnosed.h): 0, 1, 2
+RATE_GROWTHS = (0.1, 0.2, 0.4, 0.8, 1.6)  # G [-] of the scaled shape's grid
+RATE_GROWTH_REFINE = 2**0.25  # then G, S and the filter polished (first steps: 1/4 octave)
+RATE_SCALED_EVALS = 60  # ... by at most this many fits (Nelder-Mead in log G, log S, log tau)
 
 __all__ = [
+    "FAMILY_CODES",
     "RATE_BANDS",
     "RATE_FAMILIES",
+    "RATE_GROWTHS",
+    "RATE_GROWTH_REFINE",
     "RATE_POLISH_ROUNDS",
     "RATE_SATURATIONS",
+    "RATE_SCALED_EVALS",
     "RATE_SATURATION_REFINE",
     "RATE_TAUS",
     "RATE_TAU_REFINE",
     "RateBasis",
+    "SCALED",
     "filtered_rate",
     "input_rate",
     "play_bands",
     "rate_columns",
+    "rate_growth",
     "rate_params",
     "rate_saturation",
+    "rate_shapes",
     "saturated_rate",
+    "scaled_plays",
 ]
 
 
@@ -239,6 +275,9 @@ class RateBasis:
         With ``Z`` None: the plays at rest at ``v[0]`` before the first sample (the
         nominal's start, :func:`~pimodel.diagnosis.effects.make_segment`); False (default):
         at 0.
+    projection : numpy.ndarray or None
+        ``V`` (n, q) when the fits' play columns are ``Z V`` (the diagnosis' compression):
+        :meth:`scaled_rows` are then projected the same way; None: the plays as they are.
 
     Examples
     --------
@@ -253,8 +292,9 @@ class RateBasis:
 
     def __init__(self, Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
                  weights, bands: int = RATE_BANDS, *, input_range: float | None = None,
-                 at_rest: bool = False):
+                 at_rest: bool = False, projection: np.ndarray | None = None):
         self.Z, self.radii, self.at_rest = Z, np.asarray(radii, float), at_rest
+        self.projection = projection
         self.v, self.dt, self.rate_scale, self.input_range = v, dt, rate_scale, input_range
         self.bands = play_bands(self.radii.size, bands)
         self.weights = np.asarray(weights, float)
@@ -319,14 +359,7 @@ class RateBasis:
         if key not in self._cache:
             rho = saturated_rate(self.rate(key[0]), saturation)
             if family == "weight":
-                if self._weighted is None:
-                    member = np.zeros((self.radii.size, len(self.bands)))
-                    for b, g in enumerate(self.bands):
-                        member[g, b] = self.weights[g]
-                    self._weighted = np.empty((self.v.size, member.shape[1]))
-                    for c, Zc in self._play_chunks():
-                        self._weighted[c] = Zc @ member
-                cols = rho[:, None] * self._weighted
+                cols = rho[:, None] * self._band_sums()
             else:
                 cols = self._radius_columns(rho)
             self._cache.clear()  # the latest only: a search asks for each filter once
@@ -347,6 +380,49 @@ class RateBasis:
         """
         self._cache.clear()
         self._weighted = None
+
+    def _band_sums(self) -> np.ndarray:
+        """Band sums ``sum_{i in b} w0_i z_i[k]`` of the nominal plays (built on first use)."""
+        if self._weighted is None:
+            member = np.zeros((self.radii.size, len(self.bands)))
+            for b, g in enumerate(self.bands):
+                member[g, b] = self.weights[g]
+            self._weighted = np.empty((self.v.size, member.shape[1]))
+            for c, Zc in self._play_chunks():
+                self._weighted[c] = Zc @ member
+        return self._weighted
+
+    def scaled_rows(self, tau: float, saturation: float | None, growth: float) -> np.ndarray:
+        """The plays of the exact shape as rows (:func:`scaled_plays`, at rest as the nominal's
+        plays; memoised, the latest only).
+
+        Parameters
+        ----------
+        tau, saturation, growth : float
+            The filter [s] (> 0), ``S`` (or None) and ``G``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, N), or (q, N) with a ``projection``; C-contiguous.
+
+        Examples
+        --------
+        >>> v = np.r_[np.linspace(0.0, 1.0, 11), np.full(3, 1.0)]
+        >>> basis = RateBasis(None, [0.0, 0.2], v, 1.0, 0.1, [1.0, 1.0], at_rest=True)
+        >>> basis.scaled_rows(1e-9, None, 0.5)[:, 10].round(6).tolist()  # radius 0.2 -> 0.3
+        [1.0, 0.7]
+        """
+        key = ("scaled", float(tau), saturation, float(growth))
+        if key not in self._cache:
+            z0 = float(self.v[0]) if self.at_rest else 0.0
+            Zs = scaled_plays(self.v, self.radii, self.dt, self.rate_scale, tau, saturation,
+                              growth, z0)
+            rows = np.ascontiguousarray((Zs if self.projection is None else
+                                         Zs @ self.projection).T)
+            self._cache.clear()
+            self._cache[key] = rows
+        return self._cache[key]
 
     def _play_chunks(self):
         """``(slice, Z[slice])`` over the record, the plays computed chunk by chunk (their
@@ -385,6 +461,73 @@ class RateBasis:
             out[c] = np.add.reduceat(per_play, self._starts, axis=1)
             last_prev, signed_prev = last[-1], signed[-1]
         return out
+
+
+def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
+                 saturation: float | None, growth: float, z0: float = 0.0) -> np.ndarray:
+    """Outputs ``zs_i[k]`` of plays whose radii scale with the rate (the exact shape).
+
+    ``zs_i[k] = min(max(zs_i[k-1], v[k] - rho_i[k]), v[k] + rho_i[k])``, ``zs_i[-1] = z0``,
+    ``rho_i[k] = r_i (1 + G s[k] / (1 + s[k] / S))``, ``s[k]`` the strictly causal filtered
+    rate of the module docstring (``s[0] = s[1] = 0``); run by the C core
+    (``pim_rdpi_sat_run``, as :mod:`pimodel.operators.rate_dependent`), one play at a time.
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        Input ``v[k]``.
+    radii : array_like
+        Play radii ``r_i`` [input units].
+    dt : float
+        Sample time [s].
+    rate_scale : float
+        Input rate [input units / s] that makes ``s = 1``.
+    tau : float
+        Time constant of the rate's low-pass [s], ``> 0``.
+    saturation : float or None
+        ``S`` [-] (None: ``g = G s``).
+    growth : float
+        ``G`` [-].
+    z0 : float
+        Play states before ``v[0]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N, n); row ``k`` depends on ``v[0..k]``.
+
+    Raises
+    ------
+    ValueError
+        ``tau`` not finite and > 0, ``rate_scale`` not > 0, ``saturation`` not None or > 0,
+        ``growth`` not finite.
+
+    Examples
+    --------
+    >>> v = np.r_[np.linspace(0.0, 1.0, 11), np.full(3, 1.0)]  # a ramp at 0.1/s, then a hold
+    >>> zs = scaled_plays(v, [0.2], 1.0, 0.1, 1e-9, None, 0.5)
+    >>> round(float(v[10] - zs[10, 0]), 6)  # the radius grew by G s = 0.5 at the rate 1
+    0.3
+    """
+    if not (np.isfinite(tau) and tau > 0):
+        raise ValueError(f"tau: the {SCALED!r} family needs a finite time constant > 0 [s], "
+                         f"got {tau!r}")
+    if not rate_scale > 0:
+        raise ValueError(f"rate_scale: expected > 0, got {rate_scale!r}")
+    if not np.isfinite(growth):
+        raise ValueError(f"growth: expected a finite G, got {growth!r}")
+    saturated_rate(np.zeros(1), saturation)  # checks S
+    v = np.ascontiguousarray(v, float)
+    r = np.asarray(radii, float)
+    lam = float(np.exp(-dt / tau))
+    sat = 0.0 if saturation is None else saturation * rate_scale
+    out = np.empty((v.size, r.size))
+    one = np.ones(1)
+    for i in range(r.size):
+        z, hist = np.full(1, z0), np.array([v[0], 0.0])
+        out[:, i] = _native.rdpi_sat_run(one, r[i:i + 1].copy(), growth / rate_scale, sat, lam,
+                                         dt, z, hist, v)
+    return out
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,
@@ -466,9 +609,9 @@ def rate_params(p: dict) -> tuple[np.ndarray, str, float]:
     missing = [k for k in ("rate_gains", "rate_family", "rate_time_constant_s") if k not in p]
     if missing:
         raise ValueError(f"params: the rate effect needs {missing}")
-    if p["rate_family"] not in RATE_FAMILIES:
-        raise ValueError(f"params: rate_family expected one of {RATE_FAMILIES}, got "
-                         f"{p['rate_family']!r}")
+    if p["rate_family"] not in (*RATE_FAMILIES, SCALED):
+        raise ValueError(f"params: rate_family expected one of {(*RATE_FAMILIES, SCALED)}, "
+                         f"got {p['rate_family']!r}")
     return (np.asarray(p["rate_gains"], float), str(p["rate_family"]),
             float(p["rate_time_constant_s"]))
 
@@ -503,3 +646,62 @@ def rate_saturation(p: dict) -> float | None:
         raise ValueError(f"params: rate_saturation expected None or a finite number > 0, got "
                          f"{s!r}")
     return float(s)
+
+
+def rate_growth(p: dict) -> float | None:
+    """The growth ``G`` of a model's ``"scaled"`` rate shape; None for the first-order families.
+
+    Parameters
+    ----------
+    p : dict
+        The model's ``params``.
+
+    Returns
+    -------
+    float or None
+
+    Raises
+    ------
+    ValueError
+        The ``"scaled"`` family without a finite ``rate_growth``.
+
+    Examples
+    --------
+    >>> rate_growth({"rate_family": "scaled", "rate_growth": 0.4})
+    0.4
+    """
+    if p.get("rate_family") != SCALED:
+        return None
+    g = p.get("rate_growth")
+    if not (isinstance(g, (int, float)) and np.isfinite(g)):
+        raise ValueError(f"params: rate_family 'scaled' needs a finite rate_growth, got {g!r}")
+    return float(g)
+
+
+def rate_shapes(effects, fixed: dict) -> list[dict]:
+    """The rate shapes a diagnosis scores on validate (by BIC) whenever ``effects`` hold a rate
+    not yet fitted: the first-order form and the exact one (``{"rate_shape": "scaled"}``);
+    ``[{}]`` without a rate, with its parameters held in ``fixed`` (from earlier rounds) or
+    beside dynamics or a delay.
+
+    Parameters
+    ----------
+    effects : tuple of str
+        The effects of the model being fitted.
+    fixed : dict
+        Grid parameters held from earlier rounds.
+
+    Returns
+    -------
+    list of dict
+
+    Examples
+    --------
+    >>> rate_shapes(("rate",), {})
+    [{}, {'rate_shape': 'scaled'}]
+    >>> rate_shapes(("creep", "rate"), {"rate_tau": 0.01}), rate_shapes(("creep",), {})
+    ([{}], [{}])
+    """
+    if "rate" not in effects or "rate_tau" in fixed or {"dynamics", "delay"} & set(effects):
+        return [{}]
+    return [{}, {"rate_shape": SCALED}]

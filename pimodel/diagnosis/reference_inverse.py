@@ -49,7 +49,15 @@ from ..blocks.framework import BlockSettings, signal_labels, stepped_block
 from .checks import block_dt
 from .lti import inverse_sos
 from .monotone import monotone_model
-from .rate import STEP_SHARE, play_bands, rate_params, rate_saturation, saturated_rate
+from .rate import (
+    SCALED,
+    STEP_SHARE,
+    play_bands,
+    rate_growth,
+    rate_params,
+    rate_saturation,
+    saturated_rate,
+)
 from .wiener import inverse_sections
 
 __all__ = ["StaticInverse", "feedforward_block", "inverse_block", "inverse_latency",
@@ -228,18 +236,24 @@ class StaticInverse:
             self.m = taus.size
         self.asym = "asymmetry" in e
         self.rate = "rate" in e
+        self.scaled = False
         if self.rate:
             gains, family, tau = rate_params(p)
+            self.scaled = family == SCALED  # the exact shape: no fresh rate, no source
             self.rg, self.rw = np.zeros(n), np.zeros(n)  # per play: g_b r_i or g_b w0_i
             for g, idx in zip(gains, play_bands(n, gains.size), strict=True):
                 if family == "radius":
                     self.rg[idx] = g * r[idx]
+                elif family == SCALED:  # the scaled plays carry the weights w
+                    self.rw[idx] = g * self.w[idx]
                 else:
                     self.rw[idx] = g * self.w0[idx]
             self.step_size = STEP_SHARE * self.input_range
             self.tau = tau
             self.saturation = rate_saturation(p)
             self.a_rate = np.exp(-m.dt / tau) if tau > 0 else 0.0
+            self.growth = rate_growth(p)
+        if self.rate and not self.scaled:
             # the fresh rate's source: the inverse of the model without its rate term, in
             # lockstep (a low-passed rate counts every jump: no step rule)
             self.source = StaticInverse(replace(m, effects=tuple(x for x in e if x != "rate")),
@@ -253,7 +267,8 @@ class StaticInverse:
         self._memory = slice(self._rho_f + 1, self._rho_f + 1 + n)
         self._v0_prev = self._rho_f + 1 + n
         self._source = slice(self._v0_prev + 1, None)
-        self.size = self._rho_f + (2 + n + self.source.size if self.rate else 0)
+        self.size = self._rho_f + (0 if not self.rate else 1 + n if self.scaled else
+                                   2 + n + self.source.size)
 
     def labels(self) -> list[str]:
         """Names of the state values.
@@ -263,7 +278,9 @@ class StaticInverse:
         list of str
             ``started``, ``v_prev``, ``guess`` (the root rule's branch guess), ``z[1..n]``,
             ``L[1..m]`` (creep lags) and, with a rate effect, ``rho_f``, ``m[1..n]``,
-            ``v0_prev`` and ``source.*`` (the rate-free inverse that gives the fresh rate).
+            ``v0_prev`` and ``source.*`` (the rate-free inverse that gives the fresh rate);
+            the scaled family ``rate`` (its strictly causal rate [input unit / s]) and
+            ``zs[1..n]`` (its plays).
 
         Examples
         --------
@@ -271,8 +288,9 @@ class StaticInverse:
         >>> StaticInverse(DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3)).labels()
         ['started', 'v_prev', 'guess', 'z[1]', 'z[2]']
         """
-        rate = (["rho_f"] + signal_labels("m", self.n) + ["v0_prev"]
-                + [f"source.{s}" for s in self.source.labels()]) if self.rate else []
+        rate = [] if not self.rate else ["rate"] + signal_labels("zs", self.n) if self.scaled \
+            else (["rho_f"] + signal_labels("m", self.n) + ["v0_prev"]
+                  + [f"source.{s}" for s in self.source.labels()])
         return (["started", "v_prev", "guess"] + signal_labels("z", self.n)
                 + signal_labels("L", self.m) + rate)
 
@@ -309,8 +327,10 @@ class StaticInverse:
                 raise ValueError(f"z0: expected {self.n} finite play outputs, got shape "
                                  f"{z.shape}")
             x[self._z] = z
-            if self.rate:
+            if self.rate and not self.scaled:
                 x[self._source] = self.source.initial_state(z)
+        if self.scaled:  # the scaled plays start with the plays
+            x[self._memory] = x[self._z]
         return x
 
     def step(self, x: np.ndarray, yk: float) -> float:
@@ -343,7 +363,11 @@ class StaticInverse:
         rho_f = float(x[self._rho_f]) if self.rate else 0.0
         memory = x[self._memory].copy() if self.rate else None
         span = self.span
-        if self.rate:  # the fresh rate of sample k from the rate-free inverse v0 (not fed back)
+        if self.scaled:  # radii fixed by the rate of the samples before k (module .rate)
+            rs = r * (1.0 + self._growth_of(rho_f))
+            if first:  # at rest with the plays (as the model's first sample)
+                memory = z.copy()
+        elif self.rate:  # the fresh rate of sample k from the rate-free inverse v0 (not fed back)
             v0 = self.source.step(x[self._source], yk)  # advances the source's state in place
             dv0 = 0.0 if first else abs(v0 - x[self._v0_prev])
             fresh = dv0 / m.dt / p["rate_scale"] if dv0 <= self.source_step else 0.0
@@ -360,14 +384,18 @@ class StaticInverse:
             if self.asym:
                 u = (h0 - p["center"]) / p["half_range"]
                 y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
-            if self.rate and not first:  # the fresh rate (model module docstring)
+            if self.scaled:  # the scaled plays less the plays (model module docstring)
+                y = y + (np.clip(memory[None, :], vs[:, None] - rs, vs[:, None] + rs)
+                         - Zc) @ self.rw
+            elif self.rate and not first:  # the fresh rate (model module docstring)
                 gap = vs[:, None] - Zc
                 touch = (r > 0) & (np.abs(gap) >= r * (1 - 1e-9))
                 y = y + np.where(touch, -np.sign(gap) * rho_k, memory) @ self.rg \
                     + rho_k * (Zc @ self.rw)
             return y
 
-        b = np.concatenate((z - r, z + r, [v_prev]))
+        b = np.concatenate((z - r, z + r, [v_prev]) +
+                           ((memory - rs, memory + rs) if self.scaled else ()))
         b = np.unique(np.concatenate((b, [b.min() - 10 * span, b.max() + 10 * span])))
         roots = _roots(F, b, yk, cubic=self.asym)
         gb = np.abs(F(b) - yk)
@@ -380,7 +408,11 @@ class StaticInverse:
         h = float(z_new @ w0 + m.reference_offset)
         if self.creep:
             lags = h + 0 * lags if first else self.a_lag * lags + (1 - self.a_lag) * h
-        if self.rate and not first:
+        if self.scaled:
+            memory = np.clip(memory, vk - rs, vk + rs)
+            rho_f = self.a_rate * rho_f + (1 - self.a_rate) * (0.0 if first else
+                                                               abs(vk - v_prev) / m.dt)
+        elif self.rate and not first:
             dv = abs(vk - v_prev)
             rho = dv / m.dt / p["rate_scale"] if dv <= self.step_size or self.tau > 0 else 0.0
             rho = min(rho, RATE_FEEDBACK_CAP * fresh)  # (module docstring of .model)
@@ -397,6 +429,13 @@ class StaticInverse:
             x[self._rho_f] = rho_f
             x[self._memory] = memory
         return vk
+
+    def _growth_of(self, rate: float) -> float:
+        """``g`` of the scaled family at the rate ``rate`` [input unit / s] (as the C core's
+        ``pim_rdpi_sat_run``: ``beta rate / (1 + rate / sat)``)."""
+        beta, s = self.growth / self.model.params["rate_scale"], self.saturation
+        sat = 0.0 if s is None else s * self.model.params["rate_scale"]
+        return beta * rate / (1.0 + rate / sat) if sat > 0 else beta * rate
 
 
 def _sections_step(sos: np.ndarray, s: np.ndarray, u: float) -> float:

@@ -282,13 +282,17 @@ MODELS: dict[str, dict] = {
                      "input rate [input unit / s] of rho = 1 (> 0)"),
                  Var("rate_family", 63, "Integer", "parameter", "0",
                      "rate family: 0 radius (terms held from each play's last contact), "
-                     "1 weight (rho_f times the band's sum of w0 z)"),
+                     "1 weight (rho_f times the band's sum of w0 z), 2 scaled (plays whose "
+                     "radii scale with the rate, minus the plays)"),
                  Var("rate_tau", 64, "Real", "parameter", "0",
                      "low-pass time constant of the normalised input rate [s] (>= 0; "
                      "0: none, with the step rule)"),
                  Var("rate_saturation", 76, "Real", "parameter", "0",
                      "saturation S of the filtered normalised rate rho_f: the terms follow "
                      "rho_f / (1 + rho_f / S), rho_f >= 0 (S >= 0; 0: linear in rho_f)"),
+                 Var("rate_growth", 77, "Real", "parameter", "0",
+                     "growth G of the scaled family (rate_family 2): plays of radii r (1 + G s "
+                     "/ (1 + s / S)), s the strictly causal filtered normalised rate"),
                  Var("input_range", 58, "Real", "parameter", "1",
                      "input range of the step rule (rate_tau = 0): a jump above 5 % of it "
                      "has no rate (> 0)"),
@@ -357,8 +361,8 @@ MODELS: dict[str, dict] = {
 _INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset", "n_lags",
                    "creep_gain", "creep_tau", "asymmetry_quadratic", "asymmetry_cubic",
                    "center", "half_range", "rate_band_gain", "rate_scale", "rate_family",
-                   "rate_tau", "rate_saturation", "input_range", "p_hi", "r_hi", "w0_hi",
-                   "rate_band_gain_hi"}
+                   "rate_tau", "rate_saturation", "rate_growth", "input_range", "p_hi", "r_hi",
+                   "w0_hi", "rate_band_gain_hi"}
 MODELS["DiagnosedInverse"] = {
     "id": 9,
     "description": "The causal feedforward of a diagnosed model: the prefilter (the dynamics' "

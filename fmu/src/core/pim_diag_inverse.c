@@ -5,7 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define DINV_NB_MAX (2 * PIM_DINV_MAX_PLAYS + 3) /* breakpoints: z - r, z + r, v_prev, 2 ends */
+#define DINV_NB_MAX (4 * PIM_DINV_MAX_PLAYS + 3) /* breakpoints: z -+ r, zs -+ rs (scaled rate),
+                                                   v_prev, 2 ends */
 #define DINV_BISECT 200                          /* bisection steps (a double halves ~1100) */
 
 static inline double dinv_clamp(double z, double lo, double hi)
@@ -28,6 +29,7 @@ static inline double dinv_saturate(const pim_dinv *d, double rho)
 size_t pim_dinv_solver_size(const pim_dinv *d, int rate)
 {
     const size_t base = 3 + d->n + d->m;
+    if (rate && d->rate_family == PIM_DIAG_RATE_SCALED) return base + 1 + d->n; /* s, zs */
     return rate ? base + 2 + d->n + base : base;
 }
 
@@ -108,8 +110,12 @@ const char *pim_dinv_check(const pim_dinv *d)
         if (!finite_all(d->rate_w, d->n)) return "a rate band gain is not finite";
         if (!(isfinite(d->rate_scale) && d->rate_scale > 0.0))
             return "rate_scale must be finite and > 0";
-        if (d->rate_family != PIM_DIAG_RATE_RADIUS && d->rate_family != PIM_DIAG_RATE_WEIGHT)
-            return "rate_family must be 0 (radius) or 1 (weight)";
+        if (d->rate_family != PIM_DIAG_RATE_RADIUS && d->rate_family != PIM_DIAG_RATE_WEIGHT &&
+            d->rate_family != PIM_DIAG_RATE_SCALED)
+            return "rate_family must be 0 (radius), 1 (weight) or 2 (scaled)";
+        if (d->rate_family == PIM_DIAG_RATE_SCALED &&
+            !(isfinite(d->rate_tau) && d->rate_tau > 0.0 && isfinite(d->rate_growth)))
+            return "the scaled rate family needs rate_tau > 0 s and a finite rate_growth";
         if (!(isfinite(d->rate_tau) && d->rate_tau >= 0.0))
             return "rate_tau must be finite and >= 0 s";
         if (!(isfinite(d->rate_saturation) && d->rate_saturation >= 0.0))
@@ -146,7 +152,9 @@ void pim_dinv_initial_state(const pim_dinv *d, double *x, const double *z0)
     if (!z0) return;
     double *solver = x + PIM_DINV_HEAD + 2 * (d->ns + d->npost);
     for (size_t i = 0; i < n; ++i) solver[3 + i] = z0[i];
-    if (d->rate_w) {
+    if (d->rate_w && d->rate_family == PIM_DIAG_RATE_SCALED) {
+        for (size_t i = 0; i < n; ++i) solver[3 + n + d->m + 1 + i] = z0[i]; /* zs */
+    } else if (d->rate_w) {
         double *source = solver + pim_dinv_solver_size(d, 0) + 2 + n;
         for (size_t i = 0; i < n; ++i) source[3 + i] = z0[i];
     }
@@ -159,6 +167,7 @@ typedef struct {
     double lag_acc, lag_sum; /* sum g_j a_j L_j, sum g_j a_j */
     double rho_k;
     int first, rate;
+    const double *zs, *rs; /* the scaled family's plays and radii at sample k (else NULL) */
 } dinv_ctx;
 
 static double dinv_F(const dinv_ctx *c, double v)
@@ -170,7 +179,10 @@ static double dinv_F(const dinv_ctx *c, double v)
         const double r = d->r[i], zc = dinv_clamp(c->z[i], v - r, v + r);
         y += d->w[i] * zc;
         h0 += d->w0[i] * zc;
-        if (rate && radius) {
+        if (c->zs) {
+            const double zsc = dinv_clamp(c->zs[i], v - c->rs[i], v + c->rs[i]);
+            rad += (zsc - zc) * (d->rate_w[i] * d->w[i]);
+        } else if (rate && radius) {
             const double gap = v - zc;
             const int touch = r > 0.0 && fabs(gap) >= r * (1.0 - 1e-9);
             rad += (touch ? -dinv_sign(gap) * c->rho_k : c->mem[i]) * (d->rate_w[i] * r);
@@ -185,7 +197,7 @@ static double dinv_F(const dinv_ctx *c, double v)
         const double u = (h0 - d->center) / d->half;
         y += d->q * (u * u) + d->c3 * (u * u * u);
     }
-    if (rate) y += rad + c->rho_k * wgt;
+    if (rate || c->zs) y += rad + c->rho_k * wgt;
     return y;
 }
 
@@ -294,9 +306,20 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
                              1.0);
     const double a_rate = rate && d->rate_tau > 0.0 ? exp(-d->dt / d->rate_tau) : 0.0;
     const double step_size = PIM_DIAG_STEP_SHARE * d->input_range;
-    dinv_ctx c = {d, z, rate ? mem : NULL, 0.0, 0.0, 0.0, first, rate};
+    const int scaled = rate && d->rate_family == PIM_DIAG_RATE_SCALED;
+    double rs[PIM_DINV_MAX_PLAYS];
+    dinv_ctx c = {d, z, rate ? mem : NULL, 0.0, 0.0, 0.0, first, rate && !scaled, NULL, NULL};
     double fresh = 0.0;
-    if (rate) { /* the fresh rate of sample k from the rate-free inverse v0 */
+    if (scaled) { /* radii fixed by the rate before sample k (pim_rdpi_sat_run's) */
+        const double beta = d->rate_growth / d->rate_scale, sat = d->rate_saturation * d->rate_scale;
+        const double g = sat > 0.0 ? beta * *rho_f / (1.0 + *rho_f / sat) : beta * *rho_f;
+        for (size_t i = 0; i < n; ++i) {
+            rs[i] = d->r[i] + d->r[i] * g;
+            if (first) mem[i] = z[i]; /* the scaled plays at rest with the plays */
+        }
+        c.zs = mem;
+        c.rs = rs;
+    } else if (rate) { /* the fresh rate of sample k from the rate-free inverse v0 */
         const double v0 = dinv_solve(d, source, yk, 0);
         const double dv0 = first ? 0.0 : fabs(v0 - *v0_prev);
         fresh = d->rate_tau > 0.0 || dv0 <= step_size ? dv0 / d->dt / d->rate_scale : 0.0;
@@ -313,6 +336,10 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
     size_t nb = 0;
     for (size_t i = 0; i < n; ++i) b[nb++] = z[i] - d->r[i];
     for (size_t i = 0; i < n; ++i) b[nb++] = z[i] + d->r[i];
+    for (size_t i = 0; scaled && i < n; ++i) {
+        b[nb++] = mem[i] - rs[i];
+        b[nb++] = mem[i] + rs[i];
+    }
     b[nb++] = v_prev;
     qsort(b, nb, sizeof b[0], dinv_cmp);
     {
@@ -400,7 +427,10 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
     h += d->c0;
     for (size_t j = 0; j < m; ++j)
         lags[j] = first ? h : d->lag_a[j] * lags[j] + (1.0 - d->lag_a[j]) * h;
-    if (rate && !first) {
+    if (scaled) {
+        for (size_t i = 0; i < n; ++i) mem[i] = dinv_clamp(mem[i], vk - rs[i], vk + rs[i]);
+        *rho_f = a_rate * *rho_f + (1.0 - a_rate) * (first ? 0.0 : fabs(vk - v_prev) / d->dt);
+    } else if (rate && !first) {
         const double dv = fabs(vk - v_prev);
         double rho = dv <= step_size || d->rate_tau > 0.0 ? dv / d->dt / d->rate_scale : 0.0;
         if (rho > PIM_DINV_RATE_FEEDBACK_CAP * fresh) rho = PIM_DINV_RATE_FEEDBACK_CAP * fresh;

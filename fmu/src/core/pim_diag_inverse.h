@@ -30,7 +30,12 @@
  *            + sum_i g_i r_i (contact_i(v) ? -sign(v - Z_i) rho_k : m_i)   rate, radius family
  *            + rho_k sum_i g_i w0_i Z_i                                     rate, weight family
  *
- * (rate terms not on the first sample).  rho_k = a rho_f[k-1] + (1 - a) fresh[k] with fresh
+ *            + sum_i g_i w_i (clip(zs_i[k-1], v - rs_i, v + rs_i) - Z_i)    scaled family
+ *
+ * (rate terms not on the first sample; the scaled family's is 0 there, its plays zs starting
+ * with z).  The scaled family is exact: its radii rs_i = r_i (1 + g(s[k])) follow the rate of
+ * the samples before k (pim_diagnosed.h), so no fresh rate is needed; after the solve zs_i and
+ * s advance with v[k] as the model's.  rho_k = a rho_f[k-1] + (1 - a) fresh[k] with fresh
  * the rate of a nested rate-free inverse v0 run on the same ref (|v0[k] - v0[k-1]| / dt /
  * rate_scale, 0 for a jump above PIM_DIAG_STEP_SHARE input_range when rate_tau = 0), and rho_k
  * and the held terms' rate saturated as the model's (rate_saturation S > 0: rho / (1 + rho /
@@ -49,7 +54,8 @@
  * State (pim_dinv_state_size doubles): [started, seen, v_rest, f_prev, s[2 ns], g[2 npost],
  * solver]
  * with solver = [started, v_prev, guess, z[n], L[m]] and, with a rate effect, [rho_f, m[n],
- * v0_prev, source] where source is a rate-free solver's state (same layout, no rate).  The
+ * v0_prev, source] where source is a rate-free solver's state (same layout, no rate), or for
+ * the scaled family [s, zs[n]] (s in input unit / s).  The
  * layout is that of the Python stream's state (reference_inverse._InverseStream.labels).
  */
 #ifndef PIM_DIAG_INVERSE_H
@@ -80,9 +86,10 @@ typedef struct {
     double q, c3, center, half;
     const double *rate_w;  /* per play the gain of its band, or NULL: no rate term */
     double dt, rate_scale, input_range;
-    int rate_family;       /* PIM_DIAG_RATE_RADIUS or PIM_DIAG_RATE_WEIGHT */
+    int rate_family;       /* PIM_DIAG_RATE_RADIUS, _WEIGHT or _SCALED */
     double rate_tau;       /* low-pass time constant of the rate [s], >= 0 */
     double rate_saturation; /* S > 0: the rate enters as rho_f / (1 + rho_f / S); 0: linear */
+    double rate_growth;    /* G of the scaled family (pim_diagnosed.h) */
     double reference_range; /* >= 0: the root rule's scale (0: max(2 r_n, 1)) */
     size_t ns;             /* prefilter sections (0: none) */
     const double *sos;     /* ns rows of 6: b0 b1 b2 a0 a1 a2, a0 = 1 */
@@ -95,7 +102,8 @@ typedef struct {
 /* Length of the flat state (layout above). */
 PIM_API size_t pim_dinv_state_size(const pim_dinv *d);
 
-/* Length of the solver's part (without the rate source when rate = 0). */
+/* Length of the solver's part (without the rate source when rate = 0; the scaled family has
+ * none). */
 PIM_API size_t pim_dinv_solver_size(const pim_dinv *d, int rate);
 
 /* NULL when the parameters are valid, else a static message naming the first bad one. */

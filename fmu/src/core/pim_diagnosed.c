@@ -1,6 +1,8 @@
 /* The diagnosed model streamed sample by sample; semantics and state layout in pim_diagnosed.h. */
 #include "pim_diagnosed.h"
 
+#include "pim_rate_dependent.h"
+
 #include <math.h>
 
 static inline double diag_clamp(double z, double lo, double hi)
@@ -17,7 +19,7 @@ size_t pim_diag_delay_length(double delay)
 size_t pim_diag_rate_size(const pim_diag *d)
 {
     if (!d->rate_w) return 0;
-    return d->rate_family == PIM_DIAG_RATE_RADIUS ? 1 + d->n : 1;
+    return d->rate_family == PIM_DIAG_RATE_WEIGHT ? 1 : 1 + d->n;
 }
 
 size_t pim_diag_state_size(const pim_diag *d)
@@ -38,6 +40,8 @@ void pim_diag_initial_state(const pim_diag *d, double *x, double z0)
     for (size_t j = 0; j < size; ++j) x[j] = 0.0;
     for (size_t i = 0; i < d->n; ++i) x[PIM_DIAG_HEADER + i] = z0;
     for (size_t i = 0; nf && i < d->n; ++i) x[size - nf + i] = z0; /* zf */
+    if (d->rate_w && d->rate_family == PIM_DIAG_RATE_SCALED) /* zs */
+        for (size_t i = 0; i < d->n; ++i) x[PIM_DIAG_HEADER + d->n + 1 + i] = z0;
 }
 
 size_t pim_diag_element_states(const pim_diag *d)
@@ -112,8 +116,12 @@ const char *pim_diag_check(const pim_diag *d)
         if (!all_finite(d->rate_w, d->n)) return "a rate band gain is not finite";
         if (!(isfinite(d->rate_scale) && d->rate_scale > 0.0))
             return "rate_scale must be finite and > 0";
-        if (d->rate_family != PIM_DIAG_RATE_RADIUS && d->rate_family != PIM_DIAG_RATE_WEIGHT)
-            return "rate_family must be 0 (radius) or 1 (weight)";
+        if (d->rate_family != PIM_DIAG_RATE_RADIUS && d->rate_family != PIM_DIAG_RATE_WEIGHT &&
+            d->rate_family != PIM_DIAG_RATE_SCALED)
+            return "rate_family must be 0 (radius), 1 (weight) or 2 (scaled)";
+        if (d->rate_family == PIM_DIAG_RATE_SCALED &&
+            !(isfinite(d->rate_tau) && d->rate_tau > 0.0 && isfinite(d->rate_growth)))
+            return "the scaled rate family needs rate_tau > 0 s and a finite rate_growth";
         if (!(isfinite(d->rate_tau) && d->rate_tau >= 0.0))
             return "rate_tau must be finite and >= 0 s";
         if (!(isfinite(d->rate_saturation) && d->rate_saturation >= 0.0))
@@ -167,15 +175,28 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
            *s = lag + d->m, *es = s + q, *buf = es + pim_diag_element_states(d),
            *zf = buf + nbuf, *fs = zf + n;
     const int radius = nr && d->rate_family == PIM_DIAG_RATE_RADIUS;
+    const int scaled = nr && d->rate_family == PIM_DIAG_RATE_SCALED;
     const int first = x[0] == 0.0;
     if (first) {
         x[1] = v;
         x[2] = t;
         for (size_t i = 0; d->plays_start && i < n; ++i) z[i] = v; /* at rest at v[0] */
+        for (size_t i = 0; scaled && d->plays_start && i < n; ++i) mem[i] = v; /* zs */
+    }
+    /* the scaled family: its plays, one step of pim_rdpi_sat_run (rate.scaled_play_sums) */
+    double scaled_term = 0.0;
+    if (scaled) {
+        double p[PIM_DIAG_MAX_PLAYS], hist[2] = {x[1], rate[0]}, ys = 0.0;
+        for (size_t i = 0; i < n; ++i) p[i] = d->rate_w[i] * d->w[i];
+        pim_rdpi_sat_run(1, n, p, d->r, d->rate_growth / d->rate_scale,
+                         d->rate_saturation * d->rate_scale, exp(-d->dt / d->rate_tau), d->dt,
+                         mem, hist, &v, &ys);
+        rate[0] = hist[1];
+        scaled_term = ys;
     }
     /* the filtered rate rho_f[k] (rate.input_rate) */
     double rho_f = 0.0;
-    if (nr) {
+    if (nr && !scaled) {
         double rho = 0.0;
         if (!first) {
             const double dv = fabs(v - x[1]);
@@ -206,6 +227,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         }
     }
     h0 += d->c0;
+    for (size_t i = 0; scaled && i < n; ++i) scaled_term -= d->rate_w[i] * (d->w[i] * z[i]);
     /* a prefilter (Wiener model): h from the plays zf of the filtered input x_f instead */
     if (d->nw) {
         const size_t m = PIM_DIAG_SECTION, o = PIM_DIAG_SECTION - 1;
@@ -264,6 +286,8 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         double acc = 0.0;
         for (size_t i = 0; i < n; ++i) acc += d->rate_w[i] * mem[i];
         y += acc;
+    } else if (scaled) {
+        y += scaled_term;
     } else if (nr) {
         double acc = 0.0;
         for (size_t i = 0; i < n; ++i) acc += d->rate_w[i] * (d->w0[i] * z[i]);

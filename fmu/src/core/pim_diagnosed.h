@@ -39,7 +39,12 @@
  * tau = rate_tau > 0: rho_f[k] = a rho_f[k-1] + (1 - a) rho[k], a = exp(-dt / tau), from
  * rho_f[-1] = 0; tau = 0: rho_f[k] = rho[k], or 0 when |v[k] - v[k-1]| > PIM_DIAG_STEP_SHARE *
  * input_range (a sampled step has no rate); rate_saturation S > 0: rho_f[k] in the terms below
- * is rho_f[k] / (1 + rho_f[k] / S) (the filter's state stays unsaturated).  Radius family: m_i[k] = -(v[k] - z_i[k]) rho_f[k]
+ * is rho_f[k] / (1 + rho_f[k] / S) (the filter's state stays unsaturated).  Scaled family
+ * (rate_family 2, the exact shape): plays zs_i of radii r_i (1 + G s[k] / (1 + s[k] / S))
+ * (S = 0: G s[k]), s[k] the strictly causal filtered rate of pim_rdpi_sat_run
+ * (pim_rate_dependent.h, normalised: s[k] = a s[k-1] + (1 - a) |v[k-1] - v[k-2]| / dt /
+ * rate_scale, rate_tau > 0), zs_i[-1] = z_i[-1], and the term sum_i g_i w_i (zs_i[k] -
+ * z_i[k]) (the weights w: the hysteresis is that of the scaled plays).  Radius family: m_i[k] = -(v[k] - z_i[k]) rho_f[k]
  * while play i (r_i > 0) is in contact (|v[k] - z_i[k]| >= r_i (1 - 1e-9)), else m_i[k-1]
  * (m_i = 0 before its first contact): the term held at the play's last contact.
  * A fractional delay part f <= 1e-12 counts as 0 (as pimodel.diagnosis.effects.shift).
@@ -49,7 +54,9 @@
  * e[n_e], buf[nbuf], zf[n_f], f[2 nw]] (e: two states per section M_1, E_1..E_ne, n_e =
  * 2 (ne + 1), or 0 when ne = 0; zf: the plays of the filtered input and f: two states per
  * prefilter section, n_f = n, both present only when nw > 0) with rate = [rho_f[k-1], m[n]]
- * (radius family), [rho_f[k-1]] (weight family) or none; all zero (except z and zf = the
+ * (radius family), [rho_f[k-1]] (weight family), [rate[k+1], zs[n]]
+ * (scaled family: the rate pim_rdpi_sat_run holds for the next sample, in input unit / s, and
+ * the scaled plays) or none; all zero (except z and zf = the
  * initial play states, pim_diag_initial_state) before the first sample.  `head` is the
  * ring position of x[k-1] in buf (nbuf = floor(d) + 2 when d > 0, else 0).  Units: v and r
  * in the input unit, y, c, c0, center, half in the output unit, t in s, s in output unit / s.
@@ -66,6 +73,7 @@ extern "C" {
 #define PIM_DIAG_STEP_SHARE 0.05     /* pimodel.diagnosis.rate.STEP_SHARE */
 #define PIM_DIAG_RATE_RADIUS 0       /* rate_family: radii growing with the rate */
 #define PIM_DIAG_RATE_WEIGHT 1       /* rate_family: weights growing with the rate */
+#define PIM_DIAG_RATE_SCALED 2       /* rate_family: plays whose radii scale (exact shape) */
 #define PIM_DIAG_HEADER 4            /* started, v_prev, t_start, head */
 #define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + 1 + PIM_DIAG_MAX_LAGS + \
                             PIM_DIAG_MAX_ORDER + 2 * (PIM_DIAG_MAX_ELEMENTS + 1) + \
@@ -85,9 +93,10 @@ typedef struct {
     double q, c3, center, half;
     const double *rate_w;  /* per play the gain g_i of its band, or NULL: no rate term */
     double dt, rate_scale, input_range;
-    int rate_family;       /* PIM_DIAG_RATE_RADIUS or PIM_DIAG_RATE_WEIGHT */
+    int rate_family;       /* PIM_DIAG_RATE_RADIUS, _WEIGHT or _SCALED */
     double rate_tau;       /* low-pass time constant of the rate [s], >= 0 (0: none) */
     double rate_saturation; /* S > 0: the rate enters as rho_f / (1 + rho_f / S); 0: linear */
+    double rate_growth;    /* G of the scaled family (radii r_i (1 + G s / (1 + s / S))) */
     size_t order;          /* LTI order (0: none) */
     const double *b, *a;   /* b[0..order], a[0..order], a[0] = 1 */
     double delay;          /* d >= 0 [samples] */
@@ -117,7 +126,7 @@ PIM_API size_t pim_diag_element_states(const pim_diag *d);
 /* Length of the prefilter's state: n + 2 nw (zf and the sections), or 0 when nw = 0. */
 PIM_API size_t pim_diag_prefilter_states(const pim_diag *d);
 
-/* Length of the rate state: 1 + n (radius family), 1 (weight family) or 0 (no rate). */
+/* Length of the rate state: 1 + n (radius or scaled family), 1 (weight family) or 0. */
 PIM_API size_t pim_diag_rate_size(const pim_diag *d);
 
 /* Delay line length for a delay of `delay` samples: floor(delay) + 2, or 0 for delay == 0. */
@@ -125,7 +134,8 @@ PIM_API size_t pim_diag_delay_length(double delay);
 
 /*
  * NULL when the parameters are valid (finite; radii sorted >= 0; where used: half > 0,
- * rate_scale > 0, rate_family 0 or 1, rate_tau >= 0, input_range > 0 when rate_tau = 0; lags
+ * rate_scale > 0, rate_family 0, 1 or 2, rate_tau >= 0 (> 0 and rate_growth finite for 2),
+ * input_range > 0 when rate_tau = 0; lags
  * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists, for the LTI and for each
  * section of the further elements and of the prefilter; ne, nw <= PIM_DIAG_MAX_ELEMENTS;
  * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2; settle_tau >= 0), else a static message naming the first bad one

@@ -27,10 +27,18 @@ static void rate_update(double *hist, double v, double lam, double Ts)
 void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
                   double lam, double Ts, double *z, double *hist, const double *v, double *y)
 {
+    pim_rdpi_sat_run(N, n, p, alpha, beta, 0.0, lam, Ts, z, hist, v, y);
+}
+
+void pim_rdpi_sat_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
+                      double sat, double lam, double Ts, double *z, double *hist,
+                      const double *v, double *y)
+{
     for (size_t k = 0; k < N; ++k) {
         double acc = 0.0;
+        const double g = sat > 0.0 ? beta * hist[1] / (1.0 + hist[1] / sat) : beta * hist[1];
         for (size_t i = 0; i < n; ++i) {
-            const double ri = alpha[i] + alpha[i] * beta * hist[1]; /* alpha_1 = 0 stays 0 */
+            const double ri = alpha[i] + alpha[i] * g; /* alpha_1 = 0 stays 0 */
             double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
             z[i] = zi > v[k] - ri ? zi : v[k] - ri;
             acc += p[i] * z[i];

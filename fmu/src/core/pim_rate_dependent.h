@@ -41,6 +41,16 @@ PIM_API void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alp
                           double lam, double Ts, double *z, double *hist, const double *v, double *y);
 
 /*
+ * Forward run with a saturating radius growth: r_i[k] = alpha_i (1 + beta rate[k] / (1 +
+ * rate[k] / sat)) (sat in input unit / s; sat <= 0: no saturation, pim_rdpi_run), the
+ * other semantics as above (rate[k] from v[..k-1] only).  The diagnosis' "scaled" rate
+ * shape (pimodel.diagnosis.rate) runs its bands of plays through it.
+ */
+PIM_API void pim_rdpi_sat_run(size_t N, size_t n, const double *p, const double *alpha,
+                              double beta, double sat, double lam, double Ts, double *z,
+                              double *hist, const double *v, double *y);
+
+/*
  * Exact inverse run: v[k] such that the forward operator with state (z, hist) outputs yd[k];
  * z and hist are the *forward* operator's state and are advanced with v[k].  Returns 0, or
  * -1 when n > PIM_MAX_PLAYS.

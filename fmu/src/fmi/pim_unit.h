@@ -617,10 +617,11 @@ static PIM_HOT_INLINE double *unit_main_real(pim_unit *u, unsigned vr, int set)
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 8u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+#define PIM_STATE_VERSION 9u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
                                 prefilter (Wiener); 5: DiagnosedInverse fields, post sections;
                                 6: the common part, then the unit's own fields; 7: n_plays;
-                                8: inv_Ts, t_tol (derived, recomputed on load) */
+                                8: inv_Ts, t_tol (derived, recomputed on load);
+                                9: rate_growth, the scaled rate family's state */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {

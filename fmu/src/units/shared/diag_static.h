@@ -112,9 +112,15 @@ static int unit_check_diag_static(pim_unit *u)
         return unit_error(u, "parameter half_range = %g: must be finite and > 0", u->half_range);
     if (!isfinite(u->rate_scale) || !(u->rate_scale > 0.0))
         return unit_error(u, "parameter rate_scale = %g: must be finite and > 0", u->rate_scale);
-    if (u->rate_family != PIM_DIAG_RATE_RADIUS && u->rate_family != PIM_DIAG_RATE_WEIGHT)
-        return unit_error(u, "parameter rate_family = %d out of range: 0 radius, 1 weight",
-                          u->rate_family);
+    if (u->rate_family != PIM_DIAG_RATE_RADIUS && u->rate_family != PIM_DIAG_RATE_WEIGHT &&
+        u->rate_family != PIM_DIAG_RATE_SCALED)
+        return unit_error(u, "parameter rate_family = %d out of range: 0 radius, 1 weight, "
+                             "2 scaled", u->rate_family);
+    if (!isfinite(u->rate_growth))
+        return unit_error(u, "parameter rate_growth = %g: must be finite", u->rate_growth);
+    if (u->rate_family == PIM_DIAG_RATE_SCALED && !(u->rate_tau > 0.0))
+        return unit_error(u, "parameter rate_tau = %g: the scaled rate family (rate_family 2) "
+                             "needs rate_tau > 0 s", u->rate_tau);
     if (!isfinite(u->rate_tau) || u->rate_tau < 0.0)
         return unit_error(u, "parameter rate_tau = %g: must be finite and >= 0 s",
                           u->rate_tau);
@@ -154,6 +160,7 @@ static int unit_check_diag_static(pim_unit *u)
         (d)->rate_family = (u)->rate_family;                                                    \
         (d)->rate_tau = (u)->rate_tau;                                                          \
         (d)->rate_saturation = (u)->rate_saturation;                                            \
+        (d)->rate_growth = (u)->rate_growth;                                                    \
     } while (0)
 
 #endif /* PIM_DIAG_STATIC_H */
