@@ -203,3 +203,20 @@ def test_a_mode_behind_a_real_pole_gets_a_low_pass_element():
     assert "lowpass" in kinds, m.params
     rms = float(np.sqrt(np.mean((m.predict(seg) - y) ** 2)))
     assert rms < 1.5 * noise, (rms, m.params)
+
+
+def test_nelder_mead_treats_a_broken_fit_as_inadmissible():
+    """A cost that raises LinAlgError or returns NaN at some points (a mode search that ran to
+    non-finite columns) does not stop the search: those points count as inf."""
+    from pimodel.diagnosis.lti import nelder_mead
+
+    def cost(x):
+        if x[0] < -1.0:
+            raise np.linalg.LinAlgError("SVD did not converge")
+        if x[0] > 4.0:
+            return float("nan")
+        return float((x[0] - 2.0) ** 2)
+
+    r = nelder_mead(cost, np.array([-0.9]), initial_simplex=[[-0.9], [-1.5]], xatol=1e-8,
+                    fatol=1e-12)
+    assert abs(float(r.x[0]) - 2.0) < 1e-4

@@ -93,7 +93,8 @@ def nelder_mead(cost: Callable, x0: np.ndarray, **options):
     Parameters
     ----------
     cost : callable
-        ``cost(x) -> float`` (``inf`` where ``x`` is not admissible).
+        ``cost(x) -> float`` (``inf`` where ``x`` is not admissible; a point where it
+        raises ``numpy.linalg.LinAlgError`` or returns NaN counts as ``inf``).
     x0 : numpy.ndarray
         Start point.
     **options
@@ -111,8 +112,15 @@ def nelder_mead(cost: Callable, x0: np.ndarray, **options):
     >>> round(float(r.x[0]), 4)
     2.0
     """
+    def guarded(x):  # a point whose fit breaks down (non-finite columns) is not admissible
+        try:
+            f = float(cost(x))
+        except np.linalg.LinAlgError:
+            return np.inf
+        return f if np.isfinite(f) else np.inf
+
     with np.errstate(invalid="ignore"):
-        return minimize(cost, x0, method="Nelder-Mead", options=options)
+        return minimize(guarded, x0, method="Nelder-Mead", options=options)
 
 def _kind(element) -> str:
     kind = element[0]
