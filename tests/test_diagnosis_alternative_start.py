@@ -1,8 +1,10 @@
 """The alternative starts of the diagnosis' rounds (:mod:`pimodel.diagnosis.diagnose`,
 ``ALT_STARTS``): when the greedy path leaves a gap unexplained, paths forced to start from the
-next candidates are tried. On a PI stage with creep and rate-dependent hysteresis, a broad lag
-(``dynamics``) wins the first round alone, and neither creep nor rate then passes beside it;
-the path from creep finds both. An effect outside the vocabulary stays ``unexplained``."""
+next candidates are tried. On a PI stage with creep and rate-dependent hysteresis a broad lag
+(``dynamics``) can win the first round alone; the verdict must still be creep and rate. (With
+the exact rate shape, measured on seeds 6 and 7, the greedy path itself now reaches creep and
+rate, so the other starts are a safeguard there.) An effect outside the vocabulary stays
+``unexplained``."""
 
 from __future__ import annotations
 
@@ -22,12 +24,11 @@ def _pi_stage_records(effects: list[str], seed: int):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [6, 7])
-def test_rate_and_creep_found_from_an_alternative_start(seed):
-    train, validate = _pi_stage_records(["rate", "creep"], seed)
+def test_rate_and_creep_found_when_a_broad_lag_wins_alone():
+    train, validate = _pi_stage_records(["rate", "creep"], 6)
     rep = diagnose(train, validate)
     alone = {c["effect"]: c["delta_bic"] for c in rep.candidates}
-    assert min(alone, key=alone.get) == "dynamics"  # the greedy path starts elsewhere
+    assert min(alone, key=alone.get) == "dynamics"  # the first round's winner is not the truth
     assert sorted(rep.verdict["effects"]) == ["creep", "rate"]
     assert rep.verdict["gap_after"] < 0.3 * rep.verdict["gap_before"]
 

@@ -267,7 +267,8 @@ class DiagnosedModel:
             counts as a step (no rate); default ``ptp(v)``, as the diagnosis.
         measured : array_like, optional
             The record's measured output: a drift with a level per record
-            (``drift_variant == "levels"``) takes the record's level from it out of fold, as
+            (``drift_variant`` ``"levels"`` or ``"settle_levels"``) takes the record's level
+            from it out of fold, as
             the diagnosis does on a validate record (:func:`.drift.drift_term`); without it,
             the level the drift's clock predicts. Ignored by other models.
 
