@@ -21,8 +21,10 @@
  *   model_saved, model_save(u, s), model_restore(u, s)   the states a step changes, for the
  *                              rollback of a step that overflows (once per doStep, not per sample)
  *   model_step_safe(u) *       1 when no sample at the held inputs can overflow (a bound from the
- *                              checked parameters, derived once): the step then runs without the
- *                              rollback copy and without the per-sample output checks
+ *                              checked parameters, derived once; 1 implies a finite main input):
+ *                              the step then runs without the rollback copy and without the
+ *                              per-sample output checks, a one-sample step on unit_one_sample's
+ *                              fast path
  *   model_step_done(u) *       after a step's samples (e.g. the RadiusEstimator's health output)
  *   model_check_states(u, s)   the states of a loaded FMU state s (parameters already checked)
  *   model_report(u, buf, size) * a report in words logged once at terminate (0: none)
@@ -489,7 +491,7 @@ PIM_NOINLINE static int unit_do_step_general(pim_unit *u, double t, double h)
  * rounding) at inputs that cannot overflow it (model_step_safe): t at the FMU's time within
  * u->t_tol and >= 0 (the general path's first test), t + h > t (so h > 0), the end in the
  * one-sample window (PIM_ONE_LO; so t + h, and h, are finite) and the inputs admissible
- * (unit_check_inputs, its first test inline so that this path calls nothing on its way).  The
+ * (unit_check_inputs: the main input is finite as model_step_safe implies).  The
  * general path would then take the same checks, find k1 = k_next + 1 and run its loop once:
  * this runs that sample and returns 1.  Any other step returns 0 with nothing changed, for
  * unit_do_step_general (which also gives a failing step's reason).
@@ -499,7 +501,7 @@ static PIM_HOT_INLINE int unit_one_sample(pim_unit *u, double t, double h)
     const double t_end = t + h, d = t_end * u->inv_Ts - (double)u->k_next;
     if (!(u->mode == PIM_STEP_MODE && fabs(t - u->time) <= u->t_tol && t >= 0.0 && t_end > t &&
           d >= PIM_ONE_LO && d <= PIM_ONE_HI && u->k_next <= PIM_ONE_KMAX &&
-          model_step_safe(u) && isfinite(u->in1) && model_check_inputs(u) == 0))
+          model_step_safe(u) && model_check_inputs(u) == 0))
         return 0;
     model_sample(u);
     ++u->k_next;
