@@ -6,12 +6,16 @@ sample (setReal + doStep + getReal) in the C host (issue 5: 50 ns). The C host r
 times; the medians of its wall-clock and CPU ns per sample are printed with the machine's load
 average (a loaded machine inflates the wall clock most, so the verdict is on CPU time), beside
 the same loop calling only the C core's ``pim_pi_step`` (the floor that no FMU glue can go
-below) and the ratio of the two. The Python loop shows what a Python master costs on top.
+below) and the ratio of the two. With valgrind installed it also prints both loops'
+instructions per sample (callgrind: the count of 2N samples minus that of N, so the set-up
+cancels), which a loaded machine does not change. The Python loop shows what a Python master
+costs on top.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
 import statistics
 import subprocess
 import tempfile
@@ -67,6 +71,23 @@ def _medians(cmd: list[str]) -> tuple[float, float]:
             statistics.median(float(r[1]) for r in runs))
 
 
+def _instructions(cmd: list[str], n_samples: int = 100_000) -> float | None:
+    """Instructions per sample of a program whose second-last argument is N (callgrind), or None
+    without valgrind."""
+    if shutil.which("valgrind") is None:
+        return None
+
+    def total(N: int) -> int:
+        run = [*cmd]
+        run[-2] = str(N)
+        out = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                              *run], capture_output=True, text=True, check=True).stderr
+        return int(next(line for line in out.splitlines() if "Collected" in line)
+                   .split()[-1])
+
+    return (total(2 * n_samples) - total(n_samples)) / n_samples
+
+
 def main() -> None:
     n = 10
     with tempfile.TemporaryDirectory() as tmp:
@@ -91,6 +112,9 @@ def main() -> None:
         ns_c, cpu_c = _medians([str(host), str(tmp / "binaries/linux64/PIHysteresis.so"),
                                 guid("PIHysteresis"), str(N), str(n)])
         ns_f, cpu_f = _medians([str(floor), str(N), str(n)])
+        ir_c = _instructions([str(host), str(tmp / "binaries/linux64/PIHysteresis.so"),
+                              guid("PIHysteresis"), str(N), str(n)])
+        ir_f = _instructions([str(floor), str(N), str(n)])
         start = {"Ts": 1e-4, "n": n, **{f"p[{i + 1}]": 1.0 / (i + 1) for i in range(n)},
                  **{f"r[{i + 1}]": 0.2 * i for i in range(n)}}
         unit = FMUUnit(fmu, start)
@@ -110,6 +134,9 @@ def main() -> None:
           f"{'met' if cpu_c < 20 else 'NOT met'}")
     print(f"the core's pim_pi_step alone in the same loop: {ns_f:.1f} ns wall, {cpu_f:.1f} ns "
           f"CPU (the FMU glue adds {cpu_c - cpu_f:.1f} ns CPU; FMU / core {cpu_c / cpu_f:.2f})")
+    if ir_c is not None and ir_f is not None:
+        print(f"instructions per sample (callgrind, with the host's loop): FMU {ir_c:.0f}, "
+              f"the core alone {ir_f:.0f}")
     print(f"fmpy FMU2Slave loop in Python: {M / t_py:,.0f} steps/s "
           f"({t_py / M * 1e6:.1f} us/step), {t_py / M * 1e9 / ns_c:.0f}x the C host")
 

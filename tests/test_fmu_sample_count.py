@@ -35,6 +35,9 @@ OFFSETS = [0.0, 1e-12, -1e-12, 3e-10, -3e-10, 4.9e-10, 5.1e-10, -5.1e-10, 9e-10,
 # and offsets of the rule's tolerance at the step's end times these factors, just inside and
 # outside it (beyond the fast count's margin, a relative 1e-6, and the resolution of t / Ts)
 TOL_FACTORS = [0.999, 0.99999, 1.00001, 1.001]
+# offsets of a one-sample step's end across the edges of doStep's one-sample fast path
+# (unit_one_sample: ends 1.02e-3 .. 1 + 4e-10 samples after the step's sample instant)
+WINDOW_OFFSETS = [-0.998985, -0.99898, -0.998975, 3.9e-10, 4e-10, 4.1e-10, -0.5, 0.0]
 
 
 def tolerance(x: float) -> float:
@@ -54,10 +57,11 @@ def fmu(tmp_path_factory):
     return path
 
 
-def run(fmu, ts: float, t0: float, seed: int) -> tuple[list, list, list, list]:
-    """Steps of 1-3 samples whose ends sit at OFFSETS samples or TOL_FACTORS tolerances
-    (shuffled) from a sample instant, with a random input held over each step; per step the
-    sample counter (from the serialized FMU state), the rule's count, the input and the
+def run(fmu, ts: float, t0: float, seed: int, offsets: list[float] = OFFSETS,
+        tol_factors: list[float] = TOL_FACTORS, most: int = 3) -> tuple[list, list, list, list]:
+    """Steps of 1 to `most` samples whose ends sit at `offsets` samples or `tol_factors`
+    tolerances (shuffled) from a sample instant, with a random input held over each step; per
+    step the sample counter (from the serialized FMU state), the rule's count, the input and the
     output."""
     md = read_model_description(fmu)
     refs = {v.name: v.valueReference for v in md.modelVariables}
@@ -75,10 +79,10 @@ def run(fmu, ts: float, t0: float, seed: int) -> tuple[list, list, list, list]:
         slave.setReal([refs[f"r[{i + 1}]"] for i in range(R.size)], list(R))
         slave.exitInitializationMode()
         t, k = t0, end_sample(t0, ts)
-        ends = [(x, False) for x in OFFSETS] + [(f, True) for f in TOL_FACTORS]
+        ends = [(x, False) for x in offsets] + [(f, True) for f in tol_factors]
         for i in rng.permutation(len(ends) * 6):
             x, of_tolerance = ends[i % len(ends)]
-            end = k + int(rng.integers(1, 4))  # k: the next sample
+            end = k + int(rng.integers(1, most + 1))  # k: the next sample
             h = (end + (x * tolerance(end) if of_tolerance else x)) * ts - t
             v = float(rng.uniform(-1.0, 1.0))
             slave.setReal([refs["v"]], [v])
@@ -105,6 +109,21 @@ def test_sample_count_is_the_rule(fmu, ts, t0):
     got, want, _, _ = run(fmu, ts, t0, seed=int(t0) + 7)
     assert got == want
     assert set(np.diff(want)) >= {1, 2, 3}  # steps of different sample counts
+
+
+@pytest.mark.parametrize("ts", [1e-4, 1 / 3000], ids=["1e-4 s", "1/3 ms"])
+@pytest.mark.parametrize("t0", [0.0, 123.4567, 1e4], ids=["t0=0", "x~1e6", "x~1e8"])
+def test_one_sample_steps_across_the_fast_path_edges_are_the_rule(fmu, ts, t0):
+    """One-sample steps whose ends straddle the edges of doStep's one-sample fast path count
+    as the rule (inside it the fast path, outside the general path), and their outputs are the
+    PI operator's on the held inputs."""
+    got, want, inputs, outputs = run(fmu, ts, t0, seed=11, offsets=WINDOW_OFFSETS,
+                                     tol_factors=[], most=1)
+    assert got == want
+    assert set(np.diff(want)) == {1}
+    k = end_sample(t0, ts)
+    y = PIOperator(P, R).simulate(np.repeat(inputs, np.diff([k, *got])))
+    np.testing.assert_allclose(outputs, y[np.array(got) - k - 1], rtol=0, atol=1e-12)
 
 
 def test_outputs_follow_the_held_inputs_without_a_shifted_sample(fmu):

@@ -290,11 +290,17 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     return fail((Inst *)c, "output derivatives are not provided");
 }
 
+/* doStep's general path, out of line so that the one-sample fast path needs no stack frame. */
+PIM_NOINLINE static fmi2Status do_step_general(Inst *c, fmi2Real t, fmi2Real h)
+{
+    return status(c, unit_do_step_general(&c->u, t, h));
+}
+
 fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior)
 {
     INST(comp);
     (void)noSetPrior;
-    return status(c, unit_do_step(&c->u, t, h));
+    return unit_one_sample(&c->u, t, h) ? fmi2OK : do_step_general(c, t, h);
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)

@@ -21,8 +21,10 @@
  *   model_saved, model_save(u, s), model_restore(u, s)   the states a step changes, for the
  *                              rollback of a step that overflows (once per doStep, not per sample)
  *   model_step_safe(u) *       1 when no sample at the held inputs can overflow (a bound from the
- *                              checked parameters, derived once): the step then runs without the
- *                              rollback copy and without the per-sample output checks
+ *                              checked parameters, derived once; 1 implies a finite main input):
+ *                              the step then runs without the rollback copy and without the
+ *                              per-sample output checks, a one-sample step on unit_one_sample's
+ *                              fast path
  *   model_step_done(u) *       after a step's samples (e.g. the RadiusEstimator's health output)
  *   model_check_states(u, s)   the states of a loaded FMU state s (parameters already checked)
  *   model_report(u, buf, size) * a report in words logged once at terminate (0: none)
@@ -417,10 +419,20 @@ static int unit_samples_checked(pim_unit *u, int64_t k1)
     return 0;
 }
 
-/* doStep(t, h): processes the samples k*Ts in [t, t+h) (the sampling rule above).  The usual
- * step takes a few comparisons: t at the FMU's time within u->t_tol, h finite and > 0, the end
- * sample from unit_end_sample's fast path; the other cases get the full checks. */
-static int unit_do_step(pim_unit *u, double t, double h)
+/* Error paths out of line, so that the accessors and doStep stay small (they run every sample). */
+#if defined(__GNUC__)
+#define PIM_COLD __attribute__((noinline, cold))
+#define PIM_NOINLINE __attribute__((noinline))
+#define PIM_HOT_INLINE __attribute__((always_inline)) inline
+#else
+#define PIM_COLD
+#define PIM_NOINLINE
+#define PIM_HOT_INLINE inline
+#endif
+
+/* doStep(t, h) in general (unit_do_step): processes the samples k*Ts in [t, t+h) (the sampling
+ * rule above), with every check. */
+PIM_NOINLINE static int unit_do_step_general(pim_unit *u, double t, double h)
 {
     if (u->mode != PIM_STEP_MODE) return unit_require_mode(u, PIM_IN(PIM_STEP_MODE), "doStep");
     if (!(h > 0.0 && h <= DBL_MAX))
@@ -461,6 +473,47 @@ static int unit_do_step(pim_unit *u, double t, double h)
     }
     u->time = t_end;
     return 0;
+}
+
+/* The one-sample window of unit_do_step: a step ending at x = t_end / Ts samples (x as
+ * unit_end_sample computes it) with x - k_next in [PIM_ONE_LO, PIM_ONE_HI] ends at sample
+ * k_next + 1, so it processes exactly sample k_next.  Proof: x - k_next is within 2^-52 of
+ * its exact value (|x - k_next| <= 2), so either x >= k_next + 1 with x - (k_next + 1) <= 0.4e-9
+ * + 2^-52 < 0.5 PIM_SAMPLE_TOL (unit_end_sample's first case: k_next + 1), or x < k_next + 1
+ * with x - k_next >= 1.02e-3 - 2^-52 >= 1.01e-3 (its second case: k_next + 1); for
+ * k_next <= PIM_ONE_KMAX, x < 2^32 as those cases need. */
+#define PIM_ONE_LO 1.02e-3
+#define PIM_ONE_HI (1.0 + 0.4 * PIM_SAMPLE_TOL)
+#define PIM_ONE_KMAX 4294967294LL
+
+/*
+ * The fast path of doStep(t, h) for the usual step, one sample on the FMU's grid (h == Ts up to
+ * rounding) at inputs that cannot overflow it (model_step_safe): t at the FMU's time within
+ * u->t_tol and >= 0 (the general path's first test), t + h > t (so h > 0), the end in the
+ * one-sample window (PIM_ONE_LO; so t + h, and h, are finite) and the inputs admissible
+ * (unit_check_inputs: the main input is finite as model_step_safe implies).  The
+ * general path would then take the same checks, find k1 = k_next + 1 and run its loop once:
+ * this runs that sample and returns 1.  Any other step returns 0 with nothing changed, for
+ * unit_do_step_general (which also gives a failing step's reason).
+ */
+static PIM_HOT_INLINE int unit_one_sample(pim_unit *u, double t, double h)
+{
+    const double t_end = t + h, d = t_end * u->inv_Ts - (double)u->k_next;
+    if (!(u->mode == PIM_STEP_MODE && fabs(t - u->time) <= u->t_tol && t >= 0.0 && t_end > t &&
+          d >= PIM_ONE_LO && d <= PIM_ONE_HI && u->k_next <= PIM_ONE_KMAX &&
+          model_step_safe(u) && model_check_inputs(u) == 0))
+        return 0;
+    model_sample(u);
+    ++u->k_next;
+    model_step_done(u);
+    u->time = t_end;
+    return 1;
+}
+
+/* doStep(t, h): the one-sample fast path, else the general path; 0, or -1 with the reason. */
+static PIM_HOT_INLINE int unit_do_step(pim_unit *u, double t, double h)
+{
+    return unit_one_sample(u, t, h) ? 0 : unit_do_step_general(u, t, h);
 }
 
 /* The unit's report in words (no '%') into buf at terminate, after a run in step mode;
@@ -513,17 +566,6 @@ static int unit_settable(const pim_unit *u, const pim_var *v)
         return u->mode == PIM_INSTANTIATED || u->mode == PIM_INIT_MODE;
     return u->mode != PIM_TERMINATED && u->mode != PIM_CONFIG_MODE;
 }
-
-/* Error paths out of line, so that the accessors stay small (they run on every get/set). */
-#if defined(__GNUC__)
-#define PIM_COLD __attribute__((noinline, cold))
-#define PIM_NOINLINE __attribute__((noinline))
-#define PIM_HOT_INLINE __attribute__((always_inline)) inline
-#else
-#define PIM_COLD
-#define PIM_NOINLINE
-#define PIM_HOT_INLINE inline
-#endif
 
 /* The reason why unit_ref refused vr (v: its variable or NULL), into u->msg; returns NULL. */
 PIM_COLD static void *unit_ref_refused(pim_unit *u, const pim_var *v, int elem, unsigned vr, char type)

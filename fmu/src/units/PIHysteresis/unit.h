@@ -26,6 +26,7 @@ static int model_setup(pim_unit *u)
     return model_derive(u);
 }
 
+/* v_safe is finite, so a safe v is finite too (a NaN compares false). */
 static int model_step_safe(const pim_unit *u) { return fabs(u->in1) <= u->v_safe; }
 
 static void model_sample(pim_unit *u)
