@@ -229,8 +229,10 @@ def test_chunks_reject_bad_sizes():
         ChunkedQR(2).add(np.zeros((2, 4)), np.zeros(5))
 
 
-LIMIT_GB = 2.0  # address space of the child (virtual: libraries and thread stacks count); 2 x 1M
-# samples reached 15.5 GB resident before issue 31, 2.6 GB before the screened choice
+LIMIT_GB = 1.4  # address space of the child (virtual: libraries and thread stacks count); 2 x 1M
+# samples reached 15.5 GB resident before issue 31, 2.6 GB before the screened choice, 1.50 GB
+# while the whole records' play rows were held through the choice (so that failed here), now
+# 0.99 GB resident, 1.27 GB of address space (benchmarks/bench_diagnosis.py, VmPeak)
 
 _CHILD = textwrap.dedent("""
     import resource, sys
