@@ -3,7 +3,8 @@
 Run: ``.venv/bin/python benchmarks/bench_diagnosis.py [--samples 100000 300000 1000000]``.
 Goals (issue 31): two 1M-sample records diagnosed in under 30 s and under 2 GB peak memory
 on two cores, time and memory growing at most linearly from 100k to 1M samples. Each size
-runs in a fresh process (its peak resident memory is the process' own, ``ru_maxrss``), with
+runs in a fresh process (its peak resident memory is the process' own, ``ru_maxrss``, and its
+peak address space, ``VmPeak``, what the memory test's ``RLIMIT_AS`` bounds), with
 wall time and process CPU time (less sensitive to the load of a shared machine). Baseline in
 the same run, also in its own process: one plain least-squares fit of a PI model
 (``np.linalg.lstsq`` on the 20-play design matrix of the train record), so the ratio says how
@@ -64,8 +65,19 @@ def run_one(n: int, what: str) -> dict:
         np.linalg.lstsq(A, tr.y, rcond=None)
     out.update(wall=time.perf_counter() - t0, cpu=time.process_time() - c0,
                peak_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-               records_mb=rss0 / 1024)
+               records_mb=rss0 / 1024, address_mb=_peak_address_space_mb())
     return out
+
+
+def _peak_address_space_mb() -> float | None:
+    """The process' peak virtual memory (``VmPeak``, what ``RLIMIT_AS`` bounds) [MB]; None
+    where ``/proc`` does not give it."""
+    try:
+        with open("/proc/self/status") as fh:
+            line = next(x for x in fh if x.startswith("VmPeak:"))
+    except (OSError, StopIteration):
+        return None
+    return int(line.split()[1]) / 1024
 
 
 def main() -> None:
@@ -78,7 +90,8 @@ def main() -> None:
         return
     print("diagnosis of a train and a validate record of N samples each (truth: creep + "
           "dynamics); each row a fresh process")
-    print(f"{'N':>10} {'step':<34}{'wall [s]':>10}{'CPU [s]':>10}{'peak [MB]':>11}")
+    print(f"{'N':>10} {'step':<34}{'wall [s]':>10}{'CPU [s]':>10}{'peak [MB]':>11}"
+          f"{'VmPeak [MB]':>13}")
     rows = {}
     for n in args.samples:
         for what in ("baseline", "diagnosis"):
@@ -91,8 +104,9 @@ def main() -> None:
             r = rows[(n, what)] = json.loads(p.stdout.strip().splitlines()[-1])
             label = "plain PI least squares (baseline)" if what == "baseline" else \
                 "whole diagnosis"
+            vm = r.get("address_mb")
             print(f"{n:>10,} {label:<34}{r['wall']:>10.2f}{r['cpu']:>10.2f}"
-                  f"{r['peak_mb']:>11.0f}")
+                  f"{r['peak_mb']:>11.0f}{'' if vm is None else f'{vm:>13.0f}'}")
             if what == "diagnosis":
                 print(f"{'':>10} verdict {r['effects']}, shrink {r['shrink']:.2f}, "
                       f"{r['plays']} plays; {r['cpu'] / rows[(n, 'baseline')]['cpu']:.0f} "

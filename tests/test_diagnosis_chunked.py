@@ -108,17 +108,41 @@ def test_nominal_segments_project_streamed_plays_as_the_full_ones(monkeypatch):
     truth = random_truth(["creep"], 8)
     recs = [truth.record(*excitation(kind, seed=9), 9) for kind in ("train", "validate")]
     radii = np.linspace(0.0, np.ptp(recs[0].v) / 2, 40)
-    tr, va, nominal, full, V, out_tr, out_va = dg._nominal_segments(
+    tr, va, nominal, full, V, out_tr, out_va, btr, bva = dg._nominal_segments(
         recs[:1], recs[1:], radii, "rest", True)
     assert V is not None and V.shape == (40, dg.PROJECTED + 1)
     ref = dg._segments(recs, radii, "rest", True)
     model = fit_nominal(ref[:1])
-    for s, r, o in zip(tr + va, ref, out_tr + out_va, strict=True):
+    for s, r, o, b in zip(tr + va, ref, out_tr + out_va, btr + bva, strict=True):
         scale = np.ptp(r.y)
         assert np.max(np.abs(s.Z - r.Z @ V)) < 1e-9 * np.max(np.abs(r.Z))
         assert np.max(np.abs(o - model.predict(r))) < 1e-9 * scale
+        assert b.Z is None and np.array_equal(b.y, r.y)  # the whole records, no play rows
     assert np.max(np.abs(nominal.predict(tr[0]) - out_tr[0])) < 0.05 * np.ptp(recs[0].y)
     assert nominal.params == full.params and set(full.params) == set(model.params)
+    # the projected nominal, fitted from streamed chunks, is the least squares on Z V itself
+    projected = fit_nominal([dg._projected(b, radii, V, True) for b in btr])
+    assert np.max(np.abs(nominal.coef - projected.coef)) < 1e-9 * np.max(np.abs(projected.coef))
+
+
+def test_screen_segments_are_the_first_samples_of_the_whole_ones(monkeypatch):
+    # a long record's segments for the choice hold only its first samples; their play rows
+    # are those of the whole record's (the prefix of every causal column), and the whole
+    # record's rows are built later from the bare segment (_with_rows)
+    dg = importlib.import_module("pimodel.diagnosis.diagnose")
+    monkeypatch.setattr(chunks, "__defaults__", (509,))
+    truth = random_truth(["creep"], 5)
+    recs = [truth.record(*excitation(kind, seed=6), 6) for kind in ("train", "validate")]
+    m = int(np.random.default_rng(7).integers(600, 1500))
+    radii = np.linspace(0.0, np.ptp(recs[0].v) / 2, 40)
+    whole = dg._nominal_segments(recs[:1], recs[1:], radii, "rest", True)
+    head = dg._nominal_segments(recs[:1], recs[1:], radii, "rest", True, m)
+    assert np.array_equal(head[2].coef, whole[2].coef)  # the nominal from the whole records
+    for h, w, b in zip(head[0] + head[1], whole[0] + whole[1], head[7] + head[8], strict=True):
+        assert h.y.size == m and b.y.size == w.y.size > m
+        assert np.max(np.abs(h.Z - w.Z[:m])) <= 1e-12 * np.max(np.abs(w.Z))
+        rows = dg._with_rows(b, radii, head[4], True)
+        assert np.max(np.abs(rows.Z - w.Z)) <= 1e-12 * np.max(np.abs(w.Z))
 
 
 def test_slow_rss_in_one_pass_equals_both_least_squares_fits(monkeypatch):
@@ -205,8 +229,10 @@ def test_chunks_reject_bad_sizes():
         ChunkedQR(2).add(np.zeros((2, 4)), np.zeros(5))
 
 
-LIMIT_GB = 2.0  # address space of the child (virtual: libraries and thread stacks count); 2 x 1M
-# samples reached 15.5 GB resident before issue 31, 2.6 GB before the screened choice
+LIMIT_GB = 1.4  # address space of the child (virtual: libraries and thread stacks count); 2 x 1M
+# samples reached 15.5 GB resident before issue 31, 2.6 GB before the screened choice, 1.50 GB
+# while the whole records' play rows were held through the choice (so that failed here), now
+# 0.99 GB resident, 1.27 GB of address space (benchmarks/bench_diagnosis.py, VmPeak)
 
 _CHILD = textwrap.dedent("""
     import resource, sys

@@ -171,3 +171,30 @@ def test_real_record_identification(real_record_path):
     # held-out RMS below 0.5 % of the 39.5 um span, and no worse than the conventional n = 10
     assert held_out_rms(adaptive) < 0.005 * np.ptp(rec.y)
     assert held_out_rms(adaptive) <= held_out_rms(conv)
+
+
+
+@pytest.mark.filterwarnings("ignore:identify. radius estimate health")  # the final mean only
+def test_identify_reports_progress_on_a_long_record(monkeypatch):
+    # a record beyond HISTORY_LIMIT runs the estimator in chunks, each announced with the
+    # share done; the progress changes nothing in the result
+    from pimodel.identification import chain
+
+    rng = np.random.default_rng(21)
+    op = random_operator(22, 3)
+    _, v = triangle(amplitude=1.0 + rng.uniform(), freq=1.0, fs=500.0, duration=4.0)
+    y = op.simulate(v)
+    monkeypatch.setattr(chain, "HISTORY_LIMIT", 1000)
+    monkeypatch.setattr(chain, "PROGRESS_CHUNK", int(rng.integers(300, 700)))
+    messages: list[str] = []
+    ident = identify(v, y, dt=2e-3, n_plays=3, passes=2, progress=messages.append)
+    shares = [float(m.rsplit(": ", 1)[1].rstrip(" %")) for m in messages if m.endswith("%")]
+    assert messages[0].startswith("loop slopes") and messages[-1] == "errors on the record"
+    samples = ident.settings["passes"] * v.size
+    assert len(shares) >= -(-v.size // chain.PROGRESS_CHUNK) >= 3  # one per chunk
+    assert len(shares) <= -(-samples // chain.PROGRESS_CHUNK)
+    assert shares[0] == 0.0 and all(b > a for a, b in zip(shares, shares[1:], strict=False))
+    assert shares[-1] < 100.0
+    quiet = identify(v, y, dt=2e-3, n_plays=3, passes=2)
+    assert np.array_equal(quiet.radii, ident.radii) and np.array_equal(quiet.weights,
+                                                                       ident.weights)

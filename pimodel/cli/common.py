@@ -15,6 +15,7 @@ __all__ = [
     "columns_for",
     "float_list",
     "load_inputs",
+    "progress_line",
     "refuse_overwrite",
     "unique_name",
 ]
@@ -255,3 +256,22 @@ def unique_name(name: str, taken, what: str = "column") -> str:
     warnings.warn(f"{what} '{name}' exists in the input; the new {what} is written as "
                   f"'{name}_{k}'", UserWarning, stacklevel=2)
     return f"{name}_{k}"
+
+
+def progress_line(quiet: bool = False, stream=None, *, label: str = "diagnose"):
+    """A ``progress(message)`` callback that rewrites one line on ``stream`` (default stderr)
+    with ``label``, the message and the seconds elapsed; None when ``quiet`` or the stream is
+    not a terminal (logs and pipes stay clean)."""
+    import sys
+    import time
+
+    stream = stream or sys.stderr
+    if quiet or not stream.isatty():
+        return None
+    t0 = time.perf_counter()
+
+    def show(message: str) -> None:
+        stream.write(f"\r\x1b[K{label}: {message} [{time.perf_counter() - t0:.0f} s]")
+        stream.flush()
+
+    return show

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from .common import add_columns_option, load_inputs, refuse_overwrite
+from .common import add_columns_option, load_inputs, progress_line, refuse_overwrite
 
 __all__ = [
     "HELP",
@@ -64,25 +64,6 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def progress_line(quiet: bool = False, stream=None):
-    """A ``progress(message)`` callback that rewrites one line on ``stream`` (default stderr)
-    with the message and the seconds elapsed; None when ``quiet`` or the stream is not a
-    terminal (logs and pipes stay clean)."""
-    import sys
-    import time
-
-    stream = stream or sys.stderr
-    if quiet or not stream.isatty():
-        return None
-    t0 = time.perf_counter()
-
-    def show(message: str) -> None:
-        stream.write(f"\r\x1b[Kdiagnose: {message} [{time.perf_counter() - t0:.0f} s]")
-        stream.flush()
-
-    return show
-
-
 def run(args: argparse.Namespace) -> int:
     from ..diagnosis import diagnose
 
@@ -95,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
     inputs = args.train + args.validate
     train = load_inputs(args, args.train, inputs)
     validate = load_inputs(args, args.validate, inputs)
-    show = progress_line(args.quiet)
+    show = progress_line(args.quiet, label="diagnose")
     rep = diagnose(train, validate, initial_state=args.initial_state, progress=show)
     if show is not None:
         show("done")

@@ -4,8 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
-from .common import add_columns_option, float_list, load_inputs, refuse_overwrite
+from .common import (
+    add_columns_option,
+    float_list,
+    load_inputs,
+    progress_line,
+    refuse_overwrite,
+)
 
 __all__ = [
     "HELP",
@@ -36,6 +43,9 @@ def register(sub) -> None:
                    help="estimator gains, one or one per play (default 20 / sum p^2)")
     p.add_argument("--passes", type=int, default=None, help="repetitions of the record")
     p.add_argument("--plots", default=None, metavar="DIR", help="write figures (PNG) here")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress line on stderr (it is shown only when stderr is a "
+                   "terminal)")
     add_columns_option(p)
     p.set_defaults(func=run)
 
@@ -70,8 +80,12 @@ def run(args: argparse.Namespace) -> int:
     gains = None
     if args.gains is not None:
         gains = args.gains[0] if len(args.gains) == 1 else args.gains
+    show = progress_line(args.quiet, label="identify")
     idn = identify(rec.v, rec.y, dt=rec.dt, n_plays=args.plays, method=args.method,
-                   gains=gains, passes=args.passes)
+                   gains=gains, passes=args.passes, progress=show)
+    if show is not None:
+        show("done")
+        sys.stderr.write("\n")
     _save_model_file(idn, rec, args)
     if args.plots:
         from ..identification.plots import plot_identification

@@ -67,8 +67,6 @@ from .effects import (
     Segment,
     base_features,
     fit_effect,
-    fit_nominal,
-    head_segment,
     make_segment,
     nominal_params,
     play_chunks,
@@ -480,17 +478,22 @@ def _baseline(train, validate, initial_state) -> dict:
             "validate": _errors(va, _plain_outputs(va, radii, coef))}
 
 
-def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool):
+def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
+                      samples: int | None = None):
     """The nominal on the chosen grid and the segments the candidates are fitted on, the play
     outputs streamed (:func:`_plain_fit`): the nominal's train and validate outputs, then its
     play columns replaced by a few combinations (the nominal's own weights, then the 32 leading
     principal directions of the train play outputs, from the Gram matrix of the same pass)
     when they keep the nominal train RSS within 1 %; the candidates' grid searches filter these
-    columns only. The projected rows are built chunk by chunk, so the full (samples x plays)
-    outputs are never held; without a projection (20 plays, or a worse RSS) the segments hold
-    them. Returns the train and validate segments, the nominal fitted on them (with the full
+    columns only. The projected nominal is fitted by normal equations streamed over the records
+    (:func:`_projected_fit`), and the segments' rows are built chunk by chunk for the records'
+    first ``samples`` samples only (None: whole; the screen of a long record), so neither the
+    full (samples x plays) outputs nor the whole records' projected rows are held; without a
+    projection (20 plays, or a worse RSS) the segments hold the full play outputs of those
+    samples. Returns the train and validate segments, the nominal fitted on them (with the full
     model's ``params``), the full nominal, the projection ``V`` (play columns = ``Z @ V``;
-    None: not compressed) and the full nominal's train and validate outputs."""
+    None: not compressed), the full nominal's train and validate outputs (every sample) and
+    the whole records as segments without play rows (:func:`_bare`, for :func:`_with_rows`)."""
     n = radii.size
     segs, ne = _plain_fit(train, radii, initial_state, at_rest)
     coef = ne.solve()
@@ -498,15 +501,14 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool)
     full = Model("nominal", 0, base_features, coef, nominal_params(coef, out_tr, segs))
     vsegs = _bare(validate, initial_state)
     out_va = _plain_outputs(vsegs, radii, coef, at_rest)
+    heads = (_bare(train, initial_state, samples), _bare(validate, initial_state, samples))
     if n > PROJECTED:
         rss_full = sum(float(np.sum((o - s.y)[s.used] ** 2)) for s, o in zip(segs, out_tr,
                                                                               strict=True))
         _, vecs = np.linalg.eigh(ne.G[:n, :n])
         w = coef[:n]
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
-        ctr = [_projected(s, radii, V, at_rest) for s in segs]
-        m = fit_nominal(ctr)
-        rss = sum(float(np.sum((m.predict(s) - s.y)[s.used] ** 2)) for s in ctr)
+        m, rss = _projected_fit(segs, radii, V, at_rest)
         # beside a slow drift too, within 1 % plus what the dropped directions fit of the noise
         # (a drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can
         # hide directions a drift model needs)
@@ -519,10 +521,42 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool)
             keep = slow_projected <= (1.01 + (n - V.shape[1]) / n_fit) * slow_full
         if keep:
             m.params = dict(full.params)
-            return (ctr, [_projected(s, radii, V, at_rest) for s in vsegs], m, full, V,
-                    out_tr, out_va)
-    return (_segments(train, radii, initial_state, at_rest),
-            _segments(validate, radii, initial_state, at_rest), full, full, None, out_tr, out_va)
+            return (*([_with_rows(s, radii, V, at_rest) for s in h] for h in heads), m, full, V,
+                    out_tr, out_va, segs, vsegs)
+    return (*([_with_rows(s, radii, None, at_rest) for s in h] for h in heads), full, full, None,
+            out_tr, out_va, segs, vsegs)
+
+
+def _projected_fit(segs: list[Segment], radii, V: np.ndarray, at_rest: bool
+                   ) -> tuple[Model, float]:
+    """The nominal on the play columns ``Z V`` and an offset (the least squares of
+    :func:`.effects.fit_nominal`, the same sums chunk by chunk), with its train RSS, the
+    projected rows built from the input one chunk at a time (two passes: the normal equations,
+    then the residuals)."""
+    def projected_chunks(s):
+        for c, P in play_chunks(s.v, radii, at_rest=at_rest):
+            rows = np.empty((V.shape[1] + 1, P.shape[1]))
+            np.matmul(V.T, P[:-1], out=rows[:-1])
+            rows[-1] = 1.0
+            yield (rows, s.y[c]) if s.mask is None else (rows[:, s.mask[c]], s.y[c][s.mask[c]])
+
+    ne = NormalEquations(V.shape[1] + 1)
+    for s in segs:
+        for X, y in projected_chunks(s):
+            ne.add_gram(X @ X.T, X @ y, y.size)
+    coef = ne.solve()
+    rss = sum(float(np.sum((coef @ X - y) ** 2)) for s in segs for X, y in projected_chunks(s))
+    return Model("nominal", 0, base_features, coef, {}), rss
+
+
+def _with_rows(s: Segment, radii, V: np.ndarray | None, at_rest: bool) -> Segment:
+    """The bare segment ``s`` (:func:`_bare`) with play columns: ``Z V`` built chunk by chunk
+    (:func:`_projected`), or the full play outputs when ``V`` is None; its rate and Wiener
+    bases kept."""
+    out = make_segment(s.t, s.v, s.y, radii, s.mask, at_rest=at_rest) if V is None else \
+        _projected(s, radii, V, at_rest)
+    out.rate_basis, out.wiener_basis = s.rate_basis, s.wiener_basis
+    return out
 
 
 def _flat_settling(m: Model, tr, va, noise: float) -> bool:
@@ -586,9 +620,13 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     radii, extended, at_rest = _nominal(train, validate, initial_state)
     n_plays = radii.size
     progress(f"nominal model ({radii.size} plays, fitted on the whole records)")
-    tr, va, nominal, full_nominal, proj, out_tr, out_va = _nominal_segments(
-        train, validate, radii, initial_state, at_rest)
-    before = _errors(va, out_va)
+    # records longer than SCREEN_SAMPLES: every search and comparison below runs on their
+    # first SCREEN_SAMPLES samples (the segments tr, va); the chosen model is refitted on the
+    # whole records (_whole_fit), whose play rows are built only then
+    screened = any(len(r) > SCREEN_SAMPLES for r in train + validate)
+    tr, va, nominal, full_nominal, proj, out_tr, out_va, *whole = _nominal_segments(
+        train, validate, radii, initial_state, at_rest, SCREEN_SAMPLES if screened else None)
+    before = _errors(whole[1], out_va)
     progress("plain least-squares baseline")
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
                               "weights": full_nominal.coef[:n_plays],
@@ -596,7 +634,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                               "grid_sizes_tried": list(GRID_SIZES),
                               "grid_extended": extended,
                               "plays_start": "at rest at v[0]" if at_rest else "at 0"},
-                    "train": _errors(tr, out_tr), "validate": before,
+                    "train": _errors(whole[0], out_tr), "validate": before,
                     "initial_state": initial_state,
                     "baseline": _baseline(train, validate, initial_state)}
     base_rms = nominal_json["baseline"]["validate"]["rms"]
@@ -605,24 +643,22 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       f" times that of a plain least-squares PI fit ({base_rms:.4g}; "
                       "report.nominal['baseline']): the effects are measured against a weak "
                       "nominal", UserWarning, stacklevel=3)
-    where = residual_breakdown(va, [s.y - o for s, o in zip(va, out_va, strict=True)])
+    where = residual_breakdown(whole[1], [s.y - o for s, o in zip(whole[1], out_va,
+                                                                   strict=True)])
     progress("noise floor")
-    noise_info = measure_noise_floor([(s.v, s.y) for s in tr + va], out_tr + out_va)
+    noise_info = measure_noise_floor([(s.v, s.y) for s in whole[0] + whole[1]],
+                                     out_tr + out_va)
     noise = noise_info["value"]
-    # records longer than SCREEN_SAMPLES: every search and comparison below runs on their
-    # first SCREEN_SAMPLES samples; the chosen model is refitted on the whole (_whole_fit)
-    whole = (tr, va, out_va)
-    screened = any(s.y.size > SCREEN_SAMPLES for s in tr + va)
+    whole.append(out_va)
     if screened:
-        tr, va = ([head_segment(s, SCREEN_SAMPLES) for s in segs_] for segs_ in (tr, va))
         out_va = [o[:SCREEN_SAMPLES] for o in out_va]
     segs = tr + va
     # the rate columns from the full play outputs (computed chunk by chunk from the input
     # when needed), weighted as the model will hold them; the step rule on the whole input
     w_ref = nominal.coef[:n_plays] if proj is None else proj @ nominal.coef[:proj.shape[1]]
-    pairs = [(w, w) for w in whole[0] + whole[1]]  # (segment, its whole record)
+    pairs = list(zip(segs, whole[0] + whole[1], strict=True))  # (segment, its whole record)
     if screened:
-        pairs += list(zip(segs, whole[0] + whole[1], strict=True))
+        pairs += [(w, w) for w in whole[0] + whole[1]]
     for s, w in pairs:
         s.rate_basis = RateBasis(None, radii, s.v, s.dt, nominal.params["rate_scale"], w_ref,
                                  input_range=float(np.ptp(w.v)), at_rest=at_rest,
@@ -743,7 +779,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         progress("the chosen model on the whole records")
         tr, va, out_va = whole
         if chosen:
-            current, cur_out = _whole_fit(chosen, current, tr, va, nominal)
+            current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
+                                          lambda s: _with_rows(s, radii, proj, at_rest))
         else:
             current, cur_out = nominal, out_va
         screen = {"samples": SCREEN_SAMPLES,
@@ -792,15 +829,26 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                            fitted)
 
 
-def _whole_fit(chosen: tuple, screened: Model, tr, va, nominal: Model) -> tuple:
+def _whole_fit(chosen: tuple, screened: Model, tr, va, nominal: Model,
+               rows: Callable[[Segment], Segment]) -> tuple:
     """The model ``screened`` (chosen on the records' first samples) refitted on the whole
     train records, every grid parameter held (``"held"``: no search, the linear part's order
-    too), and its outputs on the whole validate records. Keeps the screen's reports its refit
-    does not make (the structures tried, the validate levels)."""
-    m = fit_effect(chosen[-1], tr, chosen[:-1], {**screened.grid, "held": True}, nominal)
-    m.params = {**screened.params, **m.params, **level_report(m, va, tr)}
-    out = [m.predict(s) for s in va]
-    _release(m, tr + va)
+    too), and its outputs on the whole validate records. ``tr`` and ``va`` are the records
+    without play rows; ``rows`` gives a record its play rows: the train records' are built
+    for the fit and dropped after it, then each validate record's in turn for its prediction
+    (all at once for a drift, whose validate levels are read from every record). Keeps the
+    screen's reports its refit does not make (the structures tried, the validate levels)."""
+    trw = [rows(s) for s in tr]
+    m = fit_effect(chosen[-1], trw, chosen[:-1], {**screened.grid, "held": True}, nominal)
+    _release(m, trw)
+    del trw
+    vas = [rows(s) for s in va] if "drift" in chosen else None
+    m.params = {**screened.params, **m.params, **level_report(m, vas or [], tr)}
+    out = []
+    for i, s in enumerate(va):
+        w = vas[i] if vas else rows(s)
+        out.append(m.predict(w))
+        _release(m, [w])
     return m, out
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,7 +30,7 @@ from ..operators.pi import PIOperator
 from .adaptive.health import EstimatorHealth, estimator_health, refined_health
 from .adaptive.joint import JointEstimator
 from .adaptive.polish import refine_radii
-from .adaptive.radius_estimator import RadiusEstimator, run_tail_average
+from .adaptive.radius_estimator import RadiusEstimator, stream_tail_average
 from .branches import find_reversals
 from .conventional import fit_conventional
 from .identifiability import ExcitationReport, check_excitation
@@ -47,6 +48,7 @@ HISTORY_LIMIT = 2_000_000  # samples (record x passes) up to which the estimate 
 REFINE_LIMIT = 10_000_000  # samples x plays up to which the radii are refined in batch
 MAX_PLAYS = LIMITS["PIM_MAX_PLAYS"]  # the FMUs' limit too
 MAX_REPEATED_SAMPLES = 20_000_000  # passes * record length: bounds the repeated record's memory
+PROGRESS_CHUNK = 1_000_000  # samples per chunk of a long estimator pass (as run_tail_average)
 MIN_LOOP_R2 = 0.5               # below: "no hysteresis loop found" warning
 
 
@@ -246,7 +248,8 @@ def _errors(op: PIOperator, v: np.ndarray, y: np.ndarray) -> tuple[float, float,
 def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adaptive",
              gains=None, passes: int | None = None, linear_play: bool | None = None,
              guard: float | None = None, conventional_span: float | None = None,
-             max_segments: int = 8) -> Identification:
+             max_segments: int = 8,
+             progress: Callable[[str], None] | None = None) -> Identification:
     """Identify a PI model from a record ``(v[k], y[k])`` sampled every ``dt`` seconds.
 
     The adaptive method refines the online estimate in batch (see the module docstring;
@@ -284,6 +287,10 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
         record).
     max_segments : int, optional
         Most loop-branch segments tried by the slope fit (1 to 65). Default 8.
+    progress : callable, optional
+        Called with a short message at each stage (the slopes, the radius estimator with the
+        share of its samples done, every ``PROGRESS_CHUNK`` samples on a long record, the
+        refinement, the errors), as :func:`pimodel.diagnosis.diagnose`'s ``progress``.
 
     Returns
     -------
@@ -327,8 +334,10 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     if passes is not None:
         passes = integer_in(passes, "passes", 1, max_passes(v.size))
     max_segments = integer_in(max_segments, "max_segments", 1, MAX_PLAYS + 1)
+    progress = progress or (lambda message: None)
 
     if method == "conventional":
+        progress("conventional fit")
         n = 10 if n_plays is None else n_plays
         fit = fit_conventional(v, y, n, span=conventional_span)
         exc = check_excitation(v, fit.operator.weights, fit.operator.radii)
@@ -336,10 +345,12 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
         return Identification(fit.operator, offset, method, rms, mx, float(np.ptp(y)), exc,
                               settings={"n_plays": n, "span": fit.span})
 
+    progress("loop slopes (number and weights of plays)")
     slopes = identify_slopes(v, y, n_plays=n_plays, linear_play=linear_play,
                              max_segments=max_segments)
     _warn_if_no_loop(slopes)
     if method == "joint":
+        progress("joint estimation of weights and radii")
         return _identify_jointly(v, y, slopes, n_plays)
     p = slopes.weights
     exc = check_excitation(v, p, slopes.radii_guess)
@@ -357,16 +368,19 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard
     est = RadiusEstimator(p, dt=dt, gains=g, initial_radii=slopes.radii_guess,
                           linear_play=slopes.linear_play, guard=guard_)
+    progress(f"radius estimator ({passes} passes, {vv.size:,} samples)")
     if vv.size <= HISTORY_LIMIT:  # keep the history for the health report
         run = est.run(vv, yy)
         radii = run.history[vv.size // 2:].mean(axis=0)
         health = estimator_health(vv, p, run.history, linear_play=slopes.linear_play, y=yy,
                                   error=run.error)
     else:  # long record: bounded memory, health from the final mean only
-        _, radii = run_tail_average(est, vv, yy, tail=0.5)
+        _, radii = stream_tail_average(est, _reported_chunks(vv, yy, passes, progress),
+                                       total=vv.size, tail=0.5)
         health = estimator_health(v, p, radii[None, :], linear_play=slopes.linear_play)
     radii_from = "average of the estimate over the last half"
     if v.size * p.size <= REFINE_LIMIT:  # the batch refinement holds N x n arrays
+        progress("batch refinement of the radii")
         offset = float(np.mean(y - PIOperator(p, radii).simulate(v)))
         # the last half, as the online mean: a real stage's start-up (creep from its initial
         # state) is not in the model (shared real record, held-out RMS: 0.113 um fitting all
@@ -378,12 +392,23 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     if not health.ok:
         warnings.warn("identify: radius estimate health: " + "; ".join(health.messages),
                       UserWarning, stacklevel=2)
+    progress("errors on the record")
     op = PIOperator(p, radii)
     offset, rms, mx = _errors(op, v, y)
     settings = {"gains": np.broadcast_to(g, p.shape).tolist(), "passes": passes,
                 "guard": guard_, "radii_from": radii_from}
     return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings,
                           health)
+
+
+def _reported_chunks(v: np.ndarray, y: np.ndarray, passes: int,
+                     progress: Callable[[str], None]) -> Iterator[tuple]:
+    """``(v, y)`` in chunks of ``PROGRESS_CHUNK`` samples, each announced with the share of the
+    estimator's samples done."""
+    for a in range(0, v.size, PROGRESS_CHUNK):
+        progress(f"radius estimator ({passes} passes, {v.size:,} samples): "
+                 f"{100 * a / v.size:.0f} %")
+        yield v[a:a + PROGRESS_CHUNK], y[a:a + PROGRESS_CHUNK]
 
 
 def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification,
