@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import os
+from ctypes import byref
 from pathlib import Path
 
 import pytest
+from fmpy.fmi1 import printLogMessage
+from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.logging import addLoggerProxy
 from hypothesis import settings
 
 # No per-example deadline (a loaded 2-core machine makes timings noisy); in CI the examples are
@@ -13,6 +17,25 @@ from hypothesis import settings
 settings.register_profile("default", deadline=None)
 settings.register_profile("ci", deadline=None, derandomize=True)
 settings.load_profile("ci" if os.environ.get("CI") else "default")
+
+# fmpy's native logger proxy (fmpy/logging, addLoggerProxy) keeps the last logger it was given in
+# one process-wide pointer, and simulate_fmu(logger=...) gives it a ctypes callback that is freed
+# when the call returns (tests/test_estimator_fmu.py and the docs/estimator.md snippet do this).
+# A later FMI 2 instance with fmpy's default callbacks that logs (FMU2Slave.instantiate(): e.g. a
+# doStep that returns fmi2Error) then calls freed memory: a segfault or abort in whichever
+# pytest-xdist worker ran both. After every test the pointer is set to this logger, alive for
+# the whole process.
+_PROCESS_LOGGER = fmi2CallbackLoggerTYPE(printLogMessage)
+
+
+@pytest.fixture(autouse=True)
+def fmpy_logger_proxy_restored():
+    """After each test, fmpy's logger proxy calls a logger alive for the whole process."""
+    yield
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = _PROCESS_LOGGER
+    addLoggerProxy(byref(callbacks))
+
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = REPO.parent / "shared" / "data" / "real" / "smarthysteresis-piezo-1hz"

@@ -7,14 +7,10 @@ says."""
 
 from __future__ import annotations
 
-from ctypes import byref
 from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy.fmi1 import printLogMessage
-from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-from fmpy.logging import addLoggerProxy
 
 from pimodel import PIOperator, estimate_radii
 from pimodel.blocks import estimator_block
@@ -170,23 +166,6 @@ def test_estimator_fmu_health_output_and_log_equal_python(fmus, case, fmi):
     assert "%" not in message  # hosts may use it as a format string
 
 
-# fmpy's native logger proxy (fmpy/logging) keeps the last logger given to addLoggerProxy in one
-# process-wide pointer, and simulate_fmu(logger=...) gives it a callback freed when the call
-# returns: a later FMI 2 instance with fmpy's default callbacks that logs would call freed memory
-# (a segfault seen in a pytest-xdist worker). This logger lives as long as the process.
-_PROCESS_LOGGER = fmi2CallbackLoggerTYPE(printLogMessage)
-
-
-@pytest.fixture
-def fmpy_logger_proxy_restored():
-    """After the test, fmpy's logger proxy calls a logger alive for the whole process."""
-    yield
-    callbacks = fmi2CallbackFunctions()
-    callbacks.logger = _PROCESS_LOGGER
-    addLoggerProxy(byref(callbacks))
-
-
-@pytest.mark.usefixtures("fmpy_logger_proxy_restored")
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 def test_simulate_fmu_logger_receives_the_health_warning(fmus, fmi):
     """fmpy.simulate_fmu with a logger callback, the FMU's default start (all radii 0) on a
