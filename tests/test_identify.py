@@ -173,7 +173,6 @@ def test_real_record_identification(real_record_path):
     assert held_out_rms(adaptive) <= held_out_rms(conv)
 
 
-
 @pytest.mark.filterwarnings("ignore:identify. radius estimate health")  # the final mean only
 def test_identify_reports_progress_on_a_long_record(monkeypatch):
     # a record beyond HISTORY_LIMIT runs the estimator in chunks, each announced with the

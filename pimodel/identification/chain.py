@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,7 +30,7 @@ from ..operators.pi import PIOperator
 from .adaptive.health import EstimatorHealth, estimator_health, refined_health
 from .adaptive.joint import JointEstimator
 from .adaptive.polish import refine_radii
-from .adaptive.radius_estimator import RadiusEstimator, stream_tail_average
+from .adaptive.radius_estimator import RadiusEstimator, run_tail_average
 from .branches import find_reversals
 from .conventional import fit_conventional
 from .identifiability import ExcitationReport, check_excitation
@@ -48,7 +48,7 @@ HISTORY_LIMIT = 2_000_000  # samples (record x passes) up to which the estimate 
 REFINE_LIMIT = 10_000_000  # samples x plays up to which the radii are refined in batch
 MAX_PLAYS = LIMITS["PIM_MAX_PLAYS"]  # the FMUs' limit too
 MAX_REPEATED_SAMPLES = 20_000_000  # passes * record length: bounds the repeated record's memory
-PROGRESS_CHUNK = 1_000_000  # samples per chunk of a long estimator pass (as run_tail_average)
+PROGRESS_CHUNK = 1_000_000  # samples per chunk of a long estimator pass, each announced
 MIN_LOOP_R2 = 0.5               # below: "no hysteresis loop found" warning
 
 
@@ -375,8 +375,10 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
         health = estimator_health(vv, p, run.history, linear_play=slopes.linear_play, y=yy,
                                   error=run.error)
     else:  # long record: bounded memory, health from the final mean only
-        _, radii = stream_tail_average(est, _reported_chunks(vv, yy, passes, progress),
-                                       total=vv.size, tail=0.5)
+        _, radii = run_tail_average(
+            est, vv, yy, tail=0.5, chunk=PROGRESS_CHUNK,
+            progress=lambda share: progress(f"radius estimator ({passes} passes, "
+                                            f"{vv.size:,} samples): {100 * share:.0f} %"))
         health = estimator_health(v, p, radii[None, :], linear_play=slopes.linear_play)
     radii_from = "average of the estimate over the last half"
     if v.size * p.size <= REFINE_LIMIT:  # the batch refinement holds N x n arrays
@@ -399,16 +401,6 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
                 "guard": guard_, "radii_from": radii_from}
     return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings,
                           health)
-
-
-def _reported_chunks(v: np.ndarray, y: np.ndarray, passes: int,
-                     progress: Callable[[str], None]) -> Iterator[tuple]:
-    """``(v, y)`` in chunks of ``PROGRESS_CHUNK`` samples, each announced with the share of the
-    estimator's samples done."""
-    for a in range(0, v.size, PROGRESS_CHUNK):
-        progress(f"radius estimator ({passes} passes, {v.size:,} samples): "
-                 f"{100 * a / v.size:.0f} %")
-        yield v[a:a + PROGRESS_CHUNK], y[a:a + PROGRESS_CHUNK]
 
 
 def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification,

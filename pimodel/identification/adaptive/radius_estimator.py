@@ -56,7 +56,7 @@ of the result (:mod:`pimodel.identification.adaptive.health`).
 from __future__ import annotations
 
 import warnings
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -684,7 +684,9 @@ def stream_tail_average(estimator: RadiusEstimator, chunks: Iterable[tuple], *, 
 
 
 def run_tail_average(estimator: RadiusEstimator, v, y, *, tail: float = 0.5,
-                     chunk: int = 1_000_000) -> tuple[np.ndarray, np.ndarray]:
+                     chunk: int = 1_000_000,
+                     progress: Callable[[float], None] | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`stream_tail_average` over whole arrays ``v``, ``y``, processed in chunks.
 
     Parameters
@@ -699,6 +701,8 @@ def run_tail_average(estimator: RadiusEstimator, v, y, *, tail: float = 0.5,
         Fraction of the samples, at the end, averaged (0 < tail <= 1). Default 0.5.
     chunk : int, optional
         Samples per chunk (bounds the memory). Default 10^6.
+    progress : callable, optional
+        Called before each chunk with the share of the samples done (0 <= share < 1).
 
     Returns
     -------
@@ -725,5 +729,11 @@ def run_tail_average(estimator: RadiusEstimator, v, y, *, tail: float = 0.5,
     m = as_signal(y, "y", min_length=2)
     if x.size != m.size:
         raise ValueError(f"v and y: expected equal lengths, got {x.size} and {m.size}")
-    chunks = ((x[a:a + chunk], m[a:a + chunk]) for a in range(0, x.size, chunk))
-    return stream_tail_average(estimator, chunks, total=x.size, tail=tail)
+    progress = progress or (lambda share: None)
+
+    def chunks():
+        for a in range(0, x.size, chunk):
+            progress(a / x.size)
+            yield x[a:a + chunk], m[a:a + chunk]
+
+    return stream_tail_average(estimator, chunks(), total=x.size, tail=tail)
