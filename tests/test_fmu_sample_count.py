@@ -141,9 +141,10 @@ def test_outputs_follow_the_held_inputs_without_a_shifted_sample(fmu):
 
 
 def test_derived_sampling_fields_are_recomputed_from_a_restored_state(fmu):
-    """1/Ts and the time tolerance are derived, not read: a serialized state whose copies of
-    them are edited (checksum recomputed) resumes bit for bit like the intact one, and a t off
-    by more than the rule's tolerance is still refused."""
+    """1/Ts, the time tolerance and the fast paths' fields are derived, not read: a serialized
+    state whose copies of them are edited (checksum recomputed) resumes bit for bit like the
+    intact one, a t off by more than the rule's tolerance is still refused, and so is setting
+    the output."""
     md = read_model_description(fmu)
     refs = {v.name: v.valueReference for v in md.modelVariables}
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu),
@@ -164,8 +165,14 @@ def test_derived_sampling_fields_are_recomputed_from_a_restored_state(fmu):
         blob = slave.serializeFMUstate(state)
         slave.freeFMUstate(state)
         assert read_field(blob, "inv_Ts") == 1 / ts and read_field(blob, "t_tol") == 1e-9
+        assert read_field(blob, "fast_t_tol") == 1e-9
+        assert read_field(blob, "fast_in_vr") == refs["v"]
+        edits = {"inv_Ts": 0.5, "t_tol": 1e3, "fast_t_tol": 1e3, "fast_in_vr": refs["y"]}
+        edited = blob
+        for field, value in edits.items():
+            edited = edit_field(edited, field, value)
         runs = []
-        for edited in (blob, edit_field(edit_field(blob, "inv_Ts", 0.5), "t_tol", 1e3)):
+        for edited in (blob, edited):
             state = slave.deSerializeFMUstate(edited)
             slave.setFMUstate(state)
             slave.freeFMUstate(state)
@@ -178,6 +185,8 @@ def test_derived_sampling_fields_are_recomputed_from_a_restored_state(fmu):
             runs.append(ys)
             with pytest.raises(Exception, match="status 3"):  # fmi2Error
                 slave.doStep(t + 1e-6, 2 * ts)  # beyond min(1e-9 max(1, t), 1e-3 Ts)
+            with pytest.raises(Exception, match="status 3"):
+                slave.setReal([refs["y"]], [1.0])  # an output
         assert runs[0] == runs[1] and np.ptp(runs[0]) > 0.1
         slave.terminate()
     finally:
