@@ -18,7 +18,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 from fmu_driver import NMAX, run_job  # noqa: E402
 
 from pimodel import PIOperator  # noqa: E402
+from pimodel._native import pi_run  # noqa: E402
 from pimodel.fmu import build_fmus  # noqa: E402
+from pimodel.fmu.unit import FMUUnit  # noqa: E402
 
 TS = 1e-3
 OK, ERROR = 0, 3
@@ -105,3 +107,28 @@ def test_fast_paths_refuse_what_the_general_paths_refuse(fmus, fmi):
     want = PIOperator(p, r).simulate(np.array(held))
     np.testing.assert_allclose(ys, want, rtol=0, atol=1e-12)
     assert np.ptp(want) > 0.5
+
+
+def test_straight_play_code_is_the_cores_loop_to_the_last_bit(fmus):
+    """The FMU runs its plays as straight code for each n <= 16 (pim_pi_step_small) and the
+    loop beyond; both equal the core's loop (pim_pi_run, as Python runs it) bit for bit, signed
+    zeros included, on inputs and radii on a coarse grid so that plays tie with v +- r."""
+    rng = np.random.default_rng(29)
+    for n in range(1, 19):
+        p = rng.uniform(0.1, 1.0, n)
+        r = np.concatenate([[0.0], np.sort(rng.integers(0, 8, n - 1) * 0.25)])
+        v = rng.integers(-8, 9, 40) * 0.25
+        start = {"Ts": TS, "n": n, **{f"p[{i + 1}]": float(x) for i, x in enumerate(p)},
+                 **{f"r[{i + 1}]": float(x) for i, x in enumerate(r)}}
+        unit = FMUUnit(fmus["2.0"], start)
+        try:
+            ys = []
+            for x in v:
+                unit.set({"v": float(x)})
+                unit.step(TS)
+                ys.append(unit.get(["y"])[0])
+        finally:
+            unit.close()
+        want, _ = pi_run(p, r, np.zeros(n), v)
+        assert np.array_equal(np.array(ys).view(np.int64), want.view(np.int64)), n
+        assert np.ptp(want) > 0.5
