@@ -157,12 +157,13 @@ typedef struct {
     /* derived from Ts (unit_derive_time): 1 / Ts, so that a doStep counts its samples without
      * a division, and the tolerance of a doStep's t that needs no further check */
     double inv_Ts, t_tol;
-    /* derived from the mode, the time and t_tol (unit_fast), for the per-sample fast paths:
-     * the tolerance of doStep's t (t_tol in step mode once time > t_tol, else -1: no t
-     * passes), and the main input's value reference while an input may be set (else 2^32, no
-     * value reference) */
+    /* derived from the mode, the time, t_tol and k_next (unit_fast), for the per-sample fast
+     * paths: the tolerance of doStep's t (t_tol in step mode once time > t_tol, else -1: no t
+     * passes), the main input's value reference while an input may be set (else 2^32, no
+     * value reference), and k_next + PIM_ONE_MID, the centre of doStep's one-sample window */
     double fast_t_tol;
     uint64_t fast_in_vr;
+    double x_next;
     /* the unit's own parameters, states and derived quantities */
 #include "fields.h"
     char msg[256]; /* reason of the last failure */
@@ -342,13 +343,32 @@ static void unit_derive_time(pim_unit *u)
     u->t_tol = u->Ts < 1e-6 ? 1e-3 * u->Ts : 1e-9;
 }
 
-/* The fast paths' fields (pim_unit) from the mode, the time and t_tol: after every change of
- * the mode (unit_set_mode), of the time by the general doStep, and for a restored state.  The
- * one-sample fast path keeps them right: it moves the time forward only. */
+/* The one-sample window of doStep's fast path (unit_one_sample): a step ending at x = t_end /
+ * Ts samples (x as unit_end_sample computes it) below 2^32 with x - k_next in [PIM_ONE_LO,
+ * PIM_ONE_HI] ends at sample k_next + 1, so it processes exactly sample k_next.  Proof:
+ * x - k_next is within 2^-52 of its exact value (|x - k_next| <= 2), so either
+ * x >= k_next + 1 with x - (k_next + 1) <= 0.4e-9 + 2^-52 < 0.5 PIM_SAMPLE_TOL
+ * (unit_end_sample's first case: k_next + 1), or x < k_next + 1 with x - k_next >= 1.02e-3 -
+ * 2^-52 >= 1.01e-3 (its second case: k_next + 1); x < 2^32 as those cases need.
+ * The fast path tests |x - x_next| <= PIM_ONE_HALF with x_next = k_next + PIM_ONE_MID (exact:
+ * PIM_ONE_MID = 1/2 + 2^-9 has 10 bits, k_next < 2^43), a window [2 PIM_ONE_MID - PIM_ONE_HI
+ * + 1e-15, PIM_ONE_HI - 1e-15] (3.9e-3 .. 1 + 4e-10 samples) within [PIM_ONE_LO, PIM_ONE_HI]
+ * despite the subtraction's rounding (at most 2^-54). */
+#define PIM_ONE_LO 1.02e-3
+#define PIM_ONE_HI (1.0 + 0.4 * PIM_SAMPLE_TOL)
+#define PIM_ONE_MID (0.5 + 1.0 / 512.0)
+#define PIM_ONE_HALF (PIM_ONE_HI - PIM_ONE_MID - 1e-15)
+#define PIM_ONE_XMAX 4294967296.0
+
+/* The fast paths' fields (pim_unit) from the mode, the time, t_tol and k_next: after every
+ * change of the mode (unit_set_mode), after the general doStep, and for a restored state.  The
+ * one-sample fast path keeps them right: it moves the time forward only, and x_next with
+ * k_next. */
 static void unit_fast(pim_unit *u)
 {
     const long in_vr = unit_main_vr(PIM_AT(in1), PIM_INPUT);
     u->fast_t_tol = u->mode == PIM_STEP_MODE && u->time > u->t_tol ? u->t_tol : -1.0;
+    u->x_next = (double)u->k_next + PIM_ONE_MID;
     u->fast_in_vr = in_vr >= 0 && u->mode != PIM_TERMINATED && u->mode != PIM_CONFIG_MODE
                         ? (uint64_t)in_vr
                         : (uint64_t)1 << 32;
@@ -536,43 +556,32 @@ PIM_NOINLINE static int unit_do_step_general(pim_unit *u, double t, double h)
     return 0;
 }
 
-/* The one-sample window of unit_do_step: a step ending at x = t_end / Ts samples (x as
- * unit_end_sample computes it) below 2^32 with d = x - k_next in [PIM_ONE_LO, PIM_ONE_HI] ends
- * at sample k_next + 1, so it processes exactly sample k_next.  Proof: d is within 2^-52 of
- * its exact value (|d| <= 2), so either x >= k_next + 1 with x - (k_next + 1) <= 0.4e-9 +
- * 2^-52 < 0.5 PIM_SAMPLE_TOL (unit_end_sample's first case: k_next + 1), or x < k_next + 1
- * with x - k_next >= 1.02e-3 - 2^-52 >= 1.01e-3 (its second case: k_next + 1); x < 2^32 as
- * those cases need.  Tested as |d - PIM_ONE_MID| <= PIM_ONE_HALF: the subtraction's rounding
- * (at most 2^-54) stays within the 1e-15 by which the half width is short of the window's. */
-#define PIM_ONE_LO 1.02e-3
-#define PIM_ONE_HI (1.0 + 0.4 * PIM_SAMPLE_TOL)
-#define PIM_ONE_MID (0.5 * (PIM_ONE_LO + PIM_ONE_HI))
-#define PIM_ONE_HALF (0.5 * (PIM_ONE_HI - PIM_ONE_LO) - 1e-15)
-#define PIM_ONE_XMAX 4294967296.0
-
 /*
  * The fast path of doStep(t, h) for the usual step, one sample on the FMU's grid (h == Ts up to
  * rounding) at inputs that cannot overflow it (model_step_safe): |t - time| <= fast_t_tol
  * (unit_fast: -1 outside step mode, so no t passes; else t_tol, and time > t_tol, so a t that
- * passes is >= 0: the general path's first test), t + h > t (so h > 0), the end in the
- * one-sample window (PIM_ONE_LO; so t + h, and h, are finite) and the inputs admissible
- * (unit_check_inputs: the main input is finite as model_step_safe implies).  The
- * general path would then take the same checks, find k1 = k_next + 1 and run its loop once:
- * this runs that sample and returns 1.  Any other step returns 0 with nothing changed, for
- * unit_do_step_general (which also gives a failing step's reason).
+ * passes is >= 0: the general path's first test), the end in the one-sample window (so t + h,
+ * and h, are finite) and the inputs admissible (unit_check_inputs: the main input is finite as
+ * model_step_safe implies).  Then also t + h > t (so h > 0, the general path's other tests):
+ * k_next is the rule's sample of time, so time <= (k_next + 1e-3 + 2e-6) Ts, and t <= time +
+ * t_tol (1 + 2^-52) <= (k_next + 2.01e-3) Ts, while the window puts t + h at >= (k_next + 3.9e-3
+ * - 1e-6) Ts.  The general path would take the same checks, find k1 = k_next + 1 and run its
+ * loop once: this runs that sample and returns 1.  Any other step returns 0 with nothing
+ * changed, for unit_do_step_general (which also gives a failing step's reason).
  */
 static PIM_HOT_INLINE int unit_one_sample(pim_unit *u0, double t, double h)
 {
     pim_unit *u = PIM_UNIT_ALIGNED(u0);
     const double t_end = t + h, x = t_end * u->inv_Ts;
-    /* a NaN t or h fails t_end > t (then also x is a number), so the other tests of t and x
-     * may let NaN through: !(a > b), which compares with b in memory */
-    if (!(t_end > t && !(fabs(t - u->time) > u->fast_t_tol) && !(x >= PIM_ONE_XMAX) &&
-          !(fabs((x - (double)u->k_next) - PIM_ONE_MID) > PIM_ONE_HALF) && model_step_safe(u) &&
+    /* a NaN t or h gives a NaN x, which fails the window's test; so the tests before it may
+     * let NaN through: !(a > b), which compares with b in memory */
+    if (!(!(fabs(t - u->time) > u->fast_t_tol) && !(x >= PIM_ONE_XMAX) &&
+          fabs(x - u->x_next) <= PIM_ONE_HALF && model_step_safe(u) &&
           model_check_inputs(u) == 0))
         return 0;
     model_sample(u);
     ++u->k_next;
+    u->x_next += 1.0;
     model_step_done(u);
     u->time = t_end;
     return 1;
@@ -717,7 +726,8 @@ static PIM_HOT_INLINE double *unit_main_real(pim_unit *u, unsigned vr, int set)
                                  6: the common part, then the unit's own fields; 7: n_plays;
                                  8: inv_Ts, t_tol (derived, recomputed on load);
                                  9: rate_growth, the scaled rate family's state;
-                                 10: fast_t_tol, fast_in_vr (derived, recomputed on load),
+                                 10: fast_t_tol, fast_in_vr, x_next (derived, recomputed
+                                 on load),
                                  the unit 16-byte aligned */
 #define PIM_STATE_TOKEN 64
 
