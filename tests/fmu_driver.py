@@ -51,10 +51,12 @@ class UnitPrefix(ctypes.Structure):
                 ("out2", ctypes.c_double), ("time", ctypes.c_double),
                 ("k_next", ctypes.c_int64), ("n", ctypes.c_int), ("mode", ctypes.c_int),
                 ("n_plays", ctypes.c_uint64), ("inv_Ts", ctypes.c_double),
-                ("t_tol", ctypes.c_double)]
+                ("t_tol", ctypes.c_double), ("fast_t_tol", ctypes.c_double),
+                ("fast_in_vr", ctypes.c_uint64), ("x_next", ctypes.c_double)]
 
 
-FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q", "n_plays": "Q"}  # others are doubles
+FIELD_FORMAT = {"n": "i", "mode": "i", "k_next": "q", "n_plays": "Q",
+                "fast_in_vr": "Q"}  # others are doubles
 
 
 def field_offset(field: str, index: int = 0) -> int:

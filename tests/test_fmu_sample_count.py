@@ -36,8 +36,10 @@ OFFSETS = [0.0, 1e-12, -1e-12, 3e-10, -3e-10, 4.9e-10, 5.1e-10, -5.1e-10, 9e-10,
 # outside it (beyond the fast count's margin, a relative 1e-6, and the resolution of t / Ts)
 TOL_FACTORS = [0.999, 0.99999, 1.00001, 1.001]
 # offsets of a one-sample step's end across the edges of doStep's one-sample fast path
-# (unit_one_sample: ends 1.02e-3 .. 1 + 4e-10 samples after the step's sample instant)
-WINDOW_OFFSETS = [-0.998985, -0.99898, -0.998975, 3.9e-10, 4e-10, 4.1e-10, -0.5, 0.0]
+# (unit_one_sample: ends 3.906e-3 .. 1 + 4e-10 samples after the step's sample instant), and
+# across the edge of the window it must stay within (1.02e-3)
+WINDOW_OFFSETS = [-0.996095, -0.9960937, -0.99609, 3.9e-10, 4e-10, 4.1e-10, -0.5, 0.0,
+                  -0.998985, -0.99898, -0.998975]
 
 
 def tolerance(x: float) -> float:
@@ -141,9 +143,10 @@ def test_outputs_follow_the_held_inputs_without_a_shifted_sample(fmu):
 
 
 def test_derived_sampling_fields_are_recomputed_from_a_restored_state(fmu):
-    """1/Ts and the time tolerance are derived, not read: a serialized state whose copies of
-    them are edited (checksum recomputed) resumes bit for bit like the intact one, and a t off
-    by more than the rule's tolerance is still refused."""
+    """1/Ts, the time tolerance and the fast paths' fields are derived, not read: a serialized
+    state whose copies of them are edited (checksum recomputed) resumes bit for bit like the
+    intact one, a t off by more than the rule's tolerance is still refused, and so is setting
+    the output."""
     md = read_model_description(fmu)
     refs = {v.name: v.valueReference for v in md.modelVariables}
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu),
@@ -164,8 +167,16 @@ def test_derived_sampling_fields_are_recomputed_from_a_restored_state(fmu):
         blob = slave.serializeFMUstate(state)
         slave.freeFMUstate(state)
         assert read_field(blob, "inv_Ts") == 1 / ts and read_field(blob, "t_tol") == 1e-9
+        assert read_field(blob, "fast_t_tol") == 1e-9
+        assert read_field(blob, "fast_in_vr") == refs["v"]
+        assert read_field(blob, "x_next") == read_field(blob, "k_next") + 0.5 + 2.0**-9
+        edits = {"inv_Ts": 0.5, "t_tol": 1e3, "fast_t_tol": 1e3, "fast_in_vr": refs["y"],
+                 "x_next": 7.0}
+        changed = blob
+        for field, value in edits.items():
+            changed = edit_field(changed, field, value)
         runs = []
-        for edited in (blob, edit_field(edit_field(blob, "inv_Ts", 0.5), "t_tol", 1e3)):
+        for edited in (blob, changed):
             state = slave.deSerializeFMUstate(edited)
             slave.setFMUstate(state)
             slave.freeFMUstate(state)
@@ -178,6 +189,8 @@ def test_derived_sampling_fields_are_recomputed_from_a_restored_state(fmu):
             runs.append(ys)
             with pytest.raises(Exception, match="status 3"):  # fmi2Error
                 slave.doStep(t + 1e-6, 2 * ts)  # beyond min(1e-9 max(1, t), 1e-3 Ts)
+            with pytest.raises(Exception, match="status 3"):
+                slave.setReal([refs["y"]], [1.0])  # an output
         assert runs[0] == runs[1] and np.ptp(runs[0]) > 0.1
         slave.terminate()
     finally:

@@ -54,10 +54,24 @@ PIM_API double pim_pi_step(size_t n, const double *p, const double *r, double *z
  *     y = (p_1 z_1 + p_3 z_3 + ...) + (p_2 z_2 + p_4 z_4 + ...)
  *
  * (one order for every caller, so that they agree to the last bit).  Two plays per vector
- * operation (SSE2), and a chain of n/2 additions per sample instead of n; the loop counts
- * pairs, unrolled twice (the small n of the FMUs pay its set-up and branches every sample; the
- * order of the additions does not change).  p, r and z must not overlap.
+ * operation (SSE2), and a chain of n/2 additions per sample instead of n.  The loop counts
+ * pairs; a count known only at run time unrolled twice (the small n of the FMUs pay its set-up
+ * and branches every sample), one known when compiled (pim_pi_step_small) unrolled completely
+ * by the compiler; the order of the additions does not change.  p, r and z must not overlap.
  */
+#define PIM_PI_PAIR(i)                                                                         \
+    do {                                                                                       \
+        const size_t i_ = (i);                                                                 \
+        double a = z[i_] < v + r[i_] ? z[i_] : v + r[i_];                                      \
+        double b = z[i_ + 1] < v + r[i_ + 1] ? z[i_ + 1] : v + r[i_ + 1];                      \
+        a = a > v - r[i_] ? a : v - r[i_];                                                     \
+        b = b > v - r[i_ + 1] ? b : v - r[i_ + 1];                                             \
+        z[i_] = a;                                                                             \
+        z[i_ + 1] = b;                                                                         \
+        y_odd += p[i_] * a;                                                                    \
+        y_even += p[i_ + 1] * b;                                                               \
+    } while (0)
+
 static inline double pim_pi_step_inline(size_t n, const double *PIM_RESTRICT p,
                                         const double *PIM_RESTRICT r, double *PIM_RESTRICT z,
                                         double v)
@@ -65,19 +79,12 @@ static inline double pim_pi_step_inline(size_t n, const double *PIM_RESTRICT p,
     double y_odd = 0.0, y_even = 0.0; /* plays 1, 3, ... and 2, 4, ... (indices 0, 2, ...) */
     const size_t pairs = n / 2;
 #if defined(__GNUC__) && !defined(__clang__)
+    if (!__builtin_constant_p(pairs)) {
 #pragma GCC unroll 2
+        for (size_t j = 0; j < pairs; ++j) PIM_PI_PAIR(2 * j);
+    } else
 #endif
-    for (size_t j = 0; j < pairs; ++j) {
-        const size_t i = 2 * j;
-        double a = z[i] < v + r[i] ? z[i] : v + r[i];
-        double b = z[i + 1] < v + r[i + 1] ? z[i + 1] : v + r[i + 1];
-        a = a > v - r[i] ? a : v - r[i];
-        b = b > v - r[i + 1] ? b : v - r[i + 1];
-        z[i] = a;
-        z[i + 1] = b;
-        y_odd += p[i] * a;
-        y_even += p[i + 1] * b;
-    }
+        for (size_t j = 0; j < pairs; ++j) PIM_PI_PAIR(2 * j);
     if (n & 1) {
         const size_t i = n - 1;
         double a = z[i] < v + r[i] ? z[i] : v + r[i];
@@ -87,6 +94,34 @@ static inline double pim_pi_step_inline(size_t n, const double *PIM_RESTRICT p,
     }
     return y_odd + y_even;
 }
+#undef PIM_PI_PAIR
+
+/* The n up to which pim_pi_step_small has a straight line of code for each n. */
+#define PIM_PI_SMALL_N 16
+
+/*
+ * pim_pi_step_inline for a caller whose n is small and the same for many samples (the FMU
+ * units): a switch on n, each case pim_pi_step_inline with that n as a constant, so without a
+ * loop and at fixed offsets (a branch the processor predicts instead of a loop's set-up and
+ * branches); larger n run the loop.  The same operations in the same order, the same result.
+ */
+#define PIM_PI_SMALL_CASE(k) case k: return pim_pi_step_inline(k, p, r, z, v);
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline double pim_pi_step_small(size_t n, const double *PIM_RESTRICT p,
+                                       const double *PIM_RESTRICT r, double *PIM_RESTRICT z,
+                                       double v)
+{
+    switch (n) {
+    PIM_PI_SMALL_CASE(1) PIM_PI_SMALL_CASE(2) PIM_PI_SMALL_CASE(3) PIM_PI_SMALL_CASE(4)
+    PIM_PI_SMALL_CASE(5) PIM_PI_SMALL_CASE(6) PIM_PI_SMALL_CASE(7) PIM_PI_SMALL_CASE(8)
+    PIM_PI_SMALL_CASE(9) PIM_PI_SMALL_CASE(10) PIM_PI_SMALL_CASE(11) PIM_PI_SMALL_CASE(12)
+    PIM_PI_SMALL_CASE(13) PIM_PI_SMALL_CASE(14) PIM_PI_SMALL_CASE(15) PIM_PI_SMALL_CASE(16)
+    default: return pim_pi_step_inline(n, p, r, z, v);
+    }
+}
+#undef PIM_PI_SMALL_CASE
 
 /*
  * Runs the PI operator over v[0..N-1]: y[k] as above, z updated to z[N-1].

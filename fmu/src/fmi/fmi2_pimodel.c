@@ -65,8 +65,13 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
                        "GUID mismatch: the FMU was built for another model description");
         return NULL;
     }
-    Inst *c = (Inst *)calloc(1, sizeof(Inst));
-    if (!c) return NULL;
+    Inst *c = (Inst *)unit_alloc(sizeof(Inst));
+    if (!c) {
+        if (cb->logger)
+            cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
+                       "out of memory (or memory not 16-byte aligned)");
+        return NULL;
+    }
     c->cb = *cb;
     snprintf(c->name, sizeof c->name, "%s", name ? name : "pimodel");
     unit_defaults(&c->u);
@@ -88,7 +93,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component comp)
 {
     INST(comp);
     IN_MODES(PIM_IN(PIM_INSTANTIATED), "fmi2EnterInitializationMode");
-    c->u.mode = PIM_INIT_MODE;
+    unit_set_mode(&c->u, PIM_INIT_MODE);
     return fmi2OK;
 }
 
@@ -97,7 +102,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp)
     INST(comp);
     IN_MODES(PIM_IN(PIM_INIT_MODE), "fmi2ExitInitializationMode");
     fmi2Status st = status(c, unit_setup(&c->u));
-    if (st == fmi2OK) c->u.mode = PIM_STEP_MODE;
+    if (st == fmi2OK) unit_set_mode(&c->u, PIM_STEP_MODE);
     return st;
 }
 
@@ -112,7 +117,7 @@ fmi2Status fmi2Terminate(fmi2Component comp)
     if (unit_terminate_report(&c->u, report, sizeof report) && c->cb.logger)
         c->cb.logger(c->cb.componentEnvironment, c->name, fmi2Warning, "logStatusWarning",
                      report);
-    c->u.mode = PIM_TERMINATED;
+    unit_set_mode(&c->u, PIM_TERMINATED);
     return fmi2OK;
 }
 

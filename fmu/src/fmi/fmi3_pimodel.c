@@ -74,8 +74,12 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
         if (log) log(env, fmi3Error, "logStatusError", "event mode is not supported");
         return NULL;
     }
-    Inst *c = (Inst *)calloc(1, sizeof(Inst));
-    if (!c) return NULL;
+    Inst *c = (Inst *)unit_alloc(sizeof(Inst));
+    if (!c) {
+        if (log) log(env, fmi3Error, "logStatusError",
+                     "out of memory (or memory not 16-byte aligned)");
+        return NULL;
+    }
     c->env = env;
     c->log = log;
     unit_defaults(&c->u);
@@ -105,7 +109,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance inst, fmi3Boolean tolDef, fm
     (void)tolDef; (void)tol;
     IN_MODES(PIM_IN(PIM_INSTANTIATED), "fmi3EnterInitializationMode");
     if (unit_start(&c->u, t0, stopDef, tStop) != 0) return status(c, -1);
-    c->u.mode = PIM_INIT_MODE;
+    unit_set_mode(&c->u, PIM_INIT_MODE);
     return fmi3OK;
 }
 
@@ -114,7 +118,7 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance inst)
     INST(inst);
     IN_MODES(PIM_IN(PIM_INIT_MODE), "fmi3ExitInitializationMode");
     fmi3Status st = status(c, unit_setup(&c->u));
-    if (st == fmi3OK) c->u.mode = PIM_STEP_MODE;
+    if (st == fmi3OK) unit_set_mode(&c->u, PIM_STEP_MODE);
     return st;
 }
 
@@ -130,7 +134,7 @@ fmi3Status fmi3Terminate(fmi3Instance inst)
     char report[4096];
     if (unit_terminate_report(&c->u, report, sizeof report) && c->log)
         c->log(c->env, fmi3Warning, "logStatusWarning", report);
-    c->u.mode = PIM_TERMINATED;
+    unit_set_mode(&c->u, PIM_TERMINATED);
     return fmi3OK;
 }
 
@@ -416,7 +420,7 @@ fmi3Status fmi3EnterConfigurationMode(fmi3Instance inst)
 {
     INST(inst);
     IN_MODES(PIM_IN(PIM_INSTANTIATED), "fmi3EnterConfigurationMode");
-    c->u.mode = PIM_CONFIG_MODE;
+    unit_set_mode(&c->u, PIM_CONFIG_MODE);
     return fmi3OK;
 }
 
@@ -425,7 +429,7 @@ fmi3Status fmi3ExitConfigurationMode(fmi3Instance inst)
     INST(inst);
     IN_MODES(PIM_IN(PIM_CONFIG_MODE), "fmi3ExitConfigurationMode");
     if (unit_check_n_plays(&c->u) != 0) return status(c, -1);
-    c->u.mode = PIM_INSTANTIATED;
+    unit_set_mode(&c->u, PIM_INSTANTIATED);
     return fmi3OK;
 }
 

@@ -92,6 +92,18 @@
 #define NMAX PIM_NMAX
 
 
+/* Error paths out of line, so that the accessors and doStep stay small (they run every sample);
+ * the per-sample code inline (the framework's fast path and a unit's model_sample). */
+#if defined(__GNUC__)
+#define PIM_COLD __attribute__((noinline, cold))
+#define PIM_NOINLINE __attribute__((noinline))
+#define PIM_HOT_INLINE __attribute__((always_inline)) inline
+#else
+#define PIM_COLD
+#define PIM_NOINLINE
+#define PIM_HOT_INLINE inline
+#endif
+
 typedef enum {
     PIM_PARAMETER, PIM_INPUT, PIM_OUTPUT, PIM_INDEPENDENT, PIM_STRUCTURAL
 } pim_causality;
@@ -115,13 +127,23 @@ typedef struct {
  * FMI 3 also: instantiated <-> configuration mode (the structural parameter n_plays). */
 enum { PIM_INSTANTIATED = 1, PIM_INIT_MODE, PIM_STEP_MODE, PIM_TERMINATED, PIM_CONFIG_MODE };
 
+/* 16-byte alignment of the unit (its arrays at offsets that are multiples of 16, so the play
+ * loop reads them as aligned vectors) */
+#if defined(__GNUC__)
+#define PIM_ALIGNED16 __attribute__((aligned(16))) /* pim_unit: allocated by unit_alloc */
+#define PIM_UNIT_ALIGNED(u) ((pim_unit *)__builtin_assume_aligned((u), 16))
+#else
+#define PIM_ALIGNED16
+#define PIM_UNIT_ALIGNED(u) (u)
+#endif
+
 /* The unit: the common part (the same layout in every unit, mirrored by tests/fmu_driver.py),
  * then the unit's own fields (units/<Unit>/fields.h). */
 typedef struct {
     /* common parameters: sample time, initial play state, plays 1..64 (weights p, radii r;
      * CreepOperator: gains c in p, time constants tau in r; 16-byte aligned as the arrays
      * the core's loops run over) */
-    double Ts, z0;
+    double Ts PIM_ALIGNED16, z0;
     double p[PIM_NMAX], r[PIM_NMAX];
     /* inputs and outputs (the spec's names: in1 is v, y_d or u; in2 and out2 the
      * RadiusEstimator's y and e) */
@@ -135,6 +157,13 @@ typedef struct {
     /* derived from Ts (unit_derive_time): 1 / Ts, so that a doStep counts its samples without
      * a division, and the tolerance of a doStep's t that needs no further check */
     double inv_Ts, t_tol;
+    /* derived from the mode, the time, t_tol and k_next (unit_fast), for the per-sample fast
+     * paths: the tolerance of doStep's t (t_tol in step mode once time > t_tol, else -1: no t
+     * passes), the main input's value reference while an input may be set (else 2^32, no
+     * value reference), and k_next + PIM_ONE_MID, the centre of doStep's one-sample window */
+    double fast_t_tol;
+    uint64_t fast_in_vr;
+    double x_next;
     /* the unit's own parameters, states and derived quantities */
 #include "fields.h"
     char msg[256]; /* reason of the last failure */
@@ -155,12 +184,37 @@ static const pim_var unit_vars[] = {PIM_UNIT_VARIABLES(PIM_VAR_ROW)};
 #undef PIM_VAR_ROW
 #define PIM_NVARS (sizeof unit_vars / sizeof unit_vars[0])
 
+/* Zeroed memory of `size` bytes for a pim_unit or a struct that starts with one, or NULL when
+ * out of memory or not 16-byte aligned (PIM_UNIT_ALIGNED; what the allocators of 64-bit
+ * platforms return). */
+static void *unit_alloc(size_t size)
+{
+    void *m = calloc(1, size);
+    if (m && ((uintptr_t)m & 15u) != 0) {
+        free(m);
+        return NULL;
+    }
+    return m;
+}
+
 /* The name of the variable stored at offset (e.g. the main input's, "v", "y_d" or "u"). */
 static const char *unit_name_of(size_t offset)
 {
     for (size_t i = 0; i < PIM_NVARS; ++i)
         if (unit_vars[i].offset == offset) return unit_vars[i].name;
     return "?";
+}
+
+/* The value reference of the scalar Real variable stored at `offset` (the main input in1 of
+ * causality input, the main output out1), or -1; from the constant table, so that the
+ * compiler folds it to a number. */
+static PIM_HOT_INLINE long unit_main_vr(size_t offset, pim_causality causality)
+{
+    for (size_t i = 0; i < PIM_NVARS; ++i)
+        if (unit_vars[i].offset == offset && unit_vars[i].type == 'R' && unit_vars[i].size == 1 &&
+            unit_vars[i].causality == causality)
+            return (long)unit_vars[i].vr;
+    return -1;
 }
 
 static int unit_error(pim_unit *u, const char *fmt, ...)
@@ -289,18 +343,55 @@ static void unit_derive_time(pim_unit *u)
     u->t_tol = u->Ts < 1e-6 ? 1e-3 * u->Ts : 1e-9;
 }
 
+/* The one-sample window of doStep's fast path (unit_one_sample): a step ending at x = t_end /
+ * Ts samples (x as unit_end_sample computes it) below 2^32 with x - k_next in [PIM_ONE_LO,
+ * PIM_ONE_HI] ends at sample k_next + 1, so it processes exactly sample k_next.  Proof:
+ * x - k_next is within 2^-52 of its exact value (|x - k_next| <= 2), so either
+ * x >= k_next + 1 with x - (k_next + 1) <= 0.4e-9 + 2^-52 < 0.5 PIM_SAMPLE_TOL
+ * (unit_end_sample's first case: k_next + 1), or x < k_next + 1 with x - k_next >= 1.02e-3 -
+ * 2^-52 >= 1.01e-3 (its second case: k_next + 1); x < 2^32 as those cases need.
+ * The fast path tests |x - x_next| <= PIM_ONE_HALF with x_next = k_next + PIM_ONE_MID (exact:
+ * PIM_ONE_MID = 1/2 + 2^-9 has 10 bits, k_next < 2^43), a window [2 PIM_ONE_MID - PIM_ONE_HI
+ * + 1e-15, PIM_ONE_HI - 1e-15] (3.9e-3 .. 1 + 4e-10 samples) within [PIM_ONE_LO, PIM_ONE_HI]
+ * despite the subtraction's rounding (at most 2^-54). */
+#define PIM_ONE_LO 1.02e-3
+#define PIM_ONE_HI (1.0 + 0.4 * PIM_SAMPLE_TOL)
+#define PIM_ONE_MID (0.5 + 1.0 / 512.0)
+#define PIM_ONE_HALF (PIM_ONE_HI - PIM_ONE_MID - 1e-15)
+#define PIM_ONE_XMAX 4294967296.0
+
+/* The fast paths' fields (pim_unit) from the mode, the time, t_tol and k_next: after every
+ * change of the mode (unit_set_mode), after the general doStep, and for a restored state.  The
+ * one-sample fast path keeps them right: it moves the time forward only, and x_next with
+ * k_next. */
+static void unit_fast(pim_unit *u)
+{
+    const long in_vr = unit_main_vr(PIM_AT(in1), PIM_INPUT);
+    u->fast_t_tol = u->mode == PIM_STEP_MODE && u->time > u->t_tol ? u->t_tol : -1.0;
+    u->x_next = (double)u->k_next + PIM_ONE_MID;
+    u->fast_in_vr = in_vr >= 0 && u->mode != PIM_TERMINATED && u->mode != PIM_CONFIG_MODE
+                        ? (uint64_t)in_vr
+                        : (uint64_t)1 << 32;
+}
+
+static void unit_set_mode(pim_unit *u, int mode)
+{
+    u->mode = mode;
+    unit_fast(u);
+}
+
 static void unit_defaults(pim_unit *u)
 {
     memset(u, 0, sizeof *u);
     u->Ts = 1e-3;
     u->n = 1;
     u->n_plays = PIM_NMAX;
-    u->mode = PIM_INSTANTIATED;
     for (int i = 0; i < PIM_NMAX; ++i) u->p[i] = 1.0;
     model_defaults(u);
 #ifdef PIM_MODEL_DEFAULTS
     PIM_MODEL_DEFAULTS(u);
 #endif
+    unit_set_mode(u, PIM_INSTANTIATED);
 }
 
 /* Start time (setupExperiment / enterInitializationMode): finite and >= 0. */
@@ -355,7 +446,7 @@ static int unit_check_parameters(pim_unit *u)
  * that a step would refuse, or outputs that overflow, leave the start values. */
 static void unit_start_outputs(pim_unit *u)
 {
-    pim_unit *c = (pim_unit *)malloc(sizeof *c);
+    pim_unit *c = (pim_unit *)unit_alloc(sizeof *c);
     if (!c) return;
     *c = *u;
     if (isfinite(c->in1) && model_check_inputs(c) == 0) {
@@ -419,17 +510,6 @@ static int unit_samples_checked(pim_unit *u, int64_t k1)
     return 0;
 }
 
-/* Error paths out of line, so that the accessors and doStep stay small (they run every sample). */
-#if defined(__GNUC__)
-#define PIM_COLD __attribute__((noinline, cold))
-#define PIM_NOINLINE __attribute__((noinline))
-#define PIM_HOT_INLINE __attribute__((always_inline)) inline
-#else
-#define PIM_COLD
-#define PIM_NOINLINE
-#define PIM_HOT_INLINE inline
-#endif
-
 /* doStep(t, h) in general (unit_do_step): processes the samples k*Ts in [t, t+h) (the sampling
  * rule above), with every check. */
 PIM_NOINLINE static int unit_do_step_general(pim_unit *u, double t, double h)
@@ -472,39 +552,36 @@ PIM_NOINLINE static int unit_do_step_general(pim_unit *u, double t, double h)
         model_step_done(u);
     }
     u->time = t_end;
+    unit_fast(u);
     return 0;
 }
 
-/* The one-sample window of unit_do_step: a step ending at x = t_end / Ts samples (x as
- * unit_end_sample computes it) with x - k_next in [PIM_ONE_LO, PIM_ONE_HI] ends at sample
- * k_next + 1, so it processes exactly sample k_next.  Proof: x - k_next is within 2^-52 of
- * its exact value (|x - k_next| <= 2), so either x >= k_next + 1 with x - (k_next + 1) <= 0.4e-9
- * + 2^-52 < 0.5 PIM_SAMPLE_TOL (unit_end_sample's first case: k_next + 1), or x < k_next + 1
- * with x - k_next >= 1.02e-3 - 2^-52 >= 1.01e-3 (its second case: k_next + 1); for
- * k_next <= PIM_ONE_KMAX, x < 2^32 as those cases need. */
-#define PIM_ONE_LO 1.02e-3
-#define PIM_ONE_HI (1.0 + 0.4 * PIM_SAMPLE_TOL)
-#define PIM_ONE_KMAX 4294967294LL
-
 /*
  * The fast path of doStep(t, h) for the usual step, one sample on the FMU's grid (h == Ts up to
- * rounding) at inputs that cannot overflow it (model_step_safe): t at the FMU's time within
- * u->t_tol and >= 0 (the general path's first test), t + h > t (so h > 0), the end in the
- * one-sample window (PIM_ONE_LO; so t + h, and h, are finite) and the inputs admissible
- * (unit_check_inputs: the main input is finite as model_step_safe implies).  The
- * general path would then take the same checks, find k1 = k_next + 1 and run its loop once:
- * this runs that sample and returns 1.  Any other step returns 0 with nothing changed, for
- * unit_do_step_general (which also gives a failing step's reason).
+ * rounding) at inputs that cannot overflow it (model_step_safe): |t - time| <= fast_t_tol
+ * (unit_fast: -1 outside step mode, so no t passes; else t_tol, and time > t_tol, so a t that
+ * passes is >= 0: the general path's first test), the end in the one-sample window (so t + h,
+ * and h, are finite) and the inputs admissible (unit_check_inputs: the main input is finite as
+ * model_step_safe implies).  Then also t + h > t (so h > 0, the general path's other tests):
+ * k_next is the rule's sample of time, so time <= (k_next + 1e-3 + 2e-6) Ts, and t <= time +
+ * t_tol (1 + 2^-52) <= (k_next + 2.01e-3) Ts, while the window puts t + h at >= (k_next + 3.9e-3
+ * - 1e-6) Ts.  The general path would take the same checks, find k1 = k_next + 1 and run its
+ * loop once: this runs that sample and returns 1.  Any other step returns 0 with nothing
+ * changed, for unit_do_step_general (which also gives a failing step's reason).
  */
-static PIM_HOT_INLINE int unit_one_sample(pim_unit *u, double t, double h)
+static PIM_HOT_INLINE int unit_one_sample(pim_unit *u0, double t, double h)
 {
-    const double t_end = t + h, d = t_end * u->inv_Ts - (double)u->k_next;
-    if (!(u->mode == PIM_STEP_MODE && fabs(t - u->time) <= u->t_tol && t >= 0.0 && t_end > t &&
-          d >= PIM_ONE_LO && d <= PIM_ONE_HI && u->k_next <= PIM_ONE_KMAX &&
-          model_step_safe(u) && model_check_inputs(u) == 0))
+    pim_unit *u = PIM_UNIT_ALIGNED(u0);
+    const double t_end = t + h, x = t_end * u->inv_Ts;
+    /* a NaN t or h gives a NaN x, which fails the window's test; so the tests before it may
+     * let NaN through: !(a > b), which compares with b in memory */
+    if (!(!(fabs(t - u->time) > u->fast_t_tol) && !(x >= PIM_ONE_XMAX) &&
+          fabs(x - u->x_next) <= PIM_ONE_HALF && model_step_safe(u) &&
+          model_check_inputs(u) == 0))
         return 0;
     model_sample(u);
     ++u->k_next;
+    u->x_next += 1.0;
     model_step_done(u);
     u->time = t_end;
     return 1;
@@ -616,31 +693,16 @@ static PIM_HOT_INLINE void *unit_ref(pim_unit *u, unsigned vr, char type, int el
     return (char *)u + v->offset + (elem > 0 ? (size_t)elem * sizeof(double) : 0);
 }
 
-/* The value reference of the scalar Real variable stored at `offset` (the main input in1 of
- * causality input, the main output out1), or -1; from the constant table, so that the
- * compiler folds it to a number. */
-static PIM_HOT_INLINE long unit_main_vr(size_t offset, pim_causality causality)
-{
-    for (size_t i = 0; i < PIM_NVARS; ++i)
-        if (unit_vars[i].offset == offset && unit_vars[i].type == 'R' && unit_vars[i].size == 1 &&
-            unit_vars[i].causality == causality)
-            return (long)unit_vars[i].vr;
-    return -1;
-}
-
 /*
  * The accessors' fast path for what a master moves every step: the storage of the main input
- * in1 (set != 0, in a mode where unit_settable allows an input) or of the main output out1
+ * in1 (set != 0, in a mode where unit_settable allows an input: u->fast_in_vr) or of the
+ * main output out1
  * (set == 0); NULL for any other variable or mode, which then takes unit_ref (the same rules,
  * and the reasons of a refusal).
  */
 static PIM_HOT_INLINE double *unit_main_real(pim_unit *u, unsigned vr, int set)
 {
-    if (set)
-        return (long)vr == unit_main_vr(PIM_AT(in1), PIM_INPUT) && u->mode != PIM_TERMINATED &&
-                       u->mode != PIM_CONFIG_MODE
-                   ? &u->in1
-                   : NULL;
+    if (set) return vr == u->fast_in_vr ? &u->in1 : NULL;
     return (long)vr == unit_main_vr(PIM_AT(out1), PIM_OUTPUT) ? &u->out1 : NULL;
 }
 
@@ -659,11 +721,14 @@ static PIM_HOT_INLINE double *unit_main_real(pim_unit *u, unsigned vr, int set)
  * The in-memory FMU state (get/set) is the same byte block, checked again when set.
  */
 #define PIM_STATE_MAGIC "PIMSTATE"
-#define PIM_STATE_VERSION 9u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
-                                prefilter (Wiener); 5: DiagnosedInverse fields, post sections;
-                                6: the common part, then the unit's own fields; 7: n_plays;
-                                8: inv_Ts, t_tol (derived, recomputed on load);
-                                9: rate_growth, the scaled rate family's state */
+#define PIM_STATE_VERSION 10u /* 2: units 4-7 fields; 3: law, health; 4: DiagnosedModel
+                                 prefilter (Wiener); 5: DiagnosedInverse fields, post sections;
+                                 6: the common part, then the unit's own fields; 7: n_plays;
+                                 8: inv_Ts, t_tol (derived, recomputed on load);
+                                 9: rate_growth, the scaled rate family's state;
+                                 10: fast_t_tol, fast_in_vr, x_next (derived, recomputed
+                                 on load),
+                                 the unit 16-byte aligned */
 #define PIM_STATE_TOKEN 64
 
 typedef struct {
@@ -760,7 +825,7 @@ static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
     memcpy(&sum, bytes + sizeof h + sizeof(pim_unit), sizeof sum);
     if (sum != unit_fnv1a(bytes, sizeof h + sizeof(pim_unit)))
         return unit_error(u, "FMU state rejected: checksum mismatch (corrupted bytes)");
-    pim_unit *s = (pim_unit *)malloc(sizeof *s);
+    pim_unit *s = (pim_unit *)unit_alloc(sizeof *s);
     if (!s) return unit_error(u, "FMU state rejected: out of memory");
     memcpy(s, bytes + sizeof h, sizeof *s);
     s->msg[0] = '\0';
@@ -781,6 +846,7 @@ static int unit_state_read(pim_unit *u, const unsigned char *bytes, size_t size,
     }
     if (rc == 0 && out) {
         s->msg[0] = '\0';
+        unit_fast(s);
         *out = *s;
     }
     free(s);

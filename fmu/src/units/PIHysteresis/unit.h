@@ -29,7 +29,7 @@ static int model_setup(pim_unit *u)
 /* v_safe is finite, so a safe v is finite too (a NaN compares false). */
 static int model_step_safe(const pim_unit *u) { return fabs(u->in1) <= u->v_safe; }
 
-static void model_sample(pim_unit *u)
+static PIM_HOT_INLINE void model_sample(pim_unit *u)
 {
-    u->out1 = pim_pi_step_inline((size_t)u->n, u->p, u->r, u->z, u->in1);
+    u->out1 = pim_pi_step_small((size_t)u->n, u->p, u->r, u->z, u->in1);
 }
