@@ -76,6 +76,7 @@ MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
+LTI_MEMO = 16  # columns of the linear part's elements memoised per record (the last base mode)
 SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
@@ -1016,7 +1017,20 @@ def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     if base is None or base[0] != (p["fn"], p["zeta"]):
         base = ((p["fn"], p["zeta"]), mode(h0, p["fn"], p["zeta"], s.dt))
         static[("M1[h0]", id(s))] = base
-    cols = lti_columns(h0, p["fn"], p["zeta"], p["lti"], s.dt, base=base[1])
+    # each element's column memoised for the last base mode (the order selection tries many
+    # sets of elements around one mode; a column does not depend on the others)
+    known = static.get(("lti", id(s)))
+    if known is None or known[0] != base[0]:
+        known = static[("lti", id(s))] = (base[0], {})
+    cols = np.empty((h0.size, len(p["lti"])))
+    for j, el in enumerate(p["lti"]):
+        key = tuple(el)
+        col = known[1].pop(key, None)  # reinserted last: the least recently used goes first
+        if col is None:
+            col = lti_columns(h0, p["fn"], p["zeta"], (el,), s.dt, base=base[1])[:, 0]
+        known[1][key] = cols[:, j] = col
+        if len(known[1]) > LTI_MEMO:
+            del known[1][next(iter(known[1]))]
     return shift(cols, p["d"]) if "d" in p else cols
 
 
