@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..operators.pi import PIOperator
-from .chunked import NormalEquations, chunks
+from .chunked import CHUNK, NormalEquations, chunks
 from .creep import creep_time_constants
 from .drift import (
     DRIFT_VARIANTS,
@@ -374,9 +374,10 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     blocks = [_row_parts(features, s) for s in train]
     ne = NormalEquations(sum(X.shape[0] for X in blocks[0]))
     for P, s in zip(blocks, train, strict=True):
-        for c in chunks(s.y.size):
+        first = _first_grams(P[0], s)
+        for j, c in enumerate(chunks(s.y.size)):
             Pc, y = _used_chunk(P, s, c)
-            ne.add_gram(_gram(Pc), np.concatenate([X @ y for X in Pc]), y.size)
+            ne.add_gram(_gram(Pc, first[j]), np.concatenate([X @ y for X in Pc]), y.size)
     coef = ne.solve()
     rss = 0.0
     for P, s in zip(blocks, train, strict=True):
@@ -417,13 +418,31 @@ def _row_parts(features, s: Segment) -> tuple:
     return (features(s).T,)
 
 
-def _gram(P: tuple) -> np.ndarray:
-    """``B B^T`` of the rows ``B`` the blocks ``P`` stack, block by block."""
+def _first_grams(Z: np.ndarray, s: Segment) -> list:
+    """``Z_c Z_c^T`` of the first block of rows ``Z`` (the play rows) on each chunk ``c`` of
+    ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
+    screen's (at most ``SCREEN_SAMPLES`` samples): the fits of a search that holds the play
+    rows (creep, asymmetry, drift, the rate's filters, the linear part's elements around one
+    mode) then form only the blocks that change. Else (a whole record) None per chunk."""
+    where = s.y.size
+    if Z.shape[1] > SCREEN_SAMPLES:
+        return [None] * len(range(0, where, CHUNK))
+    key = (Z.__array_interface__["data"][0], Z.shape, Z.strides)
+    memo = s.__dict__.get("_first_grams")
+    if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
+        grams = [X @ X.T for X in (_used_chunk((Z,), s, c)[0][0] for c in chunks(where))]
+        memo = s.__dict__["_first_grams"] = (key, Z, grams)
+    return memo[2]
+
+
+def _gram(P: tuple, first: np.ndarray | None = None) -> np.ndarray:
+    """``B B^T`` of the rows ``B`` the blocks ``P`` stack, block by block (``first``: that of
+    the first block, when known)."""
     edges = np.cumsum([0] + [X.shape[0] for X in P])
     G = np.empty((edges[-1], edges[-1]))
     for i, X in enumerate(P):
         for j in range(i, len(P)):
-            blk = X @ X.T if j == i else X @ P[j].T
+            blk = (X @ X.T if first is None or i else first) if j == i else X @ P[j].T
             G[edges[i]:edges[i + 1], edges[j]:edges[j + 1]] = blk
             G[edges[j]:edges[j + 1], edges[i]:edges[i + 1]] = blk.T
     return G
