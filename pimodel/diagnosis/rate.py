@@ -488,7 +488,8 @@ def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
     ``zs_i[k] = min(max(zs_i[k-1], v[k] - rho_i[k]), v[k] + rho_i[k])``, ``zs_i[-1] = z0``,
     ``rho_i[k] = r_i (1 + G s[k] / (1 + s[k] / S))``, ``s[k]`` the strictly causal filtered
     rate of the module docstring (``s[0] = s[1] = 0``); run by the C core
-    (``pim_rdpi_sat_run``, as :mod:`pimodel.operators.rate_dependent`), one play at a time.
+    (``pim_rdpi_sat_plays``: the plays of ``pim_rdpi_sat_run``, as
+    :mod:`pimodel.operators.rate_dependent`, all on the one rate in one pass).
 
     Parameters
     ----------
@@ -539,13 +540,8 @@ def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
     r = np.asarray(radii, float)
     lam = float(np.exp(-dt / tau))
     sat = 0.0 if saturation is None else saturation * rate_scale
-    out = np.empty((v.size, r.size))
-    one = np.ones(1)
-    for i in range(r.size):
-        z, hist = np.full(1, z0), np.array([v[0], 0.0])
-        out[:, i] = _native.rdpi_sat_run(one, r[i:i + 1].copy(), growth / rate_scale, sat, lam,
-                                         dt, z, hist, v)
-    return out
+    return _native.rdpi_sat_plays(np.ascontiguousarray(r), growth / rate_scale, sat, lam, dt,
+                                  np.full(r.size, z0), np.array([v[0], 0.0]), v)
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,
