@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..operators.pi import PIOperator
-from .chunked import CHUNK, NormalEquations, chunks
+from .chunked import NormalEquations, chunks
 from .creep import creep_time_constants
 from .drift import (
     DRIFT_VARIANTS,
@@ -377,7 +377,8 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
         first = _first_grams(P[0], s)
         for j, c in enumerate(chunks(s.y.size)):
             Pc, y = _used_chunk(P, s, c)
-            ne.add_gram(_gram(Pc, first[j]), np.concatenate([X @ y for X in Pc]), y.size)
+            ne.add_gram(_gram(Pc, None if first is None else first[j]),
+                        np.concatenate([X @ y for X in Pc]), y.size)
     coef = ne.solve()
     rss = 0.0
     for P, s in zip(blocks, train, strict=True):
@@ -418,19 +419,19 @@ def _row_parts(features, s: Segment) -> tuple:
     return (features(s).T,)
 
 
-def _first_grams(Z: np.ndarray, s: Segment) -> list:
+def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
     """``Z_c Z_c^T`` of the first block of rows ``Z`` (the play rows) on each chunk ``c`` of
     ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
     screen's (at most ``SCREEN_SAMPLES`` samples): the fits of a search that holds the play
     rows (creep, asymmetry, drift, the rate's filters, the linear part's elements around one
-    mode) then form only the blocks that change. Else (a whole record) None per chunk."""
-    where = s.y.size
+    mode) then form only the blocks that change. None for a whole long record."""
     if Z.shape[1] > SCREEN_SAMPLES:
-        return [None] * len(range(0, where, CHUNK))
-    key = (Z.__array_interface__["data"][0], Z.shape, Z.strides)
+        return None
+    cuts = list(chunks(s.y.size))
+    key = (Z.__array_interface__["data"][0], Z.shape, Z.strides, len(cuts))
     memo = s.__dict__.get("_first_grams")
     if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
-        grams = [X @ X.T for X in (_used_chunk((Z,), s, c)[0][0] for c in chunks(where))]
+        grams = [X @ X.T for X in (_used_chunk((Z,), s, c)[0][0] for c in cuts)]
         memo = s.__dict__["_first_grams"] = (key, Z, grams)
     return memo[2]
 
