@@ -234,8 +234,8 @@ def test_element_columns_memoised_per_base_mode_equal_fresh_ones():
     seg = make_segment(np.arange(n) * 1e-4, v, np.zeros(n), np.linspace(0, np.ptp(v) / 2, 4))
     nominal = Model("nominal", 0, base_features, rng.uniform(0.5, 1.5, 5))
     h0 = nominal.predict(seg)
-    pool = [("mode", float(f), float(z)) for f, z in zip(rng.uniform(300, 3000, LTI_MEMO + 4),
-                                                          rng.uniform(0.05, 0.5, LTI_MEMO + 4))]
+    freqs, dampings = rng.uniform(300, 3000, LTI_MEMO + 4), rng.uniform(0.05, 0.5, LTI_MEMO + 4)
+    pool = [("mode", float(f), float(z)) for f, z in zip(freqs, dampings, strict=True)]
     pool += [("lowpass", 2e-4), ("direct",)]
     static: dict = {}
     for fn, zeta in ((150.0, 0.2), (150.0, 0.2), (410.0, 0.05)):
