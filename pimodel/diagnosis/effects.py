@@ -170,6 +170,17 @@ class Segment:
             return rows
         return rows[:n if ncols is None else min(ncols, n)]
 
+    def forget_grams(self) -> None:
+        """Drop the play rows' Gram the fits keep on the segment (and the rows it holds).
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.5]), np.zeros(3),
+        ...                    [0.0])
+        >>> seg.forget_grams()  # nothing kept yet: nothing to drop
+        """
+        self.__dict__.pop("_first_grams", None)
+
 
 def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
     """Segment of one record with the play outputs of ``radii``, the plays at rest at ``v[0]``.
