@@ -267,6 +267,9 @@ lib.pim_rdpi_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_dou
 lib.pim_rdpi_sat_run.restype = None
 lib.pim_rdpi_sat_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double,
                                  c_double, F64, F64, F64, F64]
+lib.pim_rdpi_sat_plays.restype = None
+lib.pim_rdpi_sat_plays.argtypes = [c_size, c_size, F64, c_double, c_double, c_double, c_double,
+                                   F64, F64, F64, F64]
 lib.pim_rdpi_inverse_run.restype = c_int
 lib.pim_rdpi_inverse_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64,
                                      F64, F64, F64]
@@ -306,6 +309,16 @@ def rdpi_sat_run(p: np.ndarray, alpha: np.ndarray, beta: float, sat: float, lam:
     y = np.empty(v.shape[0])
     lib.pim_rdpi_sat_run(v.shape[0], p.shape[0], p, alpha, beta, sat, lam, Ts, z, hist, v, y)
     return y
+
+
+def rdpi_sat_plays(alpha: np.ndarray, beta: float, sat: float, lam: float, Ts: float,
+                   z: np.ndarray, hist: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The play outputs ``z_i[k]`` of :func:`rdpi_sat_run` (shape (N, n)), every play on the
+    one rate; ``z`` (n) and ``hist`` (v[k-1], rate[k]) updated in place."""
+    out = np.empty((v.shape[0], alpha.shape[0]))
+    lib.pim_rdpi_sat_plays(v.shape[0], alpha.shape[0], alpha, beta, sat, lam, Ts, z, hist, v,
+                           out)
+    return out
 
 
 def rdpi_inverse_run(p: np.ndarray, alpha: np.ndarray, beta: float, lam: float, Ts: float,

@@ -316,3 +316,35 @@ def test_screened_search_finds_the_mode_of_the_whole_record(monkeypatch):
     assert abs(fits[3000][0] / 700.0 - 1) < 0.03 and abs(fits[v.size][0] / 700.0 - 1) < 0.03
     assert fits[3000][1] <= 1.05 * fits[v.size][1]
     assert effects._screen([seg], ("rate",), {}) == [seg]  # per-record bases: never screened
+
+
+def test_fits_that_hold_the_play_rows_reuse_their_gram_and_new_rows_do_not():
+    # _fit keeps the play rows' Gram per segment (_first_grams): a second fit on the same rows
+    # equals the first to the bit, and rows of the same shape but other values (a new array)
+    # are fitted as themselves, not with the kept Gram
+    from pimodel.diagnosis.effects import _fit, segment_of_rows
+
+    rng = np.random.default_rng(11)
+    n, p = 40_000, 5
+    seg = segment_of_rows(np.arange(n) * 1e-4, rng.normal(size=n), rng.normal(size=n),
+                          np.vstack((rng.normal(size=(p, n)), np.ones(n))))
+    extra = rng.normal(size=(2, n))
+
+    def features(Z):
+        def feats(s):
+            return np.vstack((Z, extra)).T
+        feats.parts = lambda s: (Z, extra)
+        return feats
+
+    def reference(Z):
+        A = np.vstack((Z, extra)).T
+        return np.linalg.lstsq(A, seg.y, rcond=None)[0]
+
+    Z1 = seg.play_rows()
+    m1, rss1 = _fit("a", 0, features(Z1), [seg])
+    m2, rss2 = _fit("a", 0, features(seg.play_rows()), [seg])  # another view, same rows
+    assert np.array_equal(m1.coef, m2.coef) and rss1 == rss2
+    Z3 = np.ascontiguousarray(Z1 * rng.uniform(0.5, 2.0, (p, 1)) + rng.normal(size=(p, n)))
+    m3, _ = _fit("a", 0, features(Z3), [seg])
+    assert np.max(np.abs(m3.coef - reference(Z3))) < 1e-8 * np.max(np.abs(reference(Z3)))
+    assert np.max(np.abs(m3.coef - m1.coef)) > 1e-3

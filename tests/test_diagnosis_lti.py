@@ -220,3 +220,29 @@ def test_nelder_mead_treats_a_broken_fit_as_inadmissible():
     r = nelder_mead(cost, np.array([-0.9]), initial_simplex=[[-0.9], [-1.5]], xatol=1e-8,
                     fatol=1e-12)
     assert abs(float(r.x[0]) - 2.0) < 1e-4
+
+
+def test_element_columns_memoised_per_base_mode_equal_fresh_ones():
+    # _lti_block keeps each element's column for the last base mode (at most LTI_MEMO): sets of
+    # elements in any order, past the memo's size and after a change of base mode, give the
+    # columns lti_columns builds afresh, to the bit
+    from pimodel.diagnosis.effects import LTI_MEMO, Model, _lti_block, base_features
+
+    rng = np.random.default_rng(4)
+    n = 3000
+    v = np.cumsum(rng.normal(0, 0.05, n))
+    seg = make_segment(np.arange(n) * 1e-4, v, np.zeros(n), np.linspace(0, np.ptp(v) / 2, 4))
+    nominal = Model("nominal", 0, base_features, rng.uniform(0.5, 1.5, 5))
+    h0 = nominal.predict(seg)
+    freqs, dampings = rng.uniform(300, 3000, LTI_MEMO + 4), rng.uniform(0.05, 0.5, LTI_MEMO + 4)
+    pool = [("mode", float(f), float(z)) for f, z in zip(freqs, dampings, strict=True)]
+    pool += [("lowpass", 2e-4), ("direct",)]
+    static: dict = {}
+    for fn, zeta in ((150.0, 0.2), (150.0, 0.2), (410.0, 0.05)):
+        for _ in range(8):
+            els = tuple(pool[i] for i in rng.choice(len(pool), int(rng.integers(1, 4)),
+                                                    replace=False))
+            p = {"fn": fn, "zeta": zeta, "lti": els}
+            got = _lti_block(seg, p, nominal, static)
+            assert np.array_equal(got, lti_columns(h0, fn, zeta, els, seg.dt))
+        assert len(static[("lti", id(seg))][1]) <= LTI_MEMO

@@ -108,3 +108,26 @@ def test_radius_estimator_equals_reference(seed, law):
     np.testing.assert_array_equal(a.used, used)
     np.testing.assert_allclose(a.radii, final, rtol=0, atol=1e-12)
     assert used.any()
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_rdpi_sat_plays_equals_sat_run_per_play(seed):
+    """``pim_rdpi_sat_plays`` (every play on the one rate in one pass, the diagnosis' scaled
+    rate shape) gives exactly the plays ``pim_rdpi_sat_run`` gives one play at a time."""
+    from pimodel import _native
+
+    rng = np.random.default_rng(seed)
+    n, N, dt = int(rng.integers(1, 30)), 4000, 1e-4
+    alpha = np.sort(rng.uniform(0, 0.5, n))
+    v = np.cumsum(rng.normal(0, 0.01, N))
+    beta, lam = rng.uniform(0, 0.01), float(np.exp(-dt / rng.uniform(1e-4, 1e-2)))
+    for sat in (0.0, rng.uniform(10, 100)):
+        z0, hist0 = rng.uniform(-0.5, 0.5, n), np.array([v[0], rng.uniform(0, 5)])
+        z, hist = z0.copy(), hist0.copy()
+        plays = _native.rdpi_sat_plays(alpha, beta, sat, lam, dt, z, hist, v)
+        for i in range(n):
+            zi, hi = z0[i:i + 1].copy(), hist0.copy()
+            ref = _native.rdpi_sat_run(np.ones(1), alpha[i:i + 1].copy(), beta, sat, lam, dt,
+                                       zi, hi, v)
+            np.testing.assert_array_equal(plays[:, i], ref)
+            assert zi[0] == z[i] and np.array_equal(hi, hist)

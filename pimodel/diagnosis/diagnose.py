@@ -777,6 +777,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     screen = None
     if screened:  # the choice, refitted on the whole records; the verdict's figures whole
         progress("the chosen model on the whole records")
+        for s in segs:  # the screen's kept play-row Grams (and rows) are done with
+            s.forget_grams()
         tr, va, out_va = whole
         if chosen:
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,

@@ -76,6 +76,7 @@ MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
+LTI_MEMO = 16  # columns of the linear part's elements memoised per record (the last base mode)
 SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
@@ -168,6 +169,17 @@ class Segment:
         if offset:
             return rows
         return rows[:n if ncols is None else min(ncols, n)]
+
+    def forget_grams(self) -> None:
+        """Drop the play rows' Gram the fits keep on the segment (and the rows it holds).
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(3) * 1e-3, np.array([0.0, 1.0, 0.5]), np.zeros(3),
+        ...                    [0.0])
+        >>> seg.forget_grams()  # nothing kept yet: nothing to drop
+        """
+        self.__dict__.pop("_first_grams", None)
 
 
 def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
@@ -373,9 +385,11 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     blocks = [_row_parts(features, s) for s in train]
     ne = NormalEquations(sum(X.shape[0] for X in blocks[0]))
     for P, s in zip(blocks, train, strict=True):
-        for c in chunks(s.y.size):
+        first = _first_grams(P[0], s)
+        for j, c in enumerate(chunks(s.y.size)):
             Pc, y = _used_chunk(P, s, c)
-            ne.add_gram(_gram(Pc), np.concatenate([X @ y for X in Pc]), y.size)
+            ne.add_gram(_gram(Pc, None if first is None else first[j]),
+                        np.concatenate([X @ y for X in Pc]), y.size)
     coef = ne.solve()
     rss = 0.0
     for P, s in zip(blocks, train, strict=True):
@@ -416,13 +430,31 @@ def _row_parts(features, s: Segment) -> tuple:
     return (features(s).T,)
 
 
-def _gram(P: tuple) -> np.ndarray:
-    """``B B^T`` of the rows ``B`` the blocks ``P`` stack, block by block."""
+def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
+    """``Z_c Z_c^T`` of the first block of rows ``Z`` (the play rows) on each chunk ``c`` of
+    ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
+    screen's (at most ``SCREEN_SAMPLES`` samples): the fits of a search that holds the play
+    rows (creep, asymmetry, drift, the rate's filters, the linear part's elements around one
+    mode) then form only the blocks that change. None for a whole long record."""
+    if Z.shape[1] > SCREEN_SAMPLES:
+        return None
+    cuts = list(chunks(s.y.size))
+    key = (Z.__array_interface__["data"][0], Z.shape, Z.strides, len(cuts))
+    memo = s.__dict__.get("_first_grams")
+    if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
+        grams = [X @ X.T for X in (_used_chunk((Z,), s, c)[0][0] for c in cuts)]
+        memo = s.__dict__["_first_grams"] = (key, Z, grams)
+    return memo[2]
+
+
+def _gram(P: tuple, first: np.ndarray | None = None) -> np.ndarray:
+    """``B B^T`` of the rows ``B`` the blocks ``P`` stack, block by block (``first``: that of
+    the first block, when known)."""
     edges = np.cumsum([0] + [X.shape[0] for X in P])
     G = np.empty((edges[-1], edges[-1]))
     for i, X in enumerate(P):
         for j in range(i, len(P)):
-            blk = X @ X.T if j == i else X @ P[j].T
+            blk = (X @ X.T if first is None or i else first) if j == i else X @ P[j].T
             G[edges[i]:edges[i + 1], edges[j]:edges[j + 1]] = blk
             G[edges[j]:edges[j + 1], edges[i]:edges[i + 1]] = blk.T
     return G
@@ -1016,7 +1048,20 @@ def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     if base is None or base[0] != (p["fn"], p["zeta"]):
         base = ((p["fn"], p["zeta"]), mode(h0, p["fn"], p["zeta"], s.dt))
         static[("M1[h0]", id(s))] = base
-    cols = lti_columns(h0, p["fn"], p["zeta"], p["lti"], s.dt, base=base[1])
+    # each element's column memoised for the last base mode (the order selection tries many
+    # sets of elements around one mode; a column does not depend on the others)
+    known = static.get(("lti", id(s)))
+    if known is None or known[0] != base[0]:
+        known = static[("lti", id(s))] = (base[0], {})
+    cols = np.empty((h0.size, len(p["lti"])))
+    for j, el in enumerate(p["lti"]):
+        key = tuple(el)
+        col = known[1].pop(key, None)  # reinserted last: the least recently used goes first
+        if col is None:
+            col = lti_columns(h0, p["fn"], p["zeta"], (el,), s.dt, base=base[1])[:, 0]
+        known[1][key] = cols[:, j] = col
+        if len(known[1]) > LTI_MEMO:
+            del known[1][next(iter(known[1]))]
     return shift(cols, p["d"]) if "d" in p else cols
 
 

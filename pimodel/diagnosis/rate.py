@@ -85,6 +85,7 @@ FAMILY_CODES = (*RATE_FAMILIES, SCALED)  # rate_family of the C core (pim_diagno
 RATE_GROWTHS = (0.1, 0.2, 0.4, 0.8, 1.6)  # G [-] of the scaled shape's grid
 RATE_GROWTH_REFINE = 2**0.25  # then G, S and the filter polished (first steps: 1/4 octave)
 RATE_SCALED_EVALS = 60  # ... by at most this many fits (Nelder-Mead in log G, log S, log tau)
+CONTACT_BYTES = 96 << 20  # a basis keeps its plays' last contacts up to this size (12 B each)
 
 __all__ = [
     "FAMILY_CODES",
@@ -301,6 +302,7 @@ class RateBasis:
         self._starts = [int(g[0]) for g in self.bands]
         self._weighted = None  # band sums of w0_i z_i, built on first use
         self._cache: dict = {}
+        self._contacts = None  # per chunk: each play's last contact and its sign (below)
 
     def rate(self, tau: float) -> np.ndarray:
         """The filtered rate ``rho_f`` of the record (:func:`input_rate`).
@@ -380,6 +382,7 @@ class RateBasis:
         """
         self._cache.clear()
         self._weighted = None
+        self._contacts = None
 
     def _band_sums(self) -> np.ndarray:
         """Band sums ``sum_{i in b} w0_i z_i[k]`` of the nominal plays (built on first use)."""
@@ -440,10 +443,28 @@ class RateBasis:
                 yield c, Zc
 
     def _radius_columns(self, rho: np.ndarray) -> np.ndarray:
-        """Band sums of ``rho_f[last contact of play i] * (-s_i r_i)``, chunk by chunk (the last
-        contact and its sign carried from chunk to chunk; nothing of size N x n is kept)."""
+        """Band sums of ``rho_f[last contact of play i] * (-s_i r_i)``, chunk by chunk. The
+        last contacts and their signs do not depend on the filter: they are found once per
+        basis (:meth:`_contact_chunks`) and kept while they take at most ``CONTACT_BYTES``
+        (a record's screen), so a search over filters costs a gather and a band sum per
+        point; longer records find them again at each call (nothing of size N x n kept)."""
+        out = np.empty((self.v.size, len(self.bands)))
+        contacts = self._contacts
+        if contacts is None:
+            contacts = self._contact_chunks()
+            if self.v.size * self.radii.size * 12 <= CONTACT_BYTES:
+                contacts = self._contacts = list(contacts)
+        for c, last, signed in contacts:
+            per_play = np.take(rho, last)
+            per_play *= signed
+            out[c] = np.add.reduceat(per_play, self._starts, axis=1)
+        return out
+
+    def _contact_chunks(self):
+        """``(slice, last, signed)`` per chunk: each play's last contact sample up to each
+        sample (0 before its first; ``int32``) and ``-gap`` there (``-(-s_i r_i)``, 0 before
+        the first contact), the last contact and its sign carried from chunk to chunk."""
         r, v = self.radii, self.v
-        out = np.empty((v.size, len(self.bands)))
         last_prev = np.full(r.size, -1, dtype=np.int64)
         signed_prev = np.zeros(r.size)
         for c, Zc in self._play_chunks():
@@ -456,11 +477,8 @@ class RateBasis:
             signed = np.where(inside, -np.take_along_axis(gap, np.maximum(local, 0), axis=0),
                               signed_prev)  # -(-s_i r_i) at the last contact
             last = np.where(inside, local + c.start, last_prev)
-            per_play = np.take(rho, np.maximum(last, 0))
-            per_play *= signed
-            out[c] = np.add.reduceat(per_play, self._starts, axis=1)
+            yield c, np.maximum(last, 0).astype(np.int32), signed
             last_prev, signed_prev = last[-1], signed[-1]
-        return out
 
 
 def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
@@ -470,7 +488,8 @@ def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
     ``zs_i[k] = min(max(zs_i[k-1], v[k] - rho_i[k]), v[k] + rho_i[k])``, ``zs_i[-1] = z0``,
     ``rho_i[k] = r_i (1 + G s[k] / (1 + s[k] / S))``, ``s[k]`` the strictly causal filtered
     rate of the module docstring (``s[0] = s[1] = 0``); run by the C core
-    (``pim_rdpi_sat_run``, as :mod:`pimodel.operators.rate_dependent`), one play at a time.
+    (``pim_rdpi_sat_plays``: the plays of ``pim_rdpi_sat_run``, as
+    :mod:`pimodel.operators.rate_dependent`, all on the one rate in one pass).
 
     Parameters
     ----------
@@ -521,13 +540,8 @@ def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
     r = np.asarray(radii, float)
     lam = float(np.exp(-dt / tau))
     sat = 0.0 if saturation is None else saturation * rate_scale
-    out = np.empty((v.size, r.size))
-    one = np.ones(1)
-    for i in range(r.size):
-        z, hist = np.full(1, z0), np.array([v[0], 0.0])
-        out[:, i] = _native.rdpi_sat_run(one, r[i:i + 1].copy(), growth / rate_scale, sat, lam,
-                                         dt, z, hist, v)
-    return out
+    return _native.rdpi_sat_plays(np.ascontiguousarray(r), growth / rate_scale, sat, lam, dt,
+                                  np.full(r.size, z0), np.array([v[0], 0.0]), v)
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,

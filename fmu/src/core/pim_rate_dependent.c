@@ -48,6 +48,22 @@ void pim_rdpi_sat_run(size_t N, size_t n, const double *p, const double *alpha, 
     }
 }
 
+void pim_rdpi_sat_plays(size_t N, size_t n, const double *alpha, double beta, double sat,
+                        double lam, double Ts, double *z, double *hist, const double *v,
+                        double *zs)
+{
+    for (size_t k = 0; k < N; ++k) {
+        const double g = sat > 0.0 ? beta * hist[1] / (1.0 + hist[1] / sat) : beta * hist[1];
+        for (size_t i = 0; i < n; ++i) {
+            const double ri = alpha[i] + alpha[i] * g; /* as pim_rdpi_sat_run */
+            double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
+            z[i] = zi > v[k] - ri ? zi : v[k] - ri;
+            zs[k * n + i] = z[i];
+        }
+        rate_update(hist, v[k], lam, Ts);
+    }
+}
+
 int pim_rdpi_inverse_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
                          double lam, double Ts, double *z, double *hist, const double *yd,
                          double *v)

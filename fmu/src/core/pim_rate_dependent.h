@@ -51,6 +51,16 @@ PIM_API void pim_rdpi_sat_run(size_t N, size_t n, const double *p, const double 
                               double *hist, const double *v, double *y);
 
 /*
+ * The play outputs of pim_rdpi_sat_run instead of their weighted sum: zs[k n + i] = z_i[k]
+ * (row-major N x n), every play on the one rate (computed once per sample); z (n) and hist
+ * (2) are updated in place.  The same steps as pim_rdpi_sat_run with p_i = 1, one play at a
+ * time (tests/test_native_equals_reference.py holds them equal).
+ */
+PIM_API void pim_rdpi_sat_plays(size_t N, size_t n, const double *alpha, double beta,
+                                double sat, double lam, double Ts, double *z, double *hist,
+                                const double *v, double *zs);
+
+/*
  * Exact inverse run: v[k] such that the forward operator with state (z, hist) outputs yd[k];
  * z and hist are the *forward* operator's state and are advanced with v[k].  Returns 0, or
  * -1 when n > PIM_MAX_PLAYS.
