@@ -989,7 +989,10 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             out = [np.ones(s.t.size)]
             h0 = nominal.predict(s)
             if "creep" in effects:
-                out += [lag(h0, tau, s.dt) - h0 for tau in nominal.params["creep_taus"]]
+                # the stage's memory at the start unknown (a start-up mask): the creep's
+                # too; its lags start at the measured first output, not at h0[0]
+                y0 = None if s.mask is None else float(s.y[0])
+                out += [lag(h0, tau, s.dt, y0) - h0 for tau in nominal.params["creep_taus"]]
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 out += [u**2, u**3]

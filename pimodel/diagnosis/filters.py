@@ -16,10 +16,12 @@ from .._native import biquad_rows
 __all__ = ["lag", "mode", "mode_coefficients", "mode_rows", "shift"]
 
 
-def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
-    """First-order lag (exact discretisation), at rest around x[0]; works column-wise.
+def lag(x: np.ndarray, tau: float, dt: float, start: float | None = None) -> np.ndarray:
+    """First-order lag (exact discretisation), at rest around x[0] (or ``start``); works
+    column-wise.
 
-    ``out[k] = a out[k-1] + (1 - a) x[k]`` with ``a = exp(-dt / tau)`` and ``out[-1] = x[0]``.
+    ``out[k] = a out[k-1] + (1 - a) x[k]`` with ``a = exp(-dt / tau)`` and ``out[-1] = x[0]``
+    (``out[-1] = start`` when given: a lag whose memory before the first sample is known).
 
     Parameters
     ----------
@@ -29,6 +31,9 @@ def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
         Time constant [s].
     dt : float
         Sample time [s].
+    start : float, optional
+        ``out[-1]``, the lag's state before the first sample (1-D ``x`` only); default
+        ``x[0]``.
 
     Returns
     -------
@@ -39,8 +44,14 @@ def lag(x: np.ndarray, tau: float, dt: float) -> np.ndarray:
     --------
     >>> np.round(lag(np.array([0.0, 1.0, 1.0, 1.0]), 1e-3, 1e-3), 4).tolist()
     [0.0, 0.6321, 0.8647, 0.9502]
+    >>> np.round(lag(np.zeros(3), 1e-3, 1e-3, start=1.0), 4).tolist()
+    [0.3679, 0.1353, 0.0498]
     """
     a = np.exp(-dt / tau)
+    if start is not None:
+        if x.ndim != 1:
+            raise ValueError(f"start: given for a 1-D signal only, got x of shape {x.shape}")
+        return lfilter([1 - a], [1, -a], x, zi=[a * start])[0]
     zi = np.atleast_1d(a * x[0])[None, :] if x.ndim > 1 else [a * x[0]]
     out, _ = lfilter([1 - a], [1, -a], x, axis=0, zi=zi)
     return out

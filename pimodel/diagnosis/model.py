@@ -266,11 +266,13 @@ class DiagnosedModel:
             Rate effect without a filter: a one-sample jump above ``STEP_SHARE`` of this range
             counts as a step (no rate); default ``ptp(v)``, as the diagnosis.
         measured : array_like, optional
-            The record's measured output: a drift with a level per record
-            (``drift_variant`` ``"levels"`` or ``"settle_levels"``) takes the record's level
-            from it out of fold, as
-            the diagnosis does on a validate record (:func:`.drift.drift_term`); without it,
-            the level the drift's clock predicts. Ignored by other models.
+            The record's measured output, used as the diagnosis uses it on a validate record:
+            a drift with a level per record (``drift_variant`` ``"levels"`` or
+            ``"settle_levels"``) takes the record's level from it out of fold
+            (:func:`.drift.drift_term`; without it, the level the drift's clock predicts);
+            with :attr:`initial_state` ``"unknown"``, the creep's lags start at its first
+            sample ``measured[0]`` (the creep of the stage's unknown memory; without it, at
+            ``h0[0]``). Ignored by other models.
 
         Returns
         -------
@@ -307,9 +309,15 @@ class DiagnosedModel:
             if "delay" in e:
                 cols = shift(cols, p["delay_samples"])
             y = y + cols @ np.asarray(p["lti_gains"], float)
+        y_meas = None if measured is None else checked_signal(measured, "measured")
+        if y_meas is not None and y_meas.shape != v.shape:
+            raise ValueError(f"measured: expected {v.size} samples like v, got {y_meas.shape}")
         if "creep" in e:
+            # memory unknown at the start: the lags start at the measured first output
+            y0 = float(y_meas[0]) if y_meas is not None and self.initial_state == "unknown" \
+                else None
             for g, tau in zip(p["creep_lag_gains"], p["creep_time_constants_s"], strict=True):
-                y = y + g * (lag(h0, tau, self.dt) - h0)
+                y = y + g * (lag(h0, tau, self.dt, y0) - h0)
         if "asymmetry" in e:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
@@ -327,10 +335,6 @@ class DiagnosedModel:
                              saturation=rate_saturation(p))
             y = y + R @ gains
         if "drift" in e:
-            y_meas = None if measured is None else checked_signal(measured, "measured")
-            if y_meas is not None and y_meas.shape != v.shape:
-                raise ValueError(f"measured: expected {v.size} samples like v, got "
-                                 f"{y_meas.shape}")
             y = y + drift_term(p, tk, y, y_meas)
         return check_finite(y, v, "v")
 
