@@ -12,7 +12,7 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from pimodel import PIOperator, estimate_radii, identify, load_record
@@ -185,6 +185,10 @@ def test_identify_on_plausible_short_records(rec, dt, n_plays, method, passes):
 @given(weights=hostile_vector, dt=hostile_float, gains=st.one_of(hostile_float, hostile_vector),
        initial_radii=st.one_of(st.none(), hostile_vector), threshold=hostile_float,
        slope_window=st.one_of(st.integers(-3, 40), st.just(2.5)))
+# found by a fresh install's Hypothesis: dt |p|^2 underflowed to 0 in default_settings
+# (ZeroDivisionError); now a ValueError naming dt
+@example(weights=[2.6699028801315387e-128], dt=1.835951004970897e-210, gains=[],
+         initial_radii=None, threshold=-1.175494351e-38, slope_window=2.5)
 def test_estimate_radii_argument_checks(weights, dt, gains, initial_radii, threshold,
                                         slope_window):
     RUNS["estimate_radii"] += 1

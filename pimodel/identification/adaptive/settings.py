@@ -204,6 +204,10 @@ def default_settings(v, y, weights, *, dt: float) -> dict:
     span_v = float(np.ptp(x))
     sig_y, sig_v = noise_level(m), noise_level(x)
     noisy = sig_y > 1e-4 * float(np.ptp(m))
+    if not dt * pp > 0.0:  # the step bound's dt |p|^2 underflows
+        raise ValueError(f"dt: dt |p|^2 = {dt!r} * {pp!r} underflows to 0; expected a sample "
+                         "time and weights whose product float64 holds (rescale the time or "
+                         "output units)")
     gains = min(G_CLEAN / pp, STEP_BOUND / (dt * pp))
     if noisy:
         gains = min(gains, float(G_NOISE * span_v / (np.sqrt(dt) * sig_y * np.sqrt(pp))))
