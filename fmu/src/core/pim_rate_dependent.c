@@ -24,6 +24,20 @@ static void rate_update(double *hist, double v, double lam, double Ts)
     hist[0] = v;
 }
 
+/* the radii's relative growth g at the rate hist[1]: r_i = alpha_i + alpha_i g */
+static double rate_growth(const double *hist, double beta, double sat)
+{
+    return sat > 0.0 ? beta * hist[1] / (1.0 + hist[1] / sat) : beta * hist[1];
+}
+
+/* one play of radius alpha_i (1 + g) at the input v (alpha_1 = 0 stays 0) */
+static double rate_play(double z, double alpha_i, double g, double v)
+{
+    const double ri = alpha_i + alpha_i * g;
+    const double zi = z < v + ri ? z : v + ri;
+    return zi > v - ri ? zi : v - ri;
+}
+
 void pim_rdpi_run(size_t N, size_t n, const double *p, const double *alpha, double beta,
                   double lam, double Ts, double *z, double *hist, const double *v, double *y)
 {
@@ -36,11 +50,9 @@ void pim_rdpi_sat_run(size_t N, size_t n, const double *p, const double *alpha, 
 {
     for (size_t k = 0; k < N; ++k) {
         double acc = 0.0;
-        const double g = sat > 0.0 ? beta * hist[1] / (1.0 + hist[1] / sat) : beta * hist[1];
+        const double g = rate_growth(hist, beta, sat);
         for (size_t i = 0; i < n; ++i) {
-            const double ri = alpha[i] + alpha[i] * g; /* alpha_1 = 0 stays 0 */
-            double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
-            z[i] = zi > v[k] - ri ? zi : v[k] - ri;
+            z[i] = rate_play(z[i], alpha[i], g, v[k]);
             acc += p[i] * z[i];
         }
         y[k] = acc;
@@ -53,13 +65,8 @@ void pim_rdpi_sat_plays(size_t N, size_t n, const double *alpha, double beta, do
                         double *zs)
 {
     for (size_t k = 0; k < N; ++k) {
-        const double g = sat > 0.0 ? beta * hist[1] / (1.0 + hist[1] / sat) : beta * hist[1];
-        for (size_t i = 0; i < n; ++i) {
-            const double ri = alpha[i] + alpha[i] * g; /* as pim_rdpi_sat_run */
-            double zi = z[i] < v[k] + ri ? z[i] : v[k] + ri;
-            z[i] = zi > v[k] - ri ? zi : v[k] - ri;
-            zs[k * n + i] = z[i];
-        }
+        const double g = rate_growth(hist, beta, sat);
+        for (size_t i = 0; i < n; ++i) zs[k * n + i] = z[i] = rate_play(z[i], alpha[i], g, v[k]);
         rate_update(hist, v[k], lam, Ts);
     }
 }
