@@ -133,3 +133,15 @@ def test_bad_input():
         DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3, effects=("wobble",))
     with pytest.raises(ValueError, match="missing key 'weights'"):
         DiagnosedModel.from_dict({"type": "DiagnosedModel", "radii": [0.0]})
+
+
+def test_simulate_names_a_measured_output_of_the_wrong_length():
+    """``measured`` is checked for every model (a creep with an unknown start reads its first
+    sample): a length other than ``v``'s is a ValueError naming it."""
+    m = DiagnosedModel([0.0, 0.5], [1.0, 0.5], 0.0, dt=1e-3, effects=("creep",),
+                       params={"creep_lag_gains": [0.05], "creep_time_constants_s": [0.1]},
+                       initial_state="unknown")
+    with pytest.raises(ValueError, match="measured: expected 3 samples like v"):
+        m.simulate([0.0, 1.0, 0.0], measured=[0.0, 1.0])
+    y = m.simulate([0.0, 1.0, 0.0], measured=[0.3, 1.0, 0.0])
+    assert np.all(np.isfinite(y)) and not np.allclose(y, m.simulate([0.0, 1.0, 0.0]))

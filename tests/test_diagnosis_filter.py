@@ -43,3 +43,17 @@ def test_mode_helpers_use_it_on_rows_and_columns():
     assert np.max(np.abs(mode_rows(np.ascontiguousarray(x.T), 800.0, 0.05, 1e-4) - ref)) < 1e-12
     assert np.max(np.abs(mode(x, 800.0, 0.05, 1e-4) - ref.T)) < 1e-12
     assert np.max(np.abs(mode(x[:, 0], 800.0, 0.05, 1e-4) - ref[0])) < 1e-12
+
+
+def test_lag_from_a_known_start_and_its_argument_check():
+    """``lag(..., start=s)``: the lag's state before the first sample is ``s`` (its free
+    response decays from there); equal to the default when ``s = x[0]``; 2-D ``x`` refused."""
+    from pimodel.diagnosis.filters import lag
+
+    x = np.sin(np.arange(50) * 0.3)
+    np.testing.assert_array_equal(lag(x, 0.01, 1e-3, start=float(x[0])), lag(x, 0.01, 1e-3))
+    a = np.exp(-1e-3 / 0.01)
+    free = lag(x, 0.01, 1e-3, start=2.0) - lag(x, 0.01, 1e-3, start=0.0)
+    np.testing.assert_allclose(free, 2.0 * a ** np.arange(1, 51), rtol=1e-12, atol=1e-15)
+    with pytest.raises(ValueError, match="start: given for a 1-D signal only"):
+        lag(np.zeros((5, 2)), 0.01, 1e-3, start=0.0)

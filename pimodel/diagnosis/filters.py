@@ -48,11 +48,10 @@ def lag(x: np.ndarray, tau: float, dt: float, start: float | None = None) -> np.
     [0.3679, 0.1353, 0.0498]
     """
     a = np.exp(-dt / tau)
-    if start is not None:
-        if x.ndim != 1:
-            raise ValueError(f"start: given for a 1-D signal only, got x of shape {x.shape}")
-        return lfilter([1 - a], [1, -a], x, zi=[a * start])[0]
-    zi = np.atleast_1d(a * x[0])[None, :] if x.ndim > 1 else [a * x[0]]
+    if start is not None and x.ndim != 1:
+        raise ValueError(f"start: given for a 1-D signal only, got x of shape {x.shape}")
+    x0 = x[0] if start is None else start
+    zi = np.atleast_1d(a * x0)[None, :] if x.ndim > 1 else [a * x0]
     out, _ = lfilter([1 - a], [1, -a], x, axis=0, zi=zi)
     return out
 
