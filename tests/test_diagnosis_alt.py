@@ -90,6 +90,17 @@ def test_alt_outside_library_is_unexplained(effect):
     assert v["unexplained"]["where"]
 
 
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
+def test_alt_revision_keeps_a_scaled_rate_whole():
+    """Seed 5's second input: the combination's rate takes the exact (scaled) shape, the rate
+    fitted alone another family; the revision's refit kept the combination's rate filter but
+    not its growth (absent from the single fit's grid) and raised a TypeError. It keeps the
+    rate's parameters together now, and the outside effect is named."""
+    v = diagnose(*alt_records(["second_input"], 5, "record"), initial_state="unknown").verdict
+    assert "unexplained" in v["effects"]
+    assert v["gap_after"] > 2 * v["noise_floor"]
+
+
 @pytest.mark.parametrize("pair,clock", [
     (("delay", "drift"), "record"),  # a fractional delay; drift restarting with each record
     (("asymmetry", "drift"), "absolute"),  # drift on the clock the records share

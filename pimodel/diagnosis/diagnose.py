@@ -74,7 +74,7 @@ from .effects import (
 )
 from .gain import gain_note, record_gains
 from .noise import measure_noise_floor
-from .rate import RateBasis, rate_shapes
+from .rate import RATE_KEYS, RateBasis, rate_shapes
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
 
@@ -883,8 +883,10 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise):
     combination without it (or whose removal leaves the gap within ``NOISE_STOP`` times the
     noise floor). Other effects keep their grid parameters; returns ``(chosen, model,
     validate outputs)``."""
-    def keys_of(e):  # grid parameters of an effect, as its single fit reports them
-        return set(fit(e)[0].grid) | (set(DRIFT_KEYS) if e == "drift" else set())
+    def keys_of(e):  # grid parameters of an effect, as its single fit reports them (a drift's
+        # and a rate's all of their kind: a single fit of another family or variant lacks some,
+        # e.g. rate_growth, which a held SCALED rate needs)
+        return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS}.get(e, ()))
 
     def refit(effects):
         if not effects:

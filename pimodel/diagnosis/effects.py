@@ -35,6 +35,7 @@ from .rate import (
     RATE_FAMILIES,
     RATE_GROWTH_REFINE,
     RATE_GROWTHS,
+    RATE_KEYS,
     RATE_POLISH_ROUNDS,
     RATE_SATURATION_REFINE,
     RATE_SATURATIONS,
@@ -711,9 +712,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
                          if "clock" in fixed else
                          [{"clock": c} for c in DRIFT_CLOCKS if c not in ("levels", "settle")])
         elif e == "rate":  # the filter is searched after the other grids (below)
-            grids.append([{k_: fixed.get(k_) for k_ in ("rate_family", "rate_tau",
-                                                         "rate_saturation", "rate_growth")}]
-                         if "rate_tau" in fixed else
+            grids.append([{k_: fixed.get(k_) for k_ in RATE_KEYS}] if "rate_tau" in fixed else
                          [{"rate_family": f, "rate_tau": RATE_TAU_START, "rate_saturation": None}
                           for f in RATE_FAMILIES])
     points = [{}]

@@ -81,6 +81,8 @@ RATE_SATURATIONS = (None, 4.0, 2.0, 1.0, 0.5)  # S [-]: rho_f / (1 + rho_f / S),
 RATE_SATURATION_REFINE = 2**0.25  # then steps of S (1/4 octave) and of the filter (1/8 decade)
 RATE_POLISH_ROUNDS = 4  # ... in turn, while the train residual falls
 SCALED = "scaled"  # the exact shape: plays whose radii scale with the rate (module docstring)
+# a rate candidate's grid parameters, held or searched together (rate_growth: SCALED only)
+RATE_KEYS = ("rate_family", "rate_tau", "rate_saturation", "rate_growth")
 FAMILY_CODES = (*RATE_FAMILIES, SCALED)  # rate_family of the C core (pim_diagnosed.h): 0, 1, 2
 RATE_GROWTHS = (0.1, 0.2, 0.4, 0.8, 1.6)  # G [-] of the scaled shape's grid
 RATE_GROWTH_REFINE = 2**0.25  # then G, S and the filter polished (first steps: 1/4 octave)
@@ -91,6 +93,7 @@ __all__ = [
     "FAMILY_CODES",
     "RATE_BANDS",
     "RATE_FAMILIES",
+    "RATE_KEYS",
     "RATE_GROWTHS",
     "RATE_GROWTH_REFINE",
     "RATE_POLISH_ROUNDS",
