@@ -19,9 +19,13 @@ effect passes in the first round, every pair is fitted jointly and the best pair
 same terms (two effects can mask each other). A further effect beside those chosen must also
 pass, on the same terms, against each chosen effect's own model refined one step (a further
 creep lag, a further element of the linear part of ``dynamics``: a low-pass or a mode), so the
-misfit of one effect is not named as another (issue 28). After each accepted effect, a lag
-chosen earlier (``dynamics`` or ``delay``, one of them) is searched again beside it and the other
-lag tried in its place, the lowest validate BIC kept (:func:`_research_lag`). Then the choice is
+misfit of one effect is not named as another (issue 28). Beside a chosen ``rate``, an effect
+that lowers the BIC but cuts the RMS by less also passes when it passes with the rate's own
+misfit on validate set aside (:mod:`.misfit`: the rate's extrapolation to faster validate input
+can leave an error no other effect cuts; a yardstick, never the model kept). After each
+accepted effect, a lag chosen earlier (``dynamics`` or ``delay``, one of them) is searched
+again beside it and the other lag tried in its place, the lowest validate BIC kept
+(:func:`_research_lag`). Then the choice is
 revised on the same terms: a chosen effect is swapped for an unchosen one while that passes, and
 an effect that no longer passes against the combination without it is dropped (an effect chosen
 early can stand in for one that only passes beside a later one). Last, a chosen ``dynamics``
