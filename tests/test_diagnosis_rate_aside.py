@@ -75,6 +75,27 @@ def test_rate_correction_recovers_the_misfit_but_not_a_level():
     assert rate_correction(("creep",), fixed, fit, va) is None
 
 
+def test_a_change_that_fits_validate_worse_is_no_correction():
+    """The model's shape also moves its level with its parameters: the refinement on the
+    detrended residual moves the level away from the records', so the plain validate RSS
+    grows, and nothing is set aside."""
+    rng = np.random.default_rng(7)
+    va = _segments(rng, 1)
+    true, start = np.array([0.5, 0.8, 0.04]), np.array([0.4, 1.0, 0.05])
+    keys = ("rate_growth", "rate_saturation", "rate_tau")
+
+    def shape(theta, t):
+        return _shape(theta, t) + 30.0 * (theta[0] - start[0])  # a level that follows G
+
+    va[0].y = _shape(true, va[0].t) + rng.normal(0.0, 0.01, va[0].t.size)  # no level moved
+
+    def fit(name, combo, fixed):
+        return None, [shape([fixed[k] for k in keys], s.t) for s in va]
+
+    fixed = {"rate_family": "scaled", **dict(zip(keys, start.tolist(), strict=True))}
+    assert rate_correction(("rate",), fixed, fit, va) is None
+
+
 def test_an_effect_masked_by_the_rates_misfit_passes_once_it_is_set_aside():
     """The current model's residual: a large error the chosen rate makes (set aside by the
     correction) plus a level a drift takes. Against the current model the drift cuts the RMS
@@ -91,6 +112,8 @@ def test_an_effect_masked_by_the_rates_misfit_passes_once_it_is_set_aside():
     assert not _passes(va, with_drift, current)
     assert _passes_rate_aside(va, with_drift, current, lambda: [misfit])
     assert not _passes_rate_aside(va, with_drift, current, lambda: None)
+    # once the rate's misfit is set aside, the current model is within the stop: no pass
+    assert not _passes_rate_aside(va, with_drift, current, lambda: [misfit], stop=0.1)
     calls = []
     assert not _passes_rate_aside(va, current, current, lambda: calls.append(1) or [misfit])
     assert not calls

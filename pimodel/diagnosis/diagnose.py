@@ -720,7 +720,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 progress("the rate's own misfit set aside")
                 corrections[key] = rate_correction(old_effects, fixed_, fit, va)
             return corrections[key]
-        return _passes(va, new, old) or _passes_rate_aside(va, new, old, correction)
+        return _passes(va, new, old) or _passes_rate_aside(va, new, old, correction,
+                                                           NOISE_STOP * noise)
 
     def choose(start=None):
         """The greedy rounds, the revision and the delay preference; ``start`` forces
@@ -956,21 +957,24 @@ def _passes(va, new, old) -> bool:
             and _errors(va, o)["rms"] <= (1 - MIN_RMS_CUT) * _errors(va, ob)["rms"])
 
 
-def _passes_rate_aside(va, new, old, correction: Callable) -> bool:
+def _passes_rate_aside(va, new, old, correction: Callable, stop: float = 0.0) -> bool:
     """Whether ``new`` passes against ``old`` once the chosen rate's own misfit on validate
     is set aside: ``new`` lowers the validate BIC by ``MIN_BIC_DROP`` as it is, and passes
     :func:`_passes` with ``correction()`` (:func:`.misfit.rate_correction`, computed only
-    then; None: no rate to refine) added to both models' validate outputs. A rate fitted on
-    slow train records and extrapolated to fast validate ones leaves an error no other effect
-    can cut; a real drift beside it then cut the validate RMS by 3-6 % only."""
+    then; None: no refinement to set aside) added to both models' validate outputs, while
+    ``old`` so corrected stays above ``stop`` (the diagnosis: ``NOISE_STOP`` noise floors,
+    where the rounds stop). A rate fitted on slow train records and extrapolated to fast
+    validate ones leaves an error no other effect can cut; a real drift beside it then cut
+    the validate RMS by 3-6 % only."""
     (m, o), (mb, ob) = new, old
     if _bic(va, o, m.k) - _bic(va, ob, mb.k) > -MIN_BIC_DROP:
         return False
     c = correction()
     if c is None:
         return False
-    return _passes(va, (m, [x + d for x, d in zip(o, c, strict=True)]),
-                   (mb, [x + d for x, d in zip(ob, c, strict=True)]))
+    old_c = [x + d for x, d in zip(ob, c, strict=True)]
+    return _errors(va, old_c)["rms"] > stop and _passes(
+        va, (m, [x + d for x, d in zip(o, c, strict=True)]), (mb, old_c))
 
 
 def _beyond_refinement(new, chosen, fixed, fit, va) -> bool:

@@ -14,7 +14,8 @@ removed (:func:`detrended_rss`), so that the refinement cannot stand in for a le
 trend (what a drift or an offset gives). Its change of the validate outputs
 (:func:`rate_correction`) is added to both models being compared: the further effect must
 then pass on the same terms against what is left once the rate's own extrapolation error is
-set aside. The refinement is a yardstick only, never the model kept (that would fit validate).
+set aside. The refinement is a yardstick only, never the model kept (that would fit validate),
+and only a refinement: it must lower the plain validate RSS as well.
 
 Discrete-time form: for validate record ``j`` with fitted samples ``k``, the detrended
 residual is ``e[k] - a_j - b_j (t[k] - tbar_j)`` with ``a_j, b_j`` the least-squares level and
@@ -91,8 +92,11 @@ def rate_correction(effects: tuple[str, ...], fixed: dict, fit: Callable, va
     -------
     list of numpy.ndarray or None
         One array per validate record (outputs at the refined parameters minus those at
-        ``fixed``); None without a rate among ``effects`` or without a positive continuous
-        parameter to refine.
+        ``fixed``); None without a rate among ``effects``, without a positive continuous
+        parameter to refine, or when the refined rate does not also lower the plain validate
+        RSS (its level and trend counted): a change that fits validate worse is no refinement,
+        and beside another effect of the input history it set aside what that effect then
+        took (``preisach_stage`` rate + creep: a spurious asymmetry).
 
     Examples
     --------
@@ -116,6 +120,11 @@ def rate_correction(effects: tuple[str, ...], fixed: dict, fit: Callable, va
                     initial_simplex=[x0, *(x0 + step * np.eye(len(keys))[i]
                                            for i in range(len(keys)))],
                     xatol=1e-3, fatol=1e-9 * rss0, maxfev=CORRECTION_EVALS)
-    if not r.fun < rss0:
-        return [np.zeros_like(o) for o in start]
-    return [o - o0 for o, o0 in zip(outputs(r.x), start, strict=True)]
+    refined = outputs(r.x)
+    if not (r.fun < rss0 and _rss(va, refined) < _rss(va, start)):
+        return None  # no refinement on these records: a change that fits validate worse
+    return [o - o0 for o, o0 in zip(refined, start, strict=True)]
+
+
+def _rss(segs, outputs) -> float:
+    return sum(float(np.sum((s.y - o)[s.used] ** 2)) for s, o in zip(segs, outputs, strict=True))
