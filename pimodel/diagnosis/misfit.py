@@ -1,21 +1,23 @@
-"""The chosen rate's own misfit on the validate records, set aside when a further effect is
-judged beside it (issue 28: a second effect only when it is real, and then whenever it is).
+"""The chosen rate's own misfit on the validate records, set aside when a drift is judged
+beside it (issue 28: a second effect only when it is real, and then whenever it is).
 
 The ``rate`` candidate is fitted on train and extrapolated to the validate records; where the
 train records' speeds do not pin its saturation, the extrapolation to faster validate input
-leaves several noise floors (docs/diagnosis.md, ``density_stage`` seeds 8 and 9). A further
-effect judged against that residual must cut an error that is not its own: a real thermal
-drift cut the validate RMS by 3-6 % beside it, under the 20 % the diagnosis asks.
+leaves several noise floors (docs/diagnosis.md, ``density_stage`` seeds 8 and 9). A drift
+judged against that residual must cut an error that is not its own: a real thermal drift cut
+the validate RMS by 3-6 % beside it, under the 20 % the diagnosis asks.
 
 The yardstick: the rate refined **on the validate records** in its continuous parameters only
 (growth ``G``, saturation ``S`` and filter ``tau``; its weights and gains still fitted on
 train at each point), by the residual with each record's level and linear trend in time
 removed (:func:`detrended_rss`), so that the refinement cannot stand in for a level or a
 trend (what a drift or an offset gives). Its change of the validate outputs
-(:func:`rate_correction`) is added to both models being compared: the further effect must
-then pass on the same terms against what is left once the rate's own extrapolation error is
-set aside. The refinement is a yardstick only, never the model kept (that would fit validate),
-and only a refinement: it must lower the plain validate RSS as well.
+(:func:`rate_correction`) is added to both models being compared: the drift must then pass
+on the same terms against what is left once the rate's own extrapolation error is set aside.
+Only the drift is judged so (:mod:`.diagnose`): the refinement leaves out exactly what the
+drift models, while an effect of the input history can take part of the rate's misfit the
+refinement leaves. The refinement is a yardstick only, never the model kept (that would fit
+validate), and only a refinement: it must lower the plain validate RSS as well.
 
 Discrete-time form: for validate record ``j`` with fitted samples ``k``, the detrended
 residual is ``e[k] - a_j - b_j (t[k] - tbar_j)`` with ``a_j, b_j`` the least-squares level and
