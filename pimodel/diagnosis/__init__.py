@@ -17,6 +17,7 @@ Modules
     chunked             least squares over chunks of a record (normal equations, running QR)
     filters             the discrete filters effects are built of: lag, mode, delay shift
     rate                the rate candidate's columns (radii or weights growing with the rate)
+    misfit              a chosen rate's own misfit on validate, set aside to judge a further effect
     drift               the drift candidate: clocks, levels per record, its term
     lti                 the dynamics' linear part: elements, order by BIC, approximate inverse
     wiener              the dynamics as a filter before the hysteresis (a Wiener model)
