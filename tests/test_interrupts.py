@@ -54,9 +54,13 @@ def _interrupt_then_resume(tmp_path: Path, workers: int) -> None:
     script = tmp_path / "sweep_script.py"
     script.write_text(textwrap.dedent(SCRIPT.format(log=str(log), cache=str(cache),
                                                     workers=workers)))
+    # Ctrl-C's default action in the sweep, as in a terminal, also where this run was started
+    # with SIGINT ignored (a background job of a shell without job control, nohup): Python keeps
+    # an ignored SIGINT ignored, and the sweep would never see it
     proc = subprocess.Popen([sys.executable, str(script)], env={**os.environ, "HANG": "1"},
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         _wait_for(lambda: len(list(cache.glob("*.json"))) >= 3 and log.exists()
                   and "3" in log.read_text().split(), timeout=240)
