@@ -48,53 +48,117 @@ PIM_API double pim_pi_step(size_t n, const double *p, const double *r, double *z
 /*
  * pim_pi_step's body, inline for the loops that run it once per sample (pim_pi_run, the
  * generalized operator, the FMU units): each play clamped into [v - r_i, v + r_i] with
- * comparisons (no branch), and the weighted sum in two interleaved partial sums, the odd plays
- * and the even plays, added at the end:
+ * comparisons (no branch), and the weighted sum in four interleaved partial sums, plays
+ * 1, 5, 9, ...; 2, 6, 10, ...; 3, 7, 11, ...; 4, 8, 12, ..., each started by its first term
+ * (0 while empty) and added at the end as
  *
- *     y = (p_1 z_1 + p_3 z_3 + ...) + (p_2 z_2 + p_4 z_4 + ...)
+ *     y = (s_1 + s_3) + (s_2 + s_4),   s_c = p_c z_c + p_(c+4) z_(c+4) + ...
  *
  * (one order for every caller, so that they agree to the last bit).  Two plays per vector
- * operation (SSE2), and a chain of n/2 additions per sample instead of n.  The loop counts
- * pairs; a count known only at run time unrolled twice (the small n of the FMUs pay its set-up
- * and branches every sample), one known when compiled (pim_pi_step_small) unrolled completely
- * by the compiler; the order of the additions does not change.  p, r and z must not overlap.
+ * operation (SSE2 where the compiler has it, the same operations in scalar code elsewhere),
+ * and a chain of about n/4 additions per sample.  One known when compiled (pim_pi_step_small)
+ * is unrolled completely by the compiler; the order of the additions does not change.
+ * p, r and z must not overlap.
  */
-#define PIM_PI_PAIR(i)                                                                         \
+#if defined(__SSE2__)
+#include <emmintrin.h>
+
+/* Plays i + 1 and i + 2 at input (v, v): z updated, (p_i z_i, p_(i+1) z_(i+1)) returned;
+ * minpd/maxpd return their first operand when it compares less/greater, else the second,
+ * as the scalar code's comparisons. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline __m128d pim_pi_pair(const double *PIM_RESTRICT p, const double *PIM_RESTRICT r,
+                                  double *PIM_RESTRICT z, __m128d vv, size_t i)
+{
+    const __m128d ri = _mm_loadu_pd(r + i);
+    __m128d a = _mm_min_pd(_mm_loadu_pd(z + i), _mm_add_pd(vv, ri));
+    a = _mm_max_pd(a, _mm_sub_pd(vv, ri));
+    _mm_storeu_pd(z + i, a);
+    return _mm_mul_pd(_mm_loadu_pd(p + i), a);
+}
+#endif
+
+/* Play i + 1 alone at input v: z[i] updated, p_i z_i returned. */
+#define PIM_PI_ONE(i, out)                                                                     \
     do {                                                                                       \
         const size_t i_ = (i);                                                                 \
         double a = z[i_] < v + r[i_] ? z[i_] : v + r[i_];                                      \
-        double b = z[i_ + 1] < v + r[i_ + 1] ? z[i_ + 1] : v + r[i_ + 1];                      \
         a = a > v - r[i_] ? a : v - r[i_];                                                     \
-        b = b > v - r[i_ + 1] ? b : v - r[i_ + 1];                                             \
         z[i_] = a;                                                                             \
-        z[i_ + 1] = b;                                                                         \
-        y_odd += p[i_] * a;                                                                    \
-        y_even += p[i_ + 1] * b;                                                               \
+        out = p[i_] * a;                                                                       \
     } while (0)
 
 static inline double pim_pi_step_inline(size_t n, const double *PIM_RESTRICT p,
                                         const double *PIM_RESTRICT r, double *PIM_RESTRICT z,
                                         double v)
 {
-    double y_odd = 0.0, y_even = 0.0; /* plays 1, 3, ... and 2, 4, ... (indices 0, 2, ...) */
-    const size_t pairs = n / 2;
-#if defined(__GNUC__) && !defined(__clang__)
-    if (!__builtin_constant_p(pairs)) {
-#pragma GCC unroll 2
-        for (size_t j = 0; j < pairs; ++j) PIM_PI_PAIR(2 * j);
-    } else
-#endif
-        for (size_t j = 0; j < pairs; ++j) PIM_PI_PAIR(2 * j);
-    if (n & 1) {
-        const size_t i = n - 1;
-        double a = z[i] < v + r[i] ? z[i] : v + r[i];
-        a = a > v - r[i] ? a : v - r[i];
-        z[i] = a;
-        y_odd += p[i] * a;
+    size_t i = 0;
+#if defined(__SSE2__)
+    /* the partial sums (s_1, s_2) and (s_3, s_4) */
+    const __m128d vv = _mm_set1_pd(v);
+    __m128d s12 = _mm_setzero_pd(), s34 = _mm_setzero_pd();
+    if (n >= 4) {
+        s12 = pim_pi_pair(p, r, z, vv, 0);
+        s34 = pim_pi_pair(p, r, z, vv, 2);
+        for (i = 4; i + 4 <= n; i += 4) {
+            s12 = _mm_add_pd(s12, pim_pi_pair(p, r, z, vv, i));
+            s34 = _mm_add_pd(s34, pim_pi_pair(p, r, z, vv, i + 2));
+        }
     }
-    return y_odd + y_even;
+    if (i + 2 <= n) {
+        s12 = i ? _mm_add_pd(s12, pim_pi_pair(p, r, z, vv, i)) : pim_pi_pair(p, r, z, vv, i);
+        i += 2;
+    }
+    if (i < n) { /* the last play of an odd n: play 4k + 1 (s_1) or 4k + 3 (s_3) */
+        double t;
+        PIM_PI_ONE(i, t);
+        if (i & 2)
+            s34 = _mm_add_sd(s34, _mm_set_sd(t));
+        else
+            s12 = _mm_add_sd(s12, _mm_set_sd(t));
+    }
+    const __m128d s = _mm_add_pd(s12, s34); /* (s_1 + s_3, s_2 + s_4) */
+    return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
+#else
+    double s1 = 0.0, s2 = 0.0, s3 = 0.0, s4 = 0.0, t1, t2;
+#define PIM_PI_TWO(i, sa, sb, first)                                                           \
+    do {                                                                                       \
+        PIM_PI_ONE((i), t1);                                                                   \
+        PIM_PI_ONE((i) + 1, t2);                                                               \
+        if (first) {                                                                           \
+            sa = t1;                                                                           \
+            sb = t2;                                                                           \
+        } else {                                                                               \
+            sa += t1;                                                                          \
+            sb += t2;                                                                          \
+        }                                                                                      \
+    } while (0)
+    if (n >= 4) {
+        PIM_PI_TWO(0, s1, s2, 1);
+        PIM_PI_TWO(2, s3, s4, 1);
+        for (i = 4; i + 4 <= n; i += 4) {
+            PIM_PI_TWO(i, s1, s2, 0);
+            PIM_PI_TWO(i + 2, s3, s4, 0);
+        }
+    }
+    if (i + 2 <= n) {
+        PIM_PI_TWO(i, s1, s2, i == 0);
+        i += 2;
+    }
+#undef PIM_PI_TWO
+    if (i < n) {
+        PIM_PI_ONE(i, t1);
+        if (i & 2)
+            s3 += t1;
+        else
+            s1 += t1;
+    }
+    return (s1 + s3) + (s2 + s4);
+#endif
 }
-#undef PIM_PI_PAIR
+#undef PIM_PI_ONE
 
 /* The n up to which pim_pi_step_small has a straight line of code for each n. */
 #define PIM_PI_SMALL_N 16
