@@ -48,24 +48,27 @@ PIM_API double pim_pi_step(size_t n, const double *p, const double *r, double *z
 /*
  * pim_pi_step's body, inline for the loops that run it once per sample (pim_pi_run, the
  * generalized operator, the FMU units): each play clamped into [v - r_i, v + r_i] with
- * comparisons (no branch), and the weighted sum in four interleaved partial sums, plays
- * 1, 5, 9, ...; 2, 6, 10, ...; 3, 7, 11, ...; 4, 8, 12, ..., each started by its first term
- * (0 while empty) and added at the end as
+ * comparisons (no branch), and the weighted sum in four interleaved partial sums, each in play
+ * order and started by its first term (0 while empty), added at the end:
  *
- *     y = (s_1 + s_3) + (s_2 + s_4),   s_c = p_c z_c + p_(c+4) z_(c+4) + ...
+ *     s_c = p_c z_c + p_(c+4) z_(c+4) + ...   (c = 1..4)
+ *     y   = (s_1 + s_3) + (s_2 + s_4)
  *
- * (one order for every caller, so that they agree to the last bit).  Two plays per vector
- * operation (SSE2 where the compiler has it, the same operations in scalar code elsewhere),
- * and a chain of about n/4 additions per sample.  One known when compiled (pim_pi_step_small)
- * is unrolled completely by the compiler; the order of the additions does not change.
- * p, r and z must not overlap.
+ * One order for every caller, so that they agree to the last bit (tests/test_native_sum_order.py
+ * holds it to this formula).  Two plays per vector operation ((s_1, s_2) and (s_3, s_4): SSE2
+ * where the compiler has it, unless PIM_NO_SIMD; the same operations in scalar code
+ * elsewhere), and a chain of about n/4 dependent additions per sample, which is what limits a
+ * sample's speed more than the count of instructions (docs/fmu.md, Speed).  A count known when
+ * compiled (pim_pi_step_small) is unrolled completely by the compiler.  p, r and z must not
+ * overlap.
  */
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(PIM_NO_SIMD)
+#define PIM_PI_SSE2 1
 #include <emmintrin.h>
 
-/* Plays i + 1 and i + 2 at input (v, v): z updated, (p_i z_i, p_(i+1) z_(i+1)) returned;
- * minpd/maxpd return their first operand when it compares less/greater, else the second,
- * as the scalar code's comparisons. */
+/* Plays i + 1 and i + 2 at input (v, v): z updated, (p_i z_i, p_(i+1) z_(i+1)) returned.
+ * minpd and maxpd return their first operand when it compares less (greater), else the second:
+ * the scalar code's comparisons. */
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
@@ -80,7 +83,7 @@ static inline __m128d pim_pi_pair(const double *PIM_RESTRICT p, const double *PI
 }
 #endif
 
-/* Play i + 1 alone at input v: z[i] updated, p_i z_i returned. */
+/* Play i + 1 alone at input v: z[i] updated, p_i z_i into `out`. */
 #define PIM_PI_ONE(i, out)                                                                     \
     do {                                                                                       \
         const size_t i_ = (i);                                                                 \
@@ -95,10 +98,10 @@ static inline double pim_pi_step_inline(size_t n, const double *PIM_RESTRICT p,
                                         double v)
 {
     size_t i = 0;
-#if defined(__SSE2__)
-    /* the partial sums (s_1, s_2) and (s_3, s_4) */
+    double t;
+#ifdef PIM_PI_SSE2
     const __m128d vv = _mm_set1_pd(v);
-    __m128d s12 = _mm_setzero_pd(), s34 = _mm_setzero_pd();
+    __m128d s12 = _mm_setzero_pd(), s34 = _mm_setzero_pd(); /* (s_1, s_2), (s_3, s_4) */
     if (n >= 4) {
         s12 = pim_pi_pair(p, r, z, vv, 0);
         s34 = pim_pi_pair(p, r, z, vv, 2);
@@ -107,55 +110,26 @@ static inline double pim_pi_step_inline(size_t n, const double *PIM_RESTRICT p,
             s34 = _mm_add_pd(s34, pim_pi_pair(p, r, z, vv, i + 2));
         }
     }
-    if (i + 2 <= n) {
-        s12 = i ? _mm_add_pd(s12, pim_pi_pair(p, r, z, vv, i)) : pim_pi_pair(p, r, z, vv, i);
+    if (i + 2 <= n) { /* plays 4k + 1, 4k + 2 */
+        s12 = i ? _mm_add_pd(s12, pim_pi_pair(p, r, z, vv, i)) : pim_pi_pair(p, r, z, vv, 0);
         i += 2;
     }
     if (i < n) { /* the last play of an odd n: play 4k + 1 (s_1) or 4k + 3 (s_3) */
-        double t;
         PIM_PI_ONE(i, t);
         if (i & 2)
-            s34 = _mm_add_sd(s34, _mm_set_sd(t));
+            s34 = i == 2 ? _mm_set_sd(t) : _mm_add_sd(s34, _mm_set_sd(t));
         else
-            s12 = _mm_add_sd(s12, _mm_set_sd(t));
+            s12 = i == 0 ? _mm_set_sd(t) : _mm_add_sd(s12, _mm_set_sd(t));
     }
     const __m128d s = _mm_add_pd(s12, s34); /* (s_1 + s_3, s_2 + s_4) */
     return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
 #else
-    double s1 = 0.0, s2 = 0.0, s3 = 0.0, s4 = 0.0, t1, t2;
-#define PIM_PI_TWO(i, sa, sb, first)                                                           \
-    do {                                                                                       \
-        PIM_PI_ONE((i), t1);                                                                   \
-        PIM_PI_ONE((i) + 1, t2);                                                               \
-        if (first) {                                                                           \
-            sa = t1;                                                                           \
-            sb = t2;                                                                           \
-        } else {                                                                               \
-            sa += t1;                                                                          \
-            sb += t2;                                                                          \
-        }                                                                                      \
-    } while (0)
-    if (n >= 4) {
-        PIM_PI_TWO(0, s1, s2, 1);
-        PIM_PI_TWO(2, s3, s4, 1);
-        for (i = 4; i + 4 <= n; i += 4) {
-            PIM_PI_TWO(i, s1, s2, 0);
-            PIM_PI_TWO(i + 2, s3, s4, 0);
-        }
+    double s[4] = {0.0, 0.0, 0.0, 0.0};
+    for (; i < n; ++i) {
+        PIM_PI_ONE(i, t);
+        s[i & 3] = i < 4 ? t : s[i & 3] + t;
     }
-    if (i + 2 <= n) {
-        PIM_PI_TWO(i, s1, s2, i == 0);
-        i += 2;
-    }
-#undef PIM_PI_TWO
-    if (i < n) {
-        PIM_PI_ONE(i, t1);
-        if (i & 2)
-            s3 += t1;
-        else
-            s1 += t1;
-    }
-    return (s1 + s3) + (s2 + s4);
+    return (s[0] + s[2]) + (s[1] + s[3]);
 #endif
 }
 #undef PIM_PI_ONE
