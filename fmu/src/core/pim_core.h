@@ -17,6 +17,12 @@
 
 #include <stddef.h>
 
+/* SSE2 for the play step's pairs (pim_pi_step_inline) where the compiler has it */
+#if defined(__SSE2__) && !defined(PIM_NO_SIMD)
+#define PIM_PI_SSE2 1
+#include <emmintrin.h>
+#endif
+
 #include "pim_limits.h" /* PIM_MAX_PLAYS (the fixed-size users' limit; the array functions
                             * take any n) and every other limit */
 
@@ -62,9 +68,7 @@ PIM_API double pim_pi_step(size_t n, const double *p, const double *r, double *z
  * compiled (pim_pi_step_small) is unrolled completely by the compiler.  p, r and z must not
  * overlap.
  */
-#if defined(__SSE2__) && !defined(PIM_NO_SIMD)
-#define PIM_PI_SSE2 1
-#include <emmintrin.h>
+#ifdef PIM_PI_SSE2
 
 /* Plays i + 1 and i + 2 at input (v, v): z updated, (p_i z_i, p_(i+1) z_(i+1)) returned.
  * minpd and maxpd return their first operand when it compares less (greater), else the second:
