@@ -3,13 +3,13 @@ getReal per sample) and steps per second through fmpy (FMU2Slave loop in Python)
 
 Run: ``.venv/bin/python benchmarks/bench_fmu.py``. Goal (issue 29): under 20 ns CPU per
 sample (setReal + doStep + getReal) in the C host (issue 5: 50 ns). The C host runs REPEATS
-times; the medians of its wall-clock and CPU ns per sample are printed with the machine's load
-average (a loaded machine inflates the wall clock most, so the verdict is on CPU time), beside
-the same loop calling only the C core's ``pim_pi_step`` (the floor that no FMU glue can go
-below) and the ratio of the two. With valgrind installed it also prints both loops'
-instructions per sample (callgrind: the count of 2N samples minus that of N, so the set-up
-cancels), which a loaded machine does not change. The Python loop shows what a Python master
-costs on top.
+times, interleaved run by run with the same loop calling only the C core's ``pim_pi_step``
+(the floor that no FMU glue can go below); the medians of both loops' wall-clock and CPU ns
+per sample are printed with the machine's load average (a loaded machine inflates the wall
+clock most, so the verdict is on CPU time) and the ratio of the two. With valgrind installed
+it also prints both loops' instructions per sample (callgrind: the count of 2N samples minus
+that of N, so the set-up cancels), which a loaded machine does not change. The Python loop
+shows what a Python master costs on top.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from pimodel.fmu.spec import config_h
 from pimodel.fmu.unit import FMUUnit
 
 HERE = Path(__file__).resolve().parent
-REPEATS = 5
+REPEATS = 7
 
 # The host's loop and input without the FMU: the C core's play step alone.
 FLOOR_C = r"""
@@ -63,12 +63,17 @@ int main(int argc, char **argv)
 """
 
 
-def _medians(cmd: list[str]) -> tuple[float, float]:
-    """Median wall and CPU ns per sample over REPEATS runs of a program printing both."""
-    runs = [subprocess.run(cmd, capture_output=True, text=True, check=True).stdout.split()
-            for _ in range(REPEATS)]
-    return (statistics.median(float(r[0]) for r in runs),
-            statistics.median(float(r[1]) for r in runs))
+def _medians(*cmds: list[str]) -> list[tuple[float, float]]:
+    """Median wall and CPU ns per sample of each program (printing both) over REPEATS runs,
+    the programs interleaved run by run, so that a change in the machine's speed during the
+    runs moves them alike."""
+    runs: list[list[list[str]]] = [[] for _ in cmds]
+    for _ in range(REPEATS):
+        for out, cmd in zip(runs, cmds, strict=True):
+            out.append(subprocess.run(cmd, capture_output=True, text=True,
+                                      check=True).stdout.split())
+    return [(statistics.median(float(r[0]) for r in out),
+             statistics.median(float(r[1]) for r in out)) for out in runs]
 
 
 def _instructions(cmd: list[str], n_samples: int = 100_000) -> float | None:
@@ -109,9 +114,10 @@ def main() -> None:
                         str(floor), "-lm"], check=True)
         N = 5_000_000
         load = os.getloadavg()[0]
-        ns_c, cpu_c = _medians([str(host), str(tmp / "binaries/linux64/PIHysteresis.so"),
-                                guid("PIHysteresis"), str(N), str(n)])
-        ns_f, cpu_f = _medians([str(floor), str(N), str(n)])
+        (ns_c, cpu_c), (ns_f, cpu_f) = _medians(
+            [str(host), str(tmp / "binaries/linux64/PIHysteresis.so"), guid("PIHysteresis"),
+             str(N), str(n)],
+            [str(floor), str(N), str(n)])
         ir_c = _instructions([str(host), str(tmp / "binaries/linux64/PIHysteresis.so"),
                               guid("PIHysteresis"), str(N), str(n)])
         ir_f = _instructions([str(floor), str(N), str(n)])

@@ -17,6 +17,12 @@
 
 #include <stddef.h>
 
+/* SSE2 for the play step's pairs (pim_pi_step_inline) where the compiler has it */
+#if defined(__SSE2__) && !defined(PIM_NO_SIMD)
+#define PIM_PI_SSE2 1
+#include <emmintrin.h>
+#endif
+
 #include "pim_limits.h" /* PIM_MAX_PLAYS (the fixed-size users' limit; the array functions
                             * take any n) and every other limit */
 
@@ -48,53 +54,89 @@ PIM_API double pim_pi_step(size_t n, const double *p, const double *r, double *z
 /*
  * pim_pi_step's body, inline for the loops that run it once per sample (pim_pi_run, the
  * generalized operator, the FMU units): each play clamped into [v - r_i, v + r_i] with
- * comparisons (no branch), and the weighted sum in two interleaved partial sums, the odd plays
- * and the even plays, added at the end:
+ * comparisons (no branch), and the weighted sum in four interleaved partial sums, each in play
+ * order and started by its first term (0 while empty), added at the end:
  *
- *     y = (p_1 z_1 + p_3 z_3 + ...) + (p_2 z_2 + p_4 z_4 + ...)
+ *     s_c = p_c z_c + p_(c+4) z_(c+4) + ...   (c = 1..4)
+ *     y   = (s_1 + s_3) + (s_2 + s_4)
  *
- * (one order for every caller, so that they agree to the last bit).  Two plays per vector
- * operation (SSE2), and a chain of n/2 additions per sample instead of n.  The loop counts
- * pairs; a count known only at run time unrolled twice (the small n of the FMUs pay its set-up
- * and branches every sample), one known when compiled (pim_pi_step_small) unrolled completely
- * by the compiler; the order of the additions does not change.  p, r and z must not overlap.
+ * One order for every caller, so that they agree to the last bit (tests/test_native_sum_order.py
+ * holds it to this formula).  Two plays per vector operation ((s_1, s_2) and (s_3, s_4): SSE2
+ * where the compiler has it, unless PIM_NO_SIMD; the same operations in scalar code
+ * elsewhere), and a chain of about n/4 dependent additions per sample, which is what limits a
+ * sample's speed more than the count of instructions (docs/fmu.md, Speed).  A count known when
+ * compiled (pim_pi_step_small) is unrolled completely by the compiler.  p, r and z must not
+ * overlap.
  */
-#define PIM_PI_PAIR(i)                                                                         \
+#ifdef PIM_PI_SSE2
+
+/* Plays i + 1 and i + 2 at input (v, v): z updated, (p_i z_i, p_(i+1) z_(i+1)) returned.
+ * minpd and maxpd return their first operand when it compares less (greater), else the second:
+ * the scalar code's comparisons. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline __m128d pim_pi_pair(const double *PIM_RESTRICT p, const double *PIM_RESTRICT r,
+                                  double *PIM_RESTRICT z, __m128d vv, size_t i)
+{
+    const __m128d ri = _mm_loadu_pd(r + i);
+    __m128d a = _mm_min_pd(_mm_loadu_pd(z + i), _mm_add_pd(vv, ri));
+    a = _mm_max_pd(a, _mm_sub_pd(vv, ri));
+    _mm_storeu_pd(z + i, a);
+    return _mm_mul_pd(_mm_loadu_pd(p + i), a);
+}
+#endif
+
+/* Play i + 1 alone at input v: z[i] updated, p_i z_i into `out`. */
+#define PIM_PI_ONE(i, out)                                                                     \
     do {                                                                                       \
         const size_t i_ = (i);                                                                 \
         double a = z[i_] < v + r[i_] ? z[i_] : v + r[i_];                                      \
-        double b = z[i_ + 1] < v + r[i_ + 1] ? z[i_ + 1] : v + r[i_ + 1];                      \
         a = a > v - r[i_] ? a : v - r[i_];                                                     \
-        b = b > v - r[i_ + 1] ? b : v - r[i_ + 1];                                             \
         z[i_] = a;                                                                             \
-        z[i_ + 1] = b;                                                                         \
-        y_odd += p[i_] * a;                                                                    \
-        y_even += p[i_ + 1] * b;                                                               \
+        out = p[i_] * a;                                                                       \
     } while (0)
 
 static inline double pim_pi_step_inline(size_t n, const double *PIM_RESTRICT p,
                                         const double *PIM_RESTRICT r, double *PIM_RESTRICT z,
                                         double v)
 {
-    double y_odd = 0.0, y_even = 0.0; /* plays 1, 3, ... and 2, 4, ... (indices 0, 2, ...) */
-    const size_t pairs = n / 2;
-#if defined(__GNUC__) && !defined(__clang__)
-    if (!__builtin_constant_p(pairs)) {
-#pragma GCC unroll 2
-        for (size_t j = 0; j < pairs; ++j) PIM_PI_PAIR(2 * j);
-    } else
-#endif
-        for (size_t j = 0; j < pairs; ++j) PIM_PI_PAIR(2 * j);
-    if (n & 1) {
-        const size_t i = n - 1;
-        double a = z[i] < v + r[i] ? z[i] : v + r[i];
-        a = a > v - r[i] ? a : v - r[i];
-        z[i] = a;
-        y_odd += p[i] * a;
+    size_t i = 0;
+    double t;
+#ifdef PIM_PI_SSE2
+    const __m128d vv = _mm_set1_pd(v);
+    __m128d s12 = _mm_setzero_pd(), s34 = _mm_setzero_pd(); /* (s_1, s_2), (s_3, s_4) */
+    if (n >= 4) {
+        s12 = pim_pi_pair(p, r, z, vv, 0);
+        s34 = pim_pi_pair(p, r, z, vv, 2);
+        for (i = 4; i + 4 <= n; i += 4) {
+            s12 = _mm_add_pd(s12, pim_pi_pair(p, r, z, vv, i));
+            s34 = _mm_add_pd(s34, pim_pi_pair(p, r, z, vv, i + 2));
+        }
     }
-    return y_odd + y_even;
+    if (i + 2 <= n) { /* plays 4k + 1, 4k + 2 */
+        s12 = i ? _mm_add_pd(s12, pim_pi_pair(p, r, z, vv, i)) : pim_pi_pair(p, r, z, vv, 0);
+        i += 2;
+    }
+    if (i < n) { /* the last play of an odd n: play 4k + 1 (s_1) or 4k + 3 (s_3) */
+        PIM_PI_ONE(i, t);
+        if (i & 2)
+            s34 = i == 2 ? _mm_set_sd(t) : _mm_add_sd(s34, _mm_set_sd(t));
+        else
+            s12 = i == 0 ? _mm_set_sd(t) : _mm_add_sd(s12, _mm_set_sd(t));
+    }
+    const __m128d s = _mm_add_pd(s12, s34); /* (s_1 + s_3, s_2 + s_4) */
+    return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
+#else
+    double s[4] = {0.0, 0.0, 0.0, 0.0};
+    for (; i < n; ++i) {
+        PIM_PI_ONE(i, t);
+        s[i & 3] = i < 4 ? t : s[i & 3] + t;
+    }
+    return (s[0] + s[2]) + (s[1] + s[3]);
+#endif
 }
-#undef PIM_PI_PAIR
+#undef PIM_PI_ONE
 
 /* The n up to which pim_pi_step_small has a straight line of code for each n. */
 #define PIM_PI_SMALL_N 16

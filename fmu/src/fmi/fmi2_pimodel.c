@@ -159,7 +159,7 @@ fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
 {
     const double *x = comp && nvr == 1 ? unit_main_real(&((Inst *)comp)->u, vr[0], 0) : NULL;
     if (!x) return get_reals(comp, vr, nvr, value);
-    value[0] = *x;
+    unit_copy_real(value, x);
     return fmi2OK;
 }
 
@@ -168,7 +168,7 @@ fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
 {
     double *x = comp && nvr == 1 ? unit_main_real(&((Inst *)comp)->u, vr[0], 1) : NULL;
     if (!x) return set_reals(comp, vr, nvr, value);
-    *x = value[0];
+    unit_copy_real(x, value);
     return fmi2OK;
 }
 

@@ -211,7 +211,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance inst, const fmi3ValueReference vr[], size
                           ? unit_main_real(&((Inst *)inst)->u, vr[0], 0)
                           : NULL;
     if (!x) return get_float64s(inst, vr, nvr, values, nValues);
-    values[0] = *x;
+    unit_copy_real(values, x);
     return fmi3OK;
 }
 
@@ -221,7 +221,7 @@ fmi3Status fmi3SetFloat64(fmi3Instance inst, const fmi3ValueReference vr[], size
     double *x = inst && nvr == 1 && nValues >= 1 ? unit_main_real(&((Inst *)inst)->u, vr[0], 1)
                                                  : NULL;
     if (!x) return set_float64s(inst, vr, nvr, values, nValues);
-    *x = values[0];
+    unit_copy_real(x, values);
     return fmi3OK;
 }
 
