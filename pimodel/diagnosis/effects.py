@@ -9,6 +9,8 @@ parameters to the nominal model (for the information criterion on the validate r
 
 from __future__ import annotations
 
+import copy
+import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 
@@ -614,7 +616,41 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
     >>> m.name, m.k, m.params["creep_time_constants_s"]  # lags for 0.3 s at 1 kHz
     ('creep', 2, [0.03, 0.3])
     """
-    return _fit_combo((*combo, name), train, dict(fixed or {}), nominal or fit_nominal(train))
+    return _order_memo((*combo, name), train, dict(fixed or {}), nominal or fit_nominal(train))
+
+
+def _order_memo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> Model:
+    """:func:`_fit_combo`, memoised on ``nominal`` for a searched linear part: a fit asking for
+    at least ``lti_min`` further elements (``fixed["lti_min"]``, the second-effect rule's
+    refined dynamics) is the fit already made with ``m0 <= lti_min`` that chose at least
+    ``lti_min`` elements on its own or found none left to add (:func:`.lti.select_order` then
+    takes the same steps: the forced ones passed its test anyway), to the bit, and is not made
+    again (each such fit is a whole mode search, grid, polish, order selection and Wiener
+    search: 360-380 passes over the screen). Otherwise the fit reuses the earlier fits' grid
+    searches (``memo["searched"]``) and goes on from where their order selection stopped
+    (``memo["order"]``). A copy of the model is returned (its ``params`` and ``grid`` its own)."""
+    if "dynamics" not in effects or {"fn", "wiener", "held"} & set(fixed):
+        return _fit_combo(effects, train, fixed, nominal)
+    lti_min = fixed.get("lti_min", 0)
+    key = (effects, tuple(id(s) for s in train),
+           repr(sorted((k_, v) for k_, v in fixed.items() if k_ != "lti_min")))
+    memo = nominal.__dict__.setdefault("_order_memo", {})
+    known = memo.setdefault(key, {"runs": []})
+    if not all(r() is s for r, s in zip(known.setdefault("train", [weakref.ref(s) for s in train]),
+                                         train, strict=True)):
+        known = memo[key] = {"runs": [], "train": [weakref.ref(s) for s in train]}
+    for m0, chose, model in known["runs"]:
+        if m0 <= lti_min <= chose:
+            return _copy_model(model)
+    known.pop("elements", None)
+    model = _fit_combo(effects, train, dict(fixed), nominal, known)
+    known["runs"].append((lti_min, known.pop("elements", -1), _copy_model(model)))
+    return model
+
+
+def _copy_model(model: Model) -> Model:
+    """``model`` with ``params`` and ``grid`` copied (the diagnosis adds to a fit's params)."""
+    return replace(model, params=copy.deepcopy(model.params), grid=copy.deepcopy(model.grid))
 
 
 def delay_grid(dt: float) -> np.ndarray:
@@ -642,10 +678,13 @@ def delay_grid(dt: float) -> np.ndarray:
     return np.unique(np.round(coarse).astype(int)[coarse <= dmax])
 
 
-def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> Model:
+def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
+               memo: dict | None = None) -> Model:
     """Joint fit; the nonlinear parameters (mode, delay, drift clock) by grid search on the
     train RSS (a mode search with the leading ``SEARCH_COLUMNS`` play columns), refined around
-    the grid optimum, then refitted with every play column."""
+    the grid optimum, then refitted with every play column. ``memo`` (:func:`_order_memo`):
+    the grid searches' result is kept in ``memo["searched"]`` (and taken from it when there),
+    the number of further elements the order selection chose in ``memo["elements"]``."""
     name = "+".join(effects)
     # an effect's own model one step richer, the yardstick a second effect must beat
     # (pimodel.diagnosis.diagnose): fixed["refine"] = "creep", a further lag;
@@ -718,94 +757,100 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
     points = [{}]
     for g in grids:  # Cartesian product of the nonlinear grids (at most dynamics x delay)
         points = [{**a, **b} for a in points for b in g]
-    best = search(points)
-    grid_tried = sorted(tried, key=lambda rp: rp[0])[:SCREEN_CONFIRM]
-    if "rate" in effects and "rate_tau" not in fixed:
-        # the rate family and filter (the other grid parameters held): the filter's grid,
-        # then geometric steps around the best positive time constant
-        best = search([{**best[0].params, "rate_family": f, "rate_tau": tau}
-                       for f in RATE_FAMILIES for tau in RATE_TAUS if tau != RATE_TAU_START],
-                      best)
-        for step in RATE_TAU_REFINE:
-            tau = best[0].params["rate_tau"]
-            if tau > 0:
-                best = search([{**best[0].params, "rate_tau": tau * f} for f in (1 / step, step)],
-                              best)
-        # the saturation of the filtered rate at that filter (module rate), then steps
-        best = search([{**best[0].params, "rate_saturation": s_} for s_ in RATE_SATURATIONS
-                       if s_ is not None], best)
-        for _ in range(RATE_POLISH_ROUNDS):  # then the filter and the saturation in turn
-            before, p_ = best[0], best[0].params
-            if p_["rate_saturation"] is None:
-                break
-            best = search([{**p_, "rate_saturation": p_["rate_saturation"] * f}
-                           for f in (1 / RATE_SATURATION_REFINE, RATE_SATURATION_REFINE)]
-                          + [{**p_, "rate_tau": p_["rate_tau"] * f}
-                             for f in (1 / RATE_TAU_REFINE[-1], RATE_TAU_REFINE[-1])
-                             if p_["rate_tau"] > 0], best)
-            if best[0] is before:
-                break
-        if scaled:
-            best = _search_scaled(search, best[0].params)
-    if best[0].params.get("clock") == "settle" and "settle_tau" not in fixed:
-        # the settling time constant (the other grid parameters held): its grid, then
-        # continuously in log T between the grid neighbours of the best point
-        tgrid, tau0 = settle_grid(train), best[0].params["settle_tau"]
-        best = search([{**best[0].params, "settle_tau": float(x)} for x in tgrid if x != tau0],
-                      best)
-        base, step = dict(best[0].params), np.log(tgrid[1] / tgrid[0])
-        r = minimize_scalar(lambda x: _fit(name, k, _combo_features(
-            effects, {**base, "settle_tau": float(np.exp(x))}, nominal, static, ncols),
-            train)[1], bounds=(np.log(base["settle_tau"]) - step,
-                               np.log(base["settle_tau"]) + step),
-            method="bounded", options={"xatol": 0.01})
-        if r.fun < best[1]:
-            best = search([{**base, "settle_tau": float(np.exp(r.x))}], best)
-    if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
-        i = int(np.searchsorted(dgrid, best[0].params["d"]))
-        lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
-        best = search([{**best[0].params, "d": int(d)} for d in range(lo, hi + 1)
-                       if d not in dgrid], best)
-        d0 = best[0].params["d"]  # then a fraction of a sample on either side
-        best = search([{**best[0].params, "d": d0 + f} for f in (-0.75, -0.5, -0.25, 0.25,
-                                                                  0.5, 0.75) if d0 + f >= 0],
-                      best)
-        # and continuously between the quarter-sample neighbours: an eighth of a sample off
-        # leaves several noise floors on fast input
-        base, d1 = dict(best[0].params), float(best[0].params["d"])
-        r = minimize_scalar(lambda d: _fit(name, k, _combo_features(
-            effects, {**base, "d": float(d)}, nominal, static, ncols), train)[1],
-            bounds=(max(d1 - 0.25, 0.0), d1 + 0.25), method="bounded",
-            options={"xatol": 0.01})
-        if r.fun < best[1]:
-            best = search([{**base, "d": float(r.x)}], best)
-    if "dynamics" in effects and not dyn_fixed:
-        # refine the mode around the grid optimum, then polish it continuously (a light
-        # mode's resonance is narrower than the grid)
-        f0, z0 = best[0].params["fn"], best[0].params["zeta"]
-        best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
-                       for f in f0 * np.linspace(0.88, 1.12, 9)
-                       for z in z0 * np.array([0.5, 0.75, 1.0, 1.35, 2.0])
-                       if f <= fmax and MODE_DAMPING_RANGE[0] <= z <= MODE_DAMPING_RANGE[1]],
-                      best)
-        base = dict(best[0].params)
-
-        def cost(x):
-            p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
-            # a mode far below the sample rate is a near-singular pole (its columns overflow
-            # the least squares: density seed 0, creep + dynamics, wandered to 1e-6 Hz)
-            if not fmin <= p["fn"] <= fmax or \
-                    not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
-                return np.inf
-            return _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
-                        train, p)[1]
-
-        x0 = np.log([base["fn"], base["zeta"]])
-        r = nelder_mead(cost, x0, initial_simplex=[x0, x0 + [0.03, 0], x0 + [0, 0.2]],
-                        xatol=1e-4, fatol=1e-9 * best[1], maxfev=60)
-        if r.fun < best[1]:
-            best = search([{**base, "fn": float(np.exp(r.x[0])), "zeta": float(np.exp(r.x[1]))}],
+    searched = None if memo is None else memo.get("searched")
+    if searched is not None:  # the same search made before (_order_memo)
+        best, grid_tried = searched
+    else:
+        best = search(points)
+        grid_tried = sorted(tried, key=lambda rp: rp[0])[:SCREEN_CONFIRM]
+        if "rate" in effects and "rate_tau" not in fixed:
+            # the rate family and filter (the other grid parameters held): the filter's grid,
+            # then geometric steps around the best positive time constant
+            best = search([{**best[0].params, "rate_family": f, "rate_tau": tau}
+                           for f in RATE_FAMILIES for tau in RATE_TAUS if tau != RATE_TAU_START],
                           best)
+            for step in RATE_TAU_REFINE:
+                tau = best[0].params["rate_tau"]
+                if tau > 0:
+                    best = search([{**best[0].params, "rate_tau": tau * f}
+                                   for f in (1 / step, step)], best)
+            # the saturation of the filtered rate at that filter (module rate), then steps
+            best = search([{**best[0].params, "rate_saturation": s_} for s_ in RATE_SATURATIONS
+                           if s_ is not None], best)
+            for _ in range(RATE_POLISH_ROUNDS):  # then the filter and the saturation in turn
+                before, p_ = best[0], best[0].params
+                if p_["rate_saturation"] is None:
+                    break
+                best = search([{**p_, "rate_saturation": p_["rate_saturation"] * f}
+                               for f in (1 / RATE_SATURATION_REFINE, RATE_SATURATION_REFINE)]
+                              + [{**p_, "rate_tau": p_["rate_tau"] * f}
+                                 for f in (1 / RATE_TAU_REFINE[-1], RATE_TAU_REFINE[-1])
+                                 if p_["rate_tau"] > 0], best)
+                if best[0] is before:
+                    break
+            if scaled:
+                best = _search_scaled(search, best[0].params)
+        if best[0].params.get("clock") == "settle" and "settle_tau" not in fixed:
+            # the settling time constant (the other grid parameters held): its grid, then
+            # continuously in log T between the grid neighbours of the best point
+            tgrid, tau0 = settle_grid(train), best[0].params["settle_tau"]
+            best = search([{**best[0].params, "settle_tau": float(x)} for x in tgrid if x != tau0],
+                          best)
+            base, step = dict(best[0].params), np.log(tgrid[1] / tgrid[0])
+            r = minimize_scalar(lambda x: _fit(name, k, _combo_features(
+                effects, {**base, "settle_tau": float(np.exp(x))}, nominal, static, ncols),
+                train)[1], bounds=(np.log(base["settle_tau"]) - step,
+                                   np.log(base["settle_tau"]) + step),
+                method="bounded", options={"xatol": 0.01})
+            if r.fun < best[1]:
+                best = search([{**base, "settle_tau": float(np.exp(r.x))}], best)
+        if "delay" in effects and "d" not in fixed:  # every sample between the grid neighbours
+            i = int(np.searchsorted(dgrid, best[0].params["d"]))
+            lo, hi = dgrid[max(i - 1, 0)], dgrid[min(i + 1, dgrid.size - 1)]
+            best = search([{**best[0].params, "d": int(d)} for d in range(lo, hi + 1)
+                           if d not in dgrid], best)
+            d0 = best[0].params["d"]  # then a fraction of a sample on either side
+            best = search([{**best[0].params, "d": d0 + f} for f in (-0.75, -0.5, -0.25, 0.25,
+                                                                      0.5, 0.75) if d0 + f >= 0],
+                          best)
+            # and continuously between the quarter-sample neighbours: an eighth of a sample off
+            # leaves several noise floors on fast input
+            base, d1 = dict(best[0].params), float(best[0].params["d"])
+            r = minimize_scalar(lambda d: _fit(name, k, _combo_features(
+                effects, {**base, "d": float(d)}, nominal, static, ncols), train)[1],
+                bounds=(max(d1 - 0.25, 0.0), d1 + 0.25), method="bounded",
+                options={"xatol": 0.01})
+            if r.fun < best[1]:
+                best = search([{**base, "d": float(r.x)}], best)
+        if "dynamics" in effects and not dyn_fixed:
+            # refine the mode around the grid optimum, then polish it continuously (a light
+            # mode's resonance is narrower than the grid)
+            f0, z0 = best[0].params["fn"], best[0].params["zeta"]
+            best = search([{**best[0].params, "fn": float(f), "zeta": float(z)}
+                           for f in f0 * np.linspace(0.88, 1.12, 9)
+                           for z in z0 * np.array([0.5, 0.75, 1.0, 1.35, 2.0])
+                           if f <= fmax and MODE_DAMPING_RANGE[0] <= z <= MODE_DAMPING_RANGE[1]],
+                          best)
+            base = dict(best[0].params)
+
+            def cost(x):
+                p = {**base, "fn": float(np.exp(x[0])), "zeta": float(np.exp(x[1]))}
+                # a mode far below the sample rate is a near-singular pole (its columns overflow
+                # the least squares: density seed 0, creep + dynamics, wandered to 1e-6 Hz)
+                if not fmin <= p["fn"] <= fmax or \
+                        not MODE_DAMPING_RANGE[0] <= p["zeta"] <= MODE_DAMPING_RANGE[1]:
+                    return np.inf
+                return _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
+                            train, p)[1]
+
+            x0 = np.log([base["fn"], base["zeta"]])
+            r = nelder_mead(cost, x0, initial_simplex=[x0, x0 + [0.03, 0], x0 + [0, 0.2]],
+                            xatol=1e-4, fatol=1e-9 * best[1], maxfev=60)
+            if r.fun < best[1]:
+                best = search([{**base, "fn": float(np.exp(r.x[0])),
+                                "zeta": float(np.exp(r.x[1]))}], best)
+        if memo is not None:
+            memo["searched"] = (best, grid_tried)
     if "dynamics" in effects and "wiener" not in fixed and not held:
         # the order of the linear part: further modes, a low-pass, a direct term (module lti);
         # chosen again beside effects added later (the base mode held, no polish)
@@ -824,7 +869,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) -> 
             lambda fn, zeta, el: [_lti_block(s, lti_point(fn, zeta, (el,)), nominal,
                                              static)[s.used, 0] for s in train],
             p0["fn"], p0["zeta"], fmax, MODE_DAMPING_RANGE, polish="fn" not in fixed,
-            min_elements=lti_min)
+            min_elements=lti_min, memo=None if memo is None else memo.setdefault("order", {}))
+        if memo is not None:  # any larger lti_min gives this fit when none was left to add
+            memo["elements"] = np.inf if memo["order"].get("exhausted") else len(elements)
         best = search([lti_point(fn, zeta, elements)])
     if train is not full:  # screened: the searched point against the grid's best, whole
         train = full
@@ -1025,7 +1072,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "drift" in effects:  # the trend column last
             parts.append(drift_columns(s.t, p, static["train"].get(id(s)),
                                        len(static["train"])).T)
-        return Z, _stack_rows(parts[1:])
+        # the other rows as they are when there is one block (the static rows, C-contiguous:
+        # a mode or delay search then copies nothing of them per point)
+        return Z, parts[1] if len(parts) == 2 else _stack_rows(parts[1:])
 
     def feats(s: Segment) -> np.ndarray:
         return _stack_rows(rows(s)).T

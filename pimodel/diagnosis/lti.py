@@ -548,7 +548,8 @@ def _best_addition(blocks: list, ys: list, column: Callable, chosen: tuple, fmax
 
 def select_order(fit: Callable, regressors: Callable, column: Callable, fn: float, zeta: float,
                  fmax: float, damping_range: tuple[float, float], *,
-                 polish: bool = True, min_elements: int = 0) -> tuple[float, float, tuple, list]:
+                 polish: bool = True, min_elements: int = 0,
+                 memo: dict | None = None) -> tuple[float, float, tuple, list]:
     """Forward selection of the extra elements by the train BIC (module docstring).
 
     Each step screens every kind of element with the base mode held (a rank-one update of the
@@ -578,6 +579,13 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
         Add elements (the best of each step) up to this many whether or not they lower the
         train BIC (at most ``MAX_ELEMENTS``): the linear part refined one step further, the
         yardstick a second effect beside ``dynamics`` must beat (:mod:`.diagnose`).
+    memo : dict or None
+        Kept between calls with the same ``fit``, ``regressors``, ``column`` and start: where
+        a call stopped on the train BIC (its state and the addition it turned down) is kept
+        in it, and a later call with a larger ``min_elements`` goes on from there, as it would
+        have (its earlier steps passed the test anyway), without making them again;
+        ``memo["exhausted"]`` is set when a call ended with no element left to add (a larger
+        ``min_elements`` then gives the same result).
 
     Returns
     -------
@@ -615,39 +623,57 @@ def select_order(fit: Callable, regressors: Callable, column: Callable, fn: floa
     def bic(rss: float, k: int) -> float:
         return n * np.log(max(rss, 1e-300) / n) + k * np.log(n)
 
-    blocks, ys = regressors(fn, zeta, ())
-    n = sum(y.size for y in ys)
-    b0 = current = bic(fit(fn, zeta, ()), 0)
-    elements: tuple = ()
-    trace = [{"structure": ["mode"], "train_bic": 0.0}]
-    while True:
+    stop = None if memo is None else memo.get("stop")
+    if stop is not None and len(stop[4]) < min_elements:  # on from where that run stopped
+        n, b0, fn, zeta, elements, current, trace, found, polished = stop
+        trace = list(trace)
+    else:
+        blocks, ys = regressors(fn, zeta, ())
+        n = sum(y.size for y in ys)
+        b0 = current = bic(fit(fn, zeta, ()), 0)
+        elements: tuple = ()
+        trace = [{"structure": ["mode"], "train_bic": 0.0}]
         found = _best_addition(blocks, ys, lambda el, f=fn, z=zeta: column(f, z, el),
                                elements, fmax, damping_range, fn)
-        if found is None:
-            break
+        polished = None
+
+    def stopped(polished_) -> None:  # the state a larger min_elements goes on from
+        if memo is not None:
+            memo["stop"] = (n, b0, fn, zeta, elements, current, tuple(trace), found, polished_)
+
+    while found is not None:
         trial = elements + (found[0],)
         k = lti_k(trial)
         forced = len(elements) < min_elements
-        if not forced and not bic(found[1], k) < current:
-            break
-        if not polish:
-            fn2, zeta2, score = fn, zeta, bic(found[1], k)
+        if polished is not None:  # taken up where an earlier call stopped
+            (fn2, zeta2, trial, score), polished = polished, None
         else:
-            # to half a BIC unit: an RSS change of rss / n moves n ln(RSS / n) by one
-            fn2, zeta2, trial = polish_elements(fit, fn, zeta, trial, fmax, damping_range,
-                                                fatol=0.5 * found[1] / n)
-            score = bic(fit(fn2, zeta2, trial), k)
-        # the polish may improve the elements already chosen as well: credit the new element
-        # only with what it adds at the polished point
-        previous = bic(fit(fn2, zeta2, trial[:-1]), lti_k(elements)) if polish else current
-        if previous < current:
-            fn, zeta, elements, current = fn2, zeta2, trial[:-1], previous
+            if not forced and not bic(found[1], k) < current:
+                stopped(None)
+                break
+            if not polish:
+                fn2, zeta2, score = fn, zeta, bic(found[1], k)
+            else:
+                # to half a BIC unit: an RSS change of rss / n moves n ln(RSS / n) by one
+                fn2, zeta2, trial = polish_elements(fit, fn, zeta, trial, fmax, damping_range,
+                                                    fatol=0.5 * found[1] / n)
+                score = bic(fit(fn2, zeta2, trial), k)
+            # the polish may improve the elements already chosen as well: credit the new
+            # element only with what it adds at the polished point
+            previous = bic(fit(fn2, zeta2, trial[:-1]), lti_k(elements)) if polish else current
+            if previous < current:
+                fn, zeta, elements, current = fn2, zeta2, trial[:-1], previous
         if not forced and not score < current:
+            stopped((fn2, zeta2, trial, score))
             break
         fn, zeta, elements, current = fn2, zeta2, trial, score
         trace.append({"structure": ["mode"] + [e[0] for e in elements],
                       "train_bic": float(current - b0)})
         blocks, ys = regressors(fn, zeta, elements)
+        found = _best_addition(blocks, ys, lambda el, f=fn, z=zeta: column(f, z, el),
+                               elements, fmax, damping_range, fn)
+    if found is None and memo is not None:  # no element left to add: any min_elements alike
+        memo["exhausted"] = True
     return fn, zeta, elements, trace
 
 
