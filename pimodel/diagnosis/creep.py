@@ -17,16 +17,16 @@ record, and the lag's state at rest at ``h0[0]`` then carries ``g_i h0[0]`` into
 level that follows the record's first output. Its gain is pinned only by the ramp (what a
 drift's trend fits), and the extrapolation to a validate record that starts elsewhere is a
 level error a drift with a level per record takes up (issue 28: on 1 s multisine records of a
-stage with a 50 ms creep behind a delay, lags up to 3 s left the creep candidate alone up to
-4x worse than the nominal on validate, and the verdict named `drift` beside the creep in 8 of
-10 seeds; with lags up to 0.3 s the creep alone fits validate to 4-9 noise floors and comes
-first in 10 of 10). A lag of at most twice the record shows at least ``1 - exp(-1/2)``
-(39 %) of its settling within it. Before, the last lag was the first at least half the
-record (0.5 to 5 times it: 3 s on those 1 s records); the first at least the record itself,
-300 s on a 40 s record, had taken the place of a drift and left no creep law. On the
-existing generators' records (10 kHz over 3 s; 5 kHz over 1.7 s; 2 kHz over 5 s) the grid is
-the one before this rule (3 ms to 3 s; 30 ms to 3 s); on a 200 Hz record of 100 s it is 0.3 s
-to 30 s, on 5 kHz records of 1 s 3 ms to 0.3 s.
+stage with a 50 ms creep behind a delay, lags up to 3 s left the creep candidate alone worse
+than the nominal on validate in 5 of 10 seeds, and the verdict named `drift` in 8 and `rate` in
+4; with lags up to 0.3 s the creep alone leaves 6-40 % of the gap, comes first in 10 of 10, and
+`drift` is named in 3, `rate` in none: docs/diagnosis.md). A lag of at most twice the record
+shows at least ``1 - exp(-1/2)`` (39 %) of its settling within it. Before, the last lag was the
+first at least half the record (0.5 to 5 times it: 3 s on those 1 s records); the first at
+least the record itself, 300 s on a 40 s record, had taken the place of a drift and left no
+creep law. On the existing generators' records (10 kHz over 3 s; 5 kHz over 1.7 s; 2 kHz over 5
+s) the grid is the one before this rule (3 ms to 3 s; 30 ms to 3 s); on a 200 Hz record of 100
+s it is 0.3 s to 30 s, on 5 kHz records of 1 s 3 ms to 0.3 s.
 """
 
 from __future__ import annotations
