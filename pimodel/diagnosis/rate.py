@@ -56,7 +56,8 @@ nominal ones (the hysteresis is ``sum_i w_i zs_i``; as an effect term beside the
 model's ``sum_i g_b w_i (zs_i - z_i)`` with one gain ``g = 1``). ``G``, ``S`` and
 ``tau > 0`` are nonlinear: a grid (``RATE_GROWTHS`` times half, once and twice the
 first-order form's ``S``, at its filter), then the three together by a Nelder-Mead polish in
-their logarithms (at most ``RATE_SCALED_EVALS`` fits; ``G`` and ``S`` trade along a valley).
+their logarithms (at most ``RATE_SCALED_EVALS`` fits; ``G`` and ``S`` trade along a valley;
+the filter at most ``RATE_TAU_MAX``, what the first-order search reaches).
 The shape is offered beside the first-order one and chosen by validate BIC
 (:func:`rate_shapes`), not with dynamics or a delay (their columns filter or shift the
 nominal plays).
