@@ -232,6 +232,28 @@ def _delayed_stage_records(seed):
     return out
 
 
+@pytest.mark.slow  # one diagnosis (~12 s alone, 25 s on a loaded machine)
+def test_creep_lags_within_the_record_leave_no_drift():
+    """Issue 28, a second effect only when it is real: on the delayed-stage records (a 50 ms
+    creep behind a 2-sample delay, 1 s multisines starting away from 0, no drift), the creep
+    candidate's lags stop at twice the record (:func:`pimodel.diagnosis.creep.
+    creep_time_constants`). A lag of 3 s on these records carried a level per record (its gain
+    times the record's first output) into validate, the creep alone fitted validate hardly
+    better than the nominal, and a drift with a level per record and a rate were named beside
+    it. Now the creep alone explains most of the gap, comes first, and no drift or rate is
+    named."""
+    train, validate = _delayed_stage_records(3)
+    rep = diagnose([train], [validate])
+    span = max(r.t[-1] - r.t[0] for r in (train, validate))
+    creep = next(c for c in rep.candidates if c["effect"] == "creep")
+    assert max(creep["params"]["creep_time_constants_s"]) <= 2 * span
+    gap = rep.verdict["gap_before"]
+    assert creep["validate"]["rms"] <= 0.5 * gap, (creep["validate"]["rms"], gap)
+    effects = rep.verdict["effects"]
+    assert effects[0] == "creep", effects
+    assert not {"drift", "rate"} & set(effects), effects
+
+
 @pytest.mark.slow  # builds on the session's FMUs and runs a diagnosis (~30 s)
 def test_report_residual_equals_the_exported_model_and_the_fmu(built_fmus):
     """The exported model simulates what the diagnosis fitted: on a record that starts away

@@ -42,6 +42,7 @@ from .rate import (
     RATE_SATURATION_REFINE,
     RATE_SATURATIONS,
     RATE_SCALED_EVALS,
+    RATE_TAU_MAX,
     RATE_TAU_REFINE,
     RATE_TAU_START,
     RATE_TAUS,
@@ -997,7 +998,8 @@ def _search_scaled(search, start: dict):
     ``start``: its filter (at least ``RATE_TAUS[1]``), ``G`` on ``RATE_GROWTHS`` times ``S``
     at half, once and twice the first-order ``S`` (1 when linear), then ``G``, ``S`` and the
     filter together by a Nelder-Mead polish in their logarithms (``G`` and ``S`` trade
-    against each other along a valley that steps of one at a time do not follow)."""
+    against each other along a valley that steps of one at a time do not follow), the filter
+    at most ``RATE_TAU_MAX`` (what the first-order search reaches, module rate)."""
     s0 = start["rate_saturation"] or 1.0
     p0 = {**start, "rate_family": SCALED, "rate_tau": max(start["rate_tau"], RATE_TAUS[1])}
     best = search([{**p0, "rate_growth": g, "rate_saturation": s0 * f}
@@ -1005,7 +1007,7 @@ def _search_scaled(search, start: dict):
 
     def point(x):
         return {**p0, "rate_growth": float(np.exp(x[0])), "rate_saturation": float(np.exp(x[1])),
-                "rate_tau": float(np.exp(x[2]))}
+                "rate_tau": min(float(np.exp(x[2])), RATE_TAU_MAX)}
 
     q = best[0].params
     x0 = np.log([q["rate_growth"], q["rate_saturation"], q["rate_tau"]])

@@ -56,7 +56,8 @@ nominal ones (the hysteresis is ``sum_i w_i zs_i``; as an effect term beside the
 model's ``sum_i g_b w_i (zs_i - z_i)`` with one gain ``g = 1``). ``G``, ``S`` and
 ``tau > 0`` are nonlinear: a grid (``RATE_GROWTHS`` times half, once and twice the
 first-order form's ``S``, at its filter), then the three together by a Nelder-Mead polish in
-their logarithms (at most ``RATE_SCALED_EVALS`` fits; ``G`` and ``S`` trade along a valley).
+their logarithms (at most ``RATE_SCALED_EVALS`` fits; ``G`` and ``S`` trade along a valley;
+the filter at most ``RATE_TAU_MAX``, what the first-order search reaches).
 The shape is offered beside the first-order one and chosen by validate BIC
 (:func:`rate_shapes`), not with dynamics or a delay (their columns filter or shift the
 nominal plays).
@@ -87,6 +88,12 @@ FAMILY_CODES = (*RATE_FAMILIES, SCALED)  # rate_family of the C core (pim_diagno
 RATE_GROWTHS = (0.1, 0.2, 0.4, 0.8, 1.6)  # G [-] of the scaled shape's grid
 RATE_GROWTH_REFINE = 2**0.25  # then G, S and the filter polished (first steps: 1/4 octave)
 RATE_SCALED_EVALS = 60  # ... by at most this many fits (Nelder-Mead in log G, log S, log tau)
+# the exact shape's filter stays within what the first-order search reaches (its grid, one
+# step of each RATE_TAU_REFINE, RATE_POLISH_ROUNDS of the finest: 30 ms * 10^0.875 = 0.22 s);
+# the polish refines the optimum and does not leave the candidate's range (issue 28: on
+# density_stage drift seed 4 it ran to 1.9 s, 38 % of the record, where the filtered rate is a
+# slow envelope of the input speed, a loop width changing in time beside a drift)
+RATE_TAU_MAX = RATE_TAUS[-1] * RATE_TAU_REFINE[0] * RATE_TAU_REFINE[-1] ** (RATE_POLISH_ROUNDS + 1)
 CONTACT_BYTES = 96 << 20  # a basis keeps its plays' last contacts up to this size (12 B each)
 
 __all__ = [
@@ -101,6 +108,7 @@ __all__ = [
     "RATE_SCALED_EVALS",
     "RATE_SATURATION_REFINE",
     "RATE_TAUS",
+    "RATE_TAU_MAX",
     "RATE_TAU_REFINE",
     "RateBasis",
     "SCALED",
