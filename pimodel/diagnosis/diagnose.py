@@ -711,9 +711,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     candidates.sort(key=lambda c: c["delta_bic"])
     corrections: dict = {}
 
-    def beside(new, old, old_effects, fixed_, added) -> bool:
-        """``new`` passes against ``old`` (the effects ``old_effects``), or, when the effect
-        ``added`` is the drift, does once the chosen rate's own misfit on validate is set aside
+    def aside(new, old, old_effects, fixed_, added) -> bool:
+        """When the effect ``added`` is the drift: whether ``new`` passes against ``old`` (the
+        effects ``old_effects``) once the chosen rate's own misfit on validate is set aside
         (module misfit, memoised per rate). Only the drift: the rate's refinement ignores each
         record's level and trend, which is what the drift models, so it cannot take the
         drift's part; an effect of the input history (asymmetry, creep, lags) can take part of
@@ -725,8 +725,13 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 progress("the rate's own misfit set aside")
                 corrections[key] = rate_correction(old_effects, fixed_, fit, va)
             return corrections[key]
-        return _passes(va, new, old) or (added == "drift" and _passes_rate_aside(
-            va, new, old, correction, NOISE_STOP * noise))
+        return added == "drift" and _passes_rate_aside(va, new, old, correction,
+                                                       NOISE_STOP * noise)
+
+    def beside(new, old, old_effects, fixed_, added) -> bool:
+        """``new`` passes against ``old`` plainly (:func:`_passes`) or with a chosen rate's
+        misfit set aside (``aside``): the revision's drop test."""
+        return _passes(va, new, old) or aside(new, old, old_effects, fixed_, added)
 
     def choose(start=None):
         """The greedy rounds, the revision and the delay preference; ``start`` forces
@@ -768,8 +773,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                         dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
                         if dbic < best[0]:
                             best = (dbic, (first, name), m, o)
-            if not accepted(best) and not (chosen and beside(best[2:], (current, cur_out),
-                                                             chosen, fixed, best[1])):
+            # accepted(best) is _passes against the current choice (its BIC difference known)
+            if not accepted(best) and not (chosen and aside(best[2:], (current, cur_out),
+                                                            chosen, fixed, best[1])):
                 break
             if chosen and not _beyond_refinement((best[2], best[3]), chosen, fixed, fit, va):
                 break  # the misfit of the effects chosen, not a further effect
