@@ -201,3 +201,13 @@ def test_estimate_radii_argument_checks(weights, dt, gains, initial_radii, thres
                   ("weights", "dt", "gains", "initial_radii", "threshold", "slope_window"))
     if res is not None:
         finite(res.radii)
+
+
+def test_identify_on_an_output_too_small_for_float64_names_y():
+    """Found by Hypothesis in CI: an output of about 1e-302 gives loop-slope weights whose
+    |p|^2 underflows to 0, and the estimator's default gain 20 / |p|^2 divided by zero; now a
+    ValueError naming y (the weights come from y's scale)."""
+    v = 1e-9 * np.sin(np.linspace(0, 6 * np.pi, 60))
+    y = 1e-293 * PIOperator([1.0, 0.5], [0.0, 4e-10]).simulate(v)
+    with pytest.raises(ValueError, match=r"^y: the loop slopes' weights"):
+        identify(v, y, dt=1e-3, method="adaptive")

@@ -31,6 +31,7 @@ from .adaptive.health import EstimatorHealth, estimator_health, refined_health
 from .adaptive.joint import JointEstimator
 from .adaptive.polish import refine_radii
 from .adaptive.radius_estimator import RadiusEstimator, run_tail_average
+from .adaptive.settings import _norm2
 from .branches import find_reversals
 from .conventional import fit_conventional
 from .identifiability import ExcitationReport, check_excitation
@@ -357,7 +358,12 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     guess = PIOperator(p, slopes.radii_guess)
     offset, _, _ = _errors(guess, v, y)
 
-    g = 20.0 / float(p @ p) if gains is None else gains
+    if gains is None:
+        try:
+            pp = _norm2(p)
+        except ValueError as err:  # weights taken from y's loop slopes: y's scale is at fault
+            raise ValueError(f"y: the loop slopes' {err}") from None
+    g = 20.0 / pp if gains is None else gains
     rev = find_reversals(v, 0.01 * float(np.ptp(v)))
     first = rev[0] if rev else 0
     if passes is None:
