@@ -122,7 +122,8 @@ def main() -> None:
                       f"{r['plays']} plays; {r['cpu'] / rows[(n, 'baseline', 1)]['cpu']:.0f} "
                       "baseline fits of CPU", flush=True)
         one, more = rows.get((n, "diagnosis", 1)), [rows.get((n, "diagnosis", w))
-                                                    for w in args.workers if w > 1]
+                                                    for w in dict.fromkeys(args.workers)
+                                                    if w > 1]
         for r in (r for r in more if r is not None and one is not None):
             print(f"{'':>10} wall ratio (threads / one thread) {r['wall'] / one['wall']:.2f}, "
                   f"CPU ratio {r['cpu'] / one['cpu']:.2f}")

@@ -854,6 +854,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         progress("the chosen model on the whole records")
         for s in segs:  # the screen's kept play-row Grams (and rows) are done with
             s.forget_grams()
+        pool.close()  # the refit is one thread's: the others end, with what they held
         tr, va, out_va = whole
         if chosen:
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
