@@ -98,3 +98,21 @@ def test_once_cache_computes_each_key_once_across_threads():
         second = pool.submit(cache.get, "k", lambda: 0)
         gate.set()
         assert (first.result(), second.result(), len(calls)) == (42, 42, 1)
+
+
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
+def test_cli_workers_option(tmp_path, capsys):
+    """``pimodel diagnose --workers N``: N >= 1 runs (the clean stage: ``none``), 0 is refused."""
+    from pimodel import save_record
+    from pimodel.cli import main
+
+    train, validate = records([], 4)
+    save_record(train[0], tmp_path / "a.csv")
+    save_record(validate[0], tmp_path / "b.csv")
+    args = ["diagnose", "--train", str(tmp_path / "a.csv"), "--validate",
+            str(tmp_path / "b.csv"), "--json", str(tmp_path / "d.json"), "--quiet"]
+    assert main([*args, "--workers", "2"]) == 0
+    assert json.loads((tmp_path / "d.json").read_text())["verdict"]["effects"] == ["none"]
+    with pytest.raises(SystemExit):
+        main([*args[:-3], "--json", str(tmp_path / "e.json"), "--workers", "0"])
+    assert ">= 1" in capsys.readouterr().err
