@@ -60,8 +60,18 @@ def register(sub) -> None:
     p.add_argument("--quiet", action="store_true",
                    help="no progress line on stderr (it is shown only when stderr is a "
                    "terminal)")
+    p.add_argument("--workers", type=_workers, default=None, metavar="N",
+                   help="threads for the diagnosis' independent fits (the same report for any "
+                   "N; 1: one thread; default: the CPUs, at most 2)")
     add_columns_option(p)
     p.set_defaults(func=run)
+
+
+def _workers(text: str) -> int:
+    n = int(text)
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text}")
+    return n
 
 
 def run(args: argparse.Namespace) -> int:
@@ -77,7 +87,8 @@ def run(args: argparse.Namespace) -> int:
     train = load_inputs(args, args.train, inputs)
     validate = load_inputs(args, args.validate, inputs)
     show = progress_line(args.quiet, label="diagnose")
-    rep = diagnose(train, validate, initial_state=args.initial_state, progress=show)
+    rep = diagnose(train, validate, initial_state=args.initial_state, progress=show,
+                   workers=args.workers)
     if show is not None:
         show("done")
         sys.stderr.write("\n")

@@ -80,6 +80,7 @@ from .gain import gain_note, record_gains
 from .misfit import rate_correction
 from .noise import measure_noise_floor
 from .rate import RATE_KEYS, RateBasis, rate_shapes
+from .threads import OnceCache, Pool, default_workers
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
 
@@ -289,7 +290,8 @@ def _check(records: list[Record], role: str) -> None:
 
 def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 3,
              initial_state: str = "rest",
-             progress: Callable[[str], None] | None = None) -> DiagnosisReport:
+             progress: Callable[[str], None] | None = None,
+             workers: int | None = None) -> DiagnosisReport:
     """Diagnose the gap between a PI model fitted on ``train`` and the ``validate`` records.
 
     Parameters
@@ -307,6 +309,13 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     progress : callable or None
         Called with a short message (``"candidate creep (1/6)"``) as each stage of the
         diagnosis starts (for a progress line on long records); None: silent.
+    workers : int or None
+        Threads for the independent fits (the candidates, the effects of a greedy round, the
+        pairs, the revision's swaps and drops, the refined and re-searched lags) and the
+        baseline beside the nominal; their results are taken in the serial order, so the
+        report is the same to the bit for any ``workers`` (module threads). 1: one thread,
+        the serial path. None: the CPUs this process may use, at most 2
+        (:func:`.threads.default_workers`).
 
     Returns
     -------
@@ -321,7 +330,7 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     ------
     ValueError
         Empty lists, records shorter than 200 samples or without a reversal, differing sample
-        times, an unknown ``initial_state``.
+        times, an unknown ``initial_state``, ``workers`` below 1.
 
     Warns
     -----
@@ -341,15 +350,18 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     if initial_state not in INITIAL_STATES:
         raise ValueError(f"initial_state: expected one of {INITIAL_STATES}, got "
                          f"{initial_state!r}")
+    workers = default_workers() if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+        raise ValueError(f"workers: expected an integer >= 1 or None, got {workers!r}")
     shared = [r.source for r in validate if any(
         r.t.size == t.t.size and np.array_equal(r.v, t.v) and np.array_equal(r.y, t.y)
         for t in train)]
     if shared:
         warnings.warn(f"validate: {shared} also in train; nothing is held out, so the validate "
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
-    with threadpool_limits(1, user_api="blas"):
+    with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool:
         return _diagnose(train, validate, max_effects, initial_state,
-                         progress or (lambda message: None))
+                         progress or (lambda message: None), pool)
 
 
 def _mask(r: Record, initial_state: str) -> np.ndarray | None:
@@ -612,7 +624,8 @@ def _projected(s: Segment, radii, V: np.ndarray, at_rest: bool) -> Segment:
 
 
 def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
-              initial_state: str, progress: Callable[[str], None]) -> DiagnosisReport:
+              initial_state: str, progress: Callable[[str], None],
+              pool: Pool) -> DiagnosisReport:
     _check(train, "train")
     _check(validate, "validate")
     dts = [(r.source, r.dt) for r in train + validate]
@@ -629,6 +642,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     # first SCREEN_SAMPLES samples (the segments tr, va); the chosen model is refitted on the
     # whole records (_whole_fit), whose play rows are built only then
     screened = any(len(r) > SCREEN_SAMPLES for r in train + validate)
+    # the baseline does not depend on the nominal: on a second thread, beside it
+    baseline = pool.submit(_baseline, train, validate, initial_state) if pool.workers > 1 \
+        else None
     tr, va, nominal, full_nominal, proj, out_tr, out_va, *whole = _nominal_segments(
         train, validate, radii, initial_state, at_rest, SCREEN_SAMPLES if screened else None)
     before = _errors(whole[1], out_va)
@@ -641,7 +657,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                               "plays_start": "at rest at v[0]" if at_rest else "at 0"},
                     "train": _errors(whole[0], out_tr), "validate": before,
                     "initial_state": initial_state,
-                    "baseline": _baseline(train, validate, initial_state)}
+                    "baseline": baseline.result() if baseline is not None else
+                    _baseline(train, validate, initial_state)}
     base_rms = nominal_json["baseline"]["validate"]["rms"]
     if before["rms"] > BASELINE_WARN * base_rms:
         warnings.warn(f"nominal: validate RMS {before['rms']:.4g} is {before['rms'] / base_rms:.2f}"
@@ -672,6 +689,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                                      at_rest=at_rest)
 
     cache: dict = {}
+    once = OnceCache() if pool.workers > 1 else None  # several threads: each key fitted once
 
     def fit(name, combo=(), fixed_=None):
         """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
@@ -685,12 +703,12 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},
                   **var, **shape}
             key = (combo, name, tuple(sorted(fx.items())))
-            if key not in cache:
-                m = fit_effect(name, tr, combo, fx, nominal)
-                cache[key] = (m, [m.predict(s) for s in va])
-                m.params.update(level_report(m, va, tr))
-                _release(m, segs)
-            m, o = cache[key]
+            if once is not None:
+                m, o = once.get(key, lambda name=name, fx=fx: fit_one(name, combo, fx))
+            else:
+                if key not in cache:
+                    cache[key] = fit_one(name, combo, fx)
+                m, o = cache[key]
             score = _bic(va, o, m.k)
             if _flat_settling(m, tr, va, noise):  # a settling no bow tells from a trend
                 continue
@@ -698,6 +716,22 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 best = (score, m, o)
         return best[1], best[2]
 
+    def fit_one(name, combo, fx):
+        m = fit_effect(name, tr, combo, fx, nominal)
+        out = (m, [m.predict(s) for s in va])
+        m.params.update(level_report(m, va, tr))
+        _release(m, segs)  # (the bases' memos of this thread: module threads)
+        return out
+
+    def prefetch(calls) -> None:
+        """With several threads: make the fits ``calls`` (``fit``'s arguments) on the pool, the
+        longest kinds first; the loops after them take them from the cache in their own
+        order, so every comparison and tie is decided as on one thread."""
+        if pool.workers > 1:
+            calls = sorted(calls, key=lambda c: -_cost(c[0], c[1] if len(c) > 1 else ()))
+            pool.map(lambda c: fit(*c), calls)
+
+    prefetch([(name,) for name in EFFECTS])
     candidates = []
     for i, name in enumerate(EFFECTS):
         progress(f"candidate {name} ({i + 1}/{len(EFFECTS)})")
@@ -746,6 +780,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if rms_now <= NOISE_STOP * noise:
                 break
             best = None
+            prefetch([(name, chosen, dict(fixed) if chosen else None)
+                      for name in (EFFECTS if chosen or start is None else (start,))
+                      if name not in chosen])
             for name in EFFECTS if chosen or start is None else (start,):
                 if name in chosen:
                     continue
@@ -765,6 +802,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 # when no single effect passes in the first round, try every pair jointly (a
                 # forced start: every pair with it)
                 rest = [e for e in EFFECTS if e not in chosen]
+                prefetch([(name, (*chosen, first), dict(fixed) if chosen else None)
+                          for i, first in enumerate(rest) for name in rest[i + 1:]
+                          if start is None or start in (first, name)])
                 for i, first in enumerate(rest):
                     for name in rest[i + 1:]:
                         if start is not None and start not in (first, name):
@@ -773,6 +813,10 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                         dbic = _bic(va, o, m.k) - _bic(va, cur_out, current.k)
                         if dbic < best[0]:
                             best = (dbic, (first, name), m, o)
+            if accepted(best) and pool.workers > 1:  # the fits the acceptance may need next
+                then = chosen + (best[1] if isinstance(best[1], tuple) else (best[1],))
+                prefetch((_refined_calls(chosen, fixed) if chosen else []) +
+                         _lag_calls(then, {**fixed, **best[2].grid}))
             # accepted(best) is _passes against the current choice (its BIC difference known)
             if not accepted(best) and not (chosen and aside(best[2:], (current, cur_out),
                                                             chosen, fixed, best[1])):
@@ -787,7 +831,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                                                      fit, va)
         progress("revising the choice")
         chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
-                                           (nominal, out_va), noise, beside)
+                                           (nominal, out_va), noise, beside,
+                                           pool.map if pool.workers > 1 else None)
         chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
         return chosen, fixed, current, cur_out
 
@@ -809,6 +854,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         progress("the chosen model on the whole records")
         for s in segs:  # the screen's kept play-row Grams (and rows) are done with
             s.forget_grams()
+        pool.close()  # the refit is one thread's: the others end, with what they held
         tr, va, out_va = whole
         if chosen:
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
@@ -902,7 +948,7 @@ def _release(model: Model, segs: list[Segment]) -> None:
                 basis.release()
 
 
-def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=None):
+def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=None, pmap=None):
     """Revise the greedy choice on the terms it was made on (each effect must lower the
     validate BIC by ``MIN_BIC_DROP`` and cut the validate RMS by ``MIN_RMS_CUT`` given the
     others). Greedy rounds judge a candidate beside the effects chosen so far only, so an
@@ -914,7 +960,9 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     noise floor); ``beside(new, old, old_effects, fixed, dropped)`` is that drop test (None:
     :func:`_passes`; the diagnosis sets a chosen rate's own misfit aside, module misfit, as
     when the effect was added). Other effects keep their grid parameters; returns ``(chosen,
-    model, validate outputs)``."""
+    model, validate outputs)``. ``pmap(refit, combinations)`` (None: none) makes a step's
+    refits beforehand, on several threads (``fit`` keeps them; the step then takes them in
+    its own order)."""
     def keys_of(e):  # grid parameters of an effect, as its single fit reports them (a drift's
         # and a rate's all of their kind: a single fit of another family or variant lacks some,
         # e.g. rate_growth, which a held SCALED rate needs)
@@ -932,6 +980,9 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     cur = (current, cur_out)
     for _ in range(len(EFFECTS)):  # swaps, the best first
         best = None
+        if pmap is not None:
+            pmap(refit, [(*(c for c in chosen if c != e), x) for e in chosen
+                         for x in EFFECTS if x not in chosen])
         for e in chosen:
             rest = tuple(c for c in chosen if c != e)
             for x in (x for x in EFFECTS if x not in chosen):
@@ -945,6 +996,8 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
         fixed.update(cur[0].grid)
     while chosen:  # drops, the least needed first
         worst = None
+        if pmap is not None:
+            pmap(refit, [tuple(c for c in chosen if c != e) for e in chosen])
         for e in chosen:
             rest = tuple(c for c in chosen if c != e)
             without = refit(rest)
@@ -996,6 +1049,16 @@ def _beyond_refinement(new, chosen, fixed, fit, va) -> bool:
     searched again beside the others (its base mode was chosen before they were modelled) with
     one further element of its linear part. So a misfit of one effect is not named as
     another."""
+    for call in _refined_calls(chosen, fixed):
+        if not _passes(va, new, fit(*call)):
+            return False
+    return True
+
+
+def _refined_calls(chosen, fixed) -> list[tuple]:
+    """The fits (``fit``'s arguments) of :func:`_beyond_refinement`, in its order: the
+    combination ``chosen`` with each chosen effect's own model refined one step."""
+    calls = []
     for e in chosen:
         if e == "creep":
             refined = {**fixed, "refine": "creep"}
@@ -1004,9 +1067,28 @@ def _beyond_refinement(new, chosen, fixed, fit, va) -> bool:
                        "lti_min": len(fixed.get("lti", ())) + 1}
         else:
             continue
-        if not _passes(va, new, fit(chosen[-1], chosen[:-1], refined)):
-            return False
-    return True
+        calls.append((chosen[-1], chosen[:-1], refined))
+    return calls
+
+
+def _lag_calls(chosen, fixed) -> list[tuple]:
+    """The fits (``fit``'s arguments) of :func:`_research_lag`, in its order: the lag chosen
+    searched again beside the other effects, then the other lag in its place (none when
+    ``chosen`` is not one lag beside other effects)."""
+    lags = [e for e in chosen if e in LAG_EFFECTS]
+    if len(chosen) < 2 or len(lags) != 1:
+        return []
+    kept = {k: x for k, x in fixed.items() if k not in LAG_KEYS} | {"search_all": True}
+    other = next(e for e in LAG_EFFECTS if e != lags[0])
+    return [(option[-1], option[:-1], dict(kept))
+            for option in (chosen, tuple(other if e == lags[0] else e for e in chosen))]
+
+
+def _cost(name: str, combo: tuple) -> int:
+    """A rough rank of a fit's cost (the pool starts the longest first): a mode search or a
+    rate's exact-shape search costs tens to hundreds of passes, a creep or asymmetry a few."""
+    return sum({"dynamics": 4, "rate": 4, "drift": 2, "delay": 2}.get(e, 1)
+               for e in (*combo, name))
 
 
 def _research_lag(chosen, cur, fixed, fit, va):
@@ -1020,14 +1102,13 @@ def _research_lag(chosen, cur, fixed, fit, va):
     the leading columns only, a base mode searched beside an asymmetry ran to the grid's
     lower end (density_stage seed 1: train RMS 0.148 um against 0.053 um at the stage's own
     mode). ``fixed`` is updated; returns ``(chosen, model, validate outputs)``."""
-    lags = [e for e in chosen if e in LAG_EFFECTS]
-    if len(chosen) < 2 or len(lags) != 1:
+    calls = _lag_calls(chosen, fixed)
+    if not calls:
         return chosen, cur[0], cur[1]
-    kept = {k: x for k, x in fixed.items() if k not in LAG_KEYS} | {"search_all": True}
-    other = next(e for e in LAG_EFFECTS if e != lags[0])
     best = (_bic(va, cur[1], cur[0].k), chosen, cur)
-    for option in (chosen, tuple(other if e == lags[0] else e for e in chosen)):
-        new = fit(option[-1], option[:-1], dict(kept))
+    for call in calls:
+        option = (*call[1], call[0])
+        new = fit(*call)
         score = _bic(va, new[1], new[0].k)
         if score < best[0]:
             best = (score, option, new)

@@ -10,6 +10,7 @@ parameters to the nominal model (for the information criterion on the validate r
 from __future__ import annotations
 
 import copy
+import threading
 import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
@@ -81,6 +82,7 @@ MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Ny
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
 LTI_MEMO = 16  # columns of the linear part's elements memoised per record (the last base mode)
+_ORDER_LOCK = threading.Lock()  # guards the memos of _order_memo (module threads)
 SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
@@ -183,7 +185,7 @@ class Segment:
         ...                    [0.0])
         >>> seg.forget_grams()  # nothing kept yet: nothing to drop
         """
-        self.__dict__.pop("_first_grams", None)
+        self.__dict__.pop("_first_grams", None)  # every thread's
 
 
 def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
@@ -444,10 +446,11 @@ def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
         return None
     cuts = list(chunks(s.y.size))
     key = (Z.__array_interface__["data"][0], Z.shape, Z.strides, len(cuts))
-    memo = s.__dict__.get("_first_grams")
+    kept = s.__dict__.setdefault("_first_grams", {})  # per thread (module threads)
+    memo = kept.get(threading.get_ident())
     if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
         grams = [X @ X.T for X in (_used_chunk((Z,), s, c)[0][0] for c in cuts)]
-        memo = s.__dict__["_first_grams"] = (key, Z, grams)
+        memo = kept[threading.get_ident()] = (key, Z, grams)
     return memo[2]
 
 
@@ -635,17 +638,21 @@ def _order_memo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) ->
     lti_min = fixed.get("lti_min", 0)
     key = (effects, tuple(id(s) for s in train),
            repr(sorted((k_, v) for k_, v in fixed.items() if k_ != "lti_min")))
-    memo = nominal.__dict__.setdefault("_order_memo", {})
-    known = memo.setdefault(key, {"runs": []})
-    if not all(r() is s for r, s in zip(known.setdefault("train", [weakref.ref(s) for s in train]),
-                                         train, strict=True)):
-        known = memo[key] = {"runs": [], "train": [weakref.ref(s) for s in train]}
-    for m0, chose, model in known["runs"]:
-        if m0 <= lti_min <= chose:
-            return _copy_model(model)
-    known.pop("elements", None)
-    model = _fit_combo(effects, train, dict(fixed), nominal, known)
-    known["runs"].append((lti_min, known.pop("elements", -1), _copy_model(model)))
+    with _ORDER_LOCK:  # one memo per key, filled by one thread at a time (module threads)
+        memo = nominal.__dict__.setdefault("_order_memo", {})
+        known = memo.setdefault(key, {"runs": [], "lock": threading.Lock()})
+        if not all(r() is s for r, s in zip(known.setdefault("train", [weakref.ref(s) for s in
+                                                                        train]),
+                                             train, strict=True)):
+            known = memo[key] = {"runs": [], "train": [weakref.ref(s) for s in train],
+                                 "lock": threading.Lock()}
+    with known["lock"]:
+        for m0, chose, model in known["runs"]:
+            if m0 <= lti_min <= chose:
+                return _copy_model(model)
+        known.pop("elements", None)
+        model = _fit_combo(effects, train, dict(fixed), nominal, known)
+        known["runs"].append((lti_min, known.pop("elements", -1), _copy_model(model)))
     return model
 
 

@@ -71,6 +71,7 @@ from scipy.signal import lfilter
 from .. import _native
 from ..operators.pi import PIOperator
 from .chunked import chunks
+from .threads import drop_threads, per_thread
 
 RATE_TAUS = (0.0, 1e-3, 3e-3, 10e-3, 30e-3)  # s: low-pass of the input rate, half decades
 RATE_TAU_START = 0.0  # the filter held while other grids (mode, delay, ...) are searched
@@ -302,6 +303,13 @@ class RateBasis:
     [0.0, 0.0, 0.025, 0.0]
     """
 
+    _cache = per_thread("cache", dict)
+    _weighted = per_thread("weighted", lambda: None)
+    _contacts = per_thread("contacts", lambda: None)
+
+    def __getstate__(self) -> dict:
+        return drop_threads(self.__dict__)
+
     def __init__(self, Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
                  weights, bands: int = RATE_BANDS, *, input_range: float | None = None,
                  at_rest: bool = False, projection: np.ndarray | None = None):
@@ -311,9 +319,9 @@ class RateBasis:
         self.bands = play_bands(self.radii.size, bands)
         self.weights = np.asarray(weights, float)
         self._starts = [int(g[0]) for g in self.bands]
-        self._weighted = None  # band sums of w0_i z_i, built on first use
-        self._cache: dict = {}
-        self._contacts = None  # per chunk: each play's last contact and its sign (below)
+        # memos (per thread, module threads): the band sums of w0_i z_i, built on first use
+        # (_weighted); the latest columns (_cache); per chunk, each play's last contact and
+        # its sign (_contacts, below)
 
     def rate(self, tau: float) -> np.ndarray:
         """The filtered rate ``rho_f`` of the record (:func:`input_rate`).

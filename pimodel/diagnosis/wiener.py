@@ -39,6 +39,7 @@ from scipy.signal import bilinear_zpk, lfilter, lfilter_zi, sosfilt, sosfilt_zi,
 
 from ..operators.pi import PIOperator
 from .lti import INVERSE_FILTER, element_coefficients, nelder_mead
+from .threads import drop_threads, per_thread
 
 __all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "inverse_sections",
            "polish_filter", "position_hint", "prefilter", "search_filter", "wiener_k"]
@@ -179,13 +180,17 @@ class WienerBasis:
     [[0.0, 0.0], [0.0, 0.0], [0.6321, 0.1321]]
     """
 
+    _cache = per_thread("cache", dict)  # the kept columns, per thread (module threads)
+
+    def __getstate__(self) -> dict:
+        return drop_threads(self.__dict__)
+
     def __init__(self, v: np.ndarray, radii, projection: np.ndarray | None, dt: float, *,
                  at_rest: bool = True):
         self.v, self.dt = np.asarray(v, float), float(dt)
         self.at_rest = at_rest
         self.radii = np.asarray(radii, float)
         self.projection = projection
-        self._cache: dict = {}
 
     def columns(self, elements: Sequence, ncols: int | None = None) -> np.ndarray:
         """The play columns of ``F[v]`` (the leading ``ncols`` of them; None: all).

@@ -1,0 +1,156 @@
+"""Threads for the diagnosis: its independent fits on a pool of threads in one process, the
+results taken in the serial order (issue 31, the wall-time goal).
+
+The heavy work of a fit is NumPy (BLAS and ufuncs release the GIL on large arrays) and the C
+core through ctypes (``ctypes.CDLL`` releases it during each call), so two threads can keep two
+cores busy. What a fit memoises on objects that the threads share is kept per thread
+(:func:`per_thread`), so no thread sees another's half-built memo and each thread's
+``release()`` drops its own. :class:`Pool` with one worker runs everything inline, in the
+caller's order: the serial path, unchanged.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Iterable
+from concurrent.futures import Future, ThreadPoolExecutor
+
+__all__ = ["Pool", "OnceCache", "per_thread", "default_workers"]
+
+MAX_DEFAULT_WORKERS = 2  # the default pool: the cores, at most this many
+
+
+def default_workers() -> int:
+    """The default number of threads of a diagnosis: the CPUs this process may run on, at most
+    ``MAX_DEFAULT_WORKERS`` (at least 1).
+
+    Examples
+    --------
+    >>> 1 <= default_workers() <= MAX_DEFAULT_WORKERS
+    True
+    """
+    import os
+
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        n = os.cpu_count() or 1
+    return max(1, min(MAX_DEFAULT_WORKERS, n))
+
+
+def per_thread(name: str, factory: Callable[[], object]) -> property:
+    """A property whose value is kept per thread (in the instance's ``_threads``, a
+    ``threading.local`` created on first use), starting at ``factory()`` in each thread.
+
+    Examples
+    --------
+    >>> class Memo:
+    ...     cache = per_thread("cache", dict)
+    >>> m = Memo(); m.cache["a"] = 1
+    >>> out = []
+    >>> t = threading.Thread(target=lambda: out.append(dict(m.cache))); t.start(); t.join()
+    >>> m.cache, out
+    ({'a': 1}, [{}])
+    """
+    def local(self) -> threading.local:
+        loc = self.__dict__.get("_threads")
+        if loc is None:
+            loc = self.__dict__.setdefault("_threads", threading.local())
+        return loc
+
+    def get(self):
+        loc = local(self)
+        try:
+            return getattr(loc, name)
+        except AttributeError:
+            value = factory()
+            setattr(loc, name, value)
+            return value
+
+    def set_(self, value) -> None:
+        setattr(local(self), name, value)
+
+    return property(get, set_)
+
+
+def drop_threads(state: dict) -> dict:
+    """``state`` (an instance's ``__dict__``) without its per-thread memos, for pickling and
+    copying (a ``threading.local`` is neither; the memos are rebuilt on use)."""
+    return {k: x for k, x in state.items() if k != "_threads"}
+
+
+class Pool:
+    """``workers`` threads for independent calls; one worker: every call inline, in order.
+
+    Examples
+    --------
+    >>> with Pool(2) as pool:
+    ...     pool.map(lambda x: x * x, [1, 2, 3]), pool.submit(sum, [1, 2]).result()
+    ([1, 4, 9], 3)
+    """
+
+    def __init__(self, workers: int):
+        self.workers = int(workers)
+        self._executor = ThreadPoolExecutor(self.workers, thread_name_prefix="pimodel-diagnose") \
+            if self.workers > 1 else None
+
+    def map(self, fn: Callable, items: Iterable) -> list:
+        """``[fn(x) for x in items]``, the calls spread over the threads, results in order."""
+        if self._executor is None:
+            return [fn(x) for x in items]
+        return list(self._executor.map(fn, items))
+
+    def submit(self, fn: Callable, *args) -> Future:
+        """``fn(*args)`` on a thread (one worker: called now); its Future."""
+        if self._executor is not None:
+            return self._executor.submit(fn, *args)
+        f: Future = Future()
+        f.set_result(fn(*args))
+        return f
+
+    def close(self) -> None:
+        """Wait for the calls under way and end the threads."""
+        if self._executor is not None:
+            self._executor.shutdown(wait=True, cancel_futures=True)
+
+    def __enter__(self) -> Pool:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class OnceCache:
+    """A memo whose every key is computed once: a thread asking for a key another thread is
+    computing waits for that result (no fit made twice, none with a half-filled memo).
+
+    Examples
+    --------
+    >>> c = OnceCache(); calls = []
+    >>> c.get("k", lambda: calls.append(1) or 7), c.get("k", lambda: 0), calls
+    (7, 7, [1])
+    """
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._entries: dict = {}
+
+    def __contains__(self, key) -> bool:
+        return key in self._entries
+
+    def get(self, key, compute: Callable[[], object]):
+        """The value of ``key``, from ``compute()`` the first time (exceptions not kept)."""
+        with self._lock:
+            entry = self._entries.get(key)
+            mine = entry is None
+            if mine:
+                entry = self._entries[key] = Future()
+        if mine:
+            try:
+                entry.set_result(compute())
+            except BaseException as exc:
+                with self._lock:
+                    del self._entries[key]
+                entry.set_exception(exc)
+                raise
+        return entry.result()

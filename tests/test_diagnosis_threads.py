@@ -1,0 +1,118 @@
+"""The diagnosis on several threads (``diagnose(workers=N)``, module
+``pimodel.diagnosis.threads``): the same report to the bit as on one thread, and the memos
+the threads share kept per thread."""
+
+from __future__ import annotations
+
+import json
+import threading
+
+import numpy as np
+import pytest
+
+from pimodel.diagnosis import diagnose
+from pimodel.diagnosis.rate import RateBasis
+from pimodel.diagnosis.threads import OnceCache, Pool
+from pimodel.stages.pi_stage import excitation, random_truth
+
+
+def records(effects, seed, drift_clock="record"):
+    """Train and validate records (as ``tests/test_diagnosis.py``'s)."""
+    tt, vt = excitation("train", seed=2 * seed + 1)
+    tv, vv = excitation("validate", seed=2 * seed + 2)
+    truth = random_truth(list(effects), seed, drift_clock=drift_clock)
+    tv = tv + tt[-1] + 1.0
+    return [truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed, "val")]
+
+
+def _everything(rep) -> tuple:
+    """The whole report: its JSON (verdict, candidates, nominal, where, the model's
+    parameters), the validate predictions and the exported model's output, as bytes."""
+    text = json.dumps(rep.to_json(), sort_keys=True, default=lambda x: np.asarray(x).tolist())
+    arrays = [np.asarray(a).tobytes() for a in (*rep.before, *rep.after)]
+    v = rep.validate[0].v
+    return text, arrays, rep.model().simulate(v).tobytes()
+
+
+@pytest.mark.slow  # two diagnoses of about 5-10 s each
+def test_the_same_report_to_the_bit_on_one_and_two_threads():
+    """Creep + dynamics: the candidates, two greedy rounds, the refined dynamics, the lag's
+    re-search and the revision, each batch of fits on two threads."""
+    train, validate = records(("creep", "dynamics"), 0)
+    one = diagnose(train, validate, workers=1)
+    two = diagnose(train, validate, workers=2)
+    assert one.verdict["effects"] == two.verdict["effects"]
+    assert _everything(one) == _everything(two)
+
+
+def test_workers_must_be_a_positive_integer():
+    train, validate = records([], 4)
+    for bad in (0, -1, 1.5, True):
+        with pytest.raises(ValueError, match="workers"):
+            diagnose(train, validate, workers=bad)
+
+
+def test_a_rate_basis_keeps_its_columns_per_thread():
+    """Two threads asking one basis for different filters at once each get their own columns
+    (one thread's memo of the latest filter never replaces what the other is using)."""
+    v = np.sin(np.linspace(0.0, 20.0, 4000)) + 0.1 * np.sin(np.linspace(0.0, 400.0, 4000))
+    basis = RateBasis(None, np.linspace(0.0, 0.8, 8), v, 1e-3, 1.0, np.ones(8),
+                      at_rest=True)
+    taus = (1e-3, 3e-2)
+    want = {tau: RateBasis(None, np.linspace(0.0, 0.8, 8), v, 1e-3, 1.0, np.ones(8),
+                           at_rest=True).columns(tau, "radius").copy() for tau in taus}
+    errors, barrier = [], threading.Barrier(2)
+
+    def work(tau):
+        barrier.wait()
+        for _ in range(30):
+            try:
+                cols = basis.columns(tau, "radius")
+                basis.columns(tau, "weight")
+                if not np.array_equal(cols, want[tau]):
+                    errors.append(tau)
+                basis.release()
+            except Exception as exc:  # another thread's release or memo under this one
+                errors.append(repr(exc))
+
+    threads = [threading.Thread(target=work, args=(tau,)) for tau in taus]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+
+
+def test_once_cache_computes_each_key_once_across_threads():
+    cache, calls, gate = OnceCache(), [], threading.Event()
+
+    def slow():
+        calls.append(1)
+        gate.wait(5.0)
+        return 42
+
+    with Pool(2) as pool:
+        first = pool.submit(cache.get, "k", slow)
+        while not calls:
+            pass
+        second = pool.submit(cache.get, "k", lambda: 0)
+        gate.set()
+        assert (first.result(), second.result(), len(calls)) == (42, 42, 1)
+
+
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
+def test_cli_workers_option(tmp_path, capsys):
+    """``pimodel diagnose --workers N``: N >= 1 runs (the clean stage: ``none``), 0 is refused."""
+    from pimodel import save_record
+    from pimodel.cli import main
+
+    train, validate = records([], 4)
+    save_record(train[0], tmp_path / "a.csv")
+    save_record(validate[0], tmp_path / "b.csv")
+    args = ["diagnose", "--train", str(tmp_path / "a.csv"), "--validate",
+            str(tmp_path / "b.csv"), "--json", str(tmp_path / "d.json"), "--quiet"]
+    assert main([*args, "--workers", "2"]) == 0
+    assert json.loads((tmp_path / "d.json").read_text())["verdict"]["effects"] == ["none"]
+    with pytest.raises(SystemExit):
+        main([*args[:-3], "--json", str(tmp_path / "e.json"), "--workers", "0"])
+    assert ">= 1" in capsys.readouterr().err
