@@ -5,7 +5,9 @@ the threads share kept per thread."""
 from __future__ import annotations
 
 import json
+import sys
 import threading
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,16 +15,9 @@ import pytest
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.rate import RateBasis
 from pimodel.diagnosis.threads import OnceCache, Pool
-from pimodel.stages.pi_stage import excitation, random_truth
 
-
-def records(effects, seed, drift_clock="record"):
-    """Train and validate records (as ``tests/test_diagnosis.py``'s)."""
-    tt, vt = excitation("train", seed=2 * seed + 1)
-    tv, vv = excitation("validate", seed=2 * seed + 2)
-    truth = random_truth(list(effects), seed, drift_clock=drift_clock)
-    tv = tv + tt[-1] + 1.0
-    return [truth.record(tt, vt, seed, "train")], [truth.record(tv, vv, 100 + seed, "val")]
+sys.path.insert(0, str(Path(__file__).parent))
+from test_diagnosis import records  # noqa: E402 (train and validate records, one each)
 
 
 def _everything(rep) -> tuple:
