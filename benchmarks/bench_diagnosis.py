@@ -5,7 +5,7 @@ Run: ``.venv/bin/python benchmarks/bench_diagnosis.py [--samples 100000 300000 1
 Goals (issue 31): two 1M-sample records diagnosed in under 30 s and under 2 GB peak memory
 on two cores, time and memory growing at most linearly from 100k to 1M samples. Each size
 runs in a fresh process (its peak resident memory is the process' own, ``ru_maxrss``, and its
-peak address space, ``VmPeak``, what the memory test's ``RLIMIT_AS`` bounds), with
+peak address space, ``VmPeak``, reservations included), with
 wall time and process CPU time (less sensitive to the load of a shared machine). Baseline in
 the same run, also in its own process: one plain least-squares fit of a PI model
 (``np.linalg.lstsq`` on the 20-play design matrix of the train record), so the ratio says how
@@ -76,8 +76,8 @@ def run_one(n: int, what: str, workers: int = 1) -> dict:
 
 
 def _peak_address_space_mb() -> float | None:
-    """The process' peak virtual memory (``VmPeak``, what ``RLIMIT_AS`` bounds) [MB]; None
-    where ``/proc`` does not give it."""
+    """The process' peak virtual memory (``VmPeak``: what ``RLIMIT_AS`` bounds; reservations
+    count) [MB]; None where ``/proc`` does not give it."""
     try:
         with open("/proc/self/status") as fh:
             line = next(x for x in fh if x.startswith("VmPeak:"))
