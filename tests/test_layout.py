@@ -22,9 +22,9 @@ from pimodel._deprecated import MOVED
 PKG = Path(pimodel.__file__).resolve().parent
 
 # bottom to top: a module may import from its own layer or below (pimodel/__init__ is the top)
-LAYERS = ["checks", "signals", "plotting", "records", "_native", "_deprecated", "operators",
-          "reference", "identification", "blocks", "loops", "stages", "diagnosis", "model_files",
-          "fmu", "experiments", "cli", "__main__"]
+LAYERS = ["cores", "checks", "signals", "plotting", "records", "_native", "_deprecated",
+          "operators", "reference", "identification", "blocks", "loops", "stages", "diagnosis",
+          "model_files", "fmu", "experiments", "cli", "__main__"]
 
 
 def _modules() -> dict[str, Path]:

@@ -322,3 +322,27 @@ def test_local_workers_start_with_the_malloc_settings(monkeypatch, parent_trim):
     got = run_cases(_start_environment, [{"i": 0}, {"i": 1}], workers=2, progress=False)
     assert got == [WORKER_ENV, WORKER_ENV]
     assert os.environ.get("MALLOC_TRIM_THRESHOLD_") == parent_trim
+
+
+def _thread_budget_seen(params: dict) -> dict:
+    from pimodel.cores import available_cores
+    from pimodel.diagnosis.threads import default_workers
+
+    return {"cores": available_cores(), "diagnosis_threads": default_workers()}
+
+
+@pytest.mark.slow
+def test_cases_on_dask_workers_get_one_thread_and_serial_cases_the_cores(scheduler):
+    """A Dask worker runs one case per core: a case's own thread pools (the diagnosis') must
+    default to one thread there, or two workers of a 2-core machine run four threads; the
+    serial path keeps the process' cores."""
+    from pimodel.cores import available_cores
+
+    cloudpickle = pytest.importorskip("cloudpickle")
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    cases = [{"i": 0}, {"i": 1}]
+    on_workers = run_cases(_thread_budget_seen, cases, scheduler=scheduler, progress=False)
+    assert on_workers == [{"cores": 1, "diagnosis_threads": 1}] * 2
+    serial = run_cases(_thread_budget_seen, cases, workers=0, progress=False)
+    n = available_cores()
+    assert serial == [{"cores": n, "diagnosis_threads": min(2, n)}] * 2

@@ -15,27 +15,24 @@ import threading
 from collections.abc import Callable, Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
 
+from ..cores import available_cores
+
 __all__ = ["Pool", "OnceCache", "per_thread", "default_workers"]
 
 MAX_DEFAULT_WORKERS = 2  # the default pool: the cores, at most this many
 
 
 def default_workers() -> int:
-    """The default number of threads of a diagnosis: the CPUs this process may run on, at most
-    ``MAX_DEFAULT_WORKERS`` (at least 1).
+    """The default number of threads of a diagnosis: the cores this process may use
+    (:func:`pimodel.cores.available_cores`: within a sweep's case on a Dask worker, one), at
+    most ``MAX_DEFAULT_WORKERS``.
 
     Examples
     --------
     >>> 1 <= default_workers() <= MAX_DEFAULT_WORKERS
     True
     """
-    import os
-
-    try:
-        n = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        n = os.cpu_count() or 1
-    return max(1, min(MAX_DEFAULT_WORKERS, n))
+    return min(MAX_DEFAULT_WORKERS, available_cores())
 
 
 def per_thread(name: str, factory: Callable[[], object]) -> property:

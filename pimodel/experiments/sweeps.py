@@ -30,11 +30,14 @@ import json
 import os
 import random
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from contextlib import nullcontext
 from functools import partial
 from itertools import product
 from pathlib import Path
 
 import numpy as np
+
+from ..cores import available_cores, thread_budget
 
 # Per-worker memory limit of the local cluster. A case keeps its records chunked (the long
 # estimator records are made and consumed in chunks of a few MB); the largest study case
@@ -209,8 +212,12 @@ def _check_cases(cases) -> list[dict]:
     return [dict(p) for p in cases]
 
 
-def _call_case(func: Callable, params: dict):
+def _call_case(func: Callable, params: dict, threads: int | None = None):
     """Run one case with one BLAS thread; the result as JSON values (runs on the worker).
+
+    ``threads``: the case's thread budget (:func:`pimodel.cores.thread_budget`; what the
+    library's own thread pools, such as the diagnosis', default to); 1 on Dask workers, which
+    run one case per core; None in the serial path (the process' cores).
 
     The garbage of the case is collected before the next one: reference cycles (closures over
     their caches, caught exceptions' frames) can hold a case's arrays, and Python's collector
@@ -221,7 +228,8 @@ def _call_case(func: Callable, params: dict):
     from threadpoolctl import threadpool_limits
 
     try:
-        with threadpool_limits(limits=1):
+        with threadpool_limits(limits=1), (nullcontext() if threads is None
+                                           else thread_budget(threads)):
             result = func(dict(params))
         return json.loads(json.dumps(plain(result)))
     finally:
@@ -370,25 +378,6 @@ def run_cases(func: Callable[[dict], object], cases: Sequence[dict], *,
     return results
 
 
-def available_cores() -> int:
-    """Cores this process may use (the default number of local workers).
-
-    Returns
-    -------
-    int
-        ``len(os.sched_getaffinity(0))`` where available, else ``os.cpu_count()``, at least 1.
-
-    Examples
-    --------
-    >>> available_cores() >= 1
-    True
-    """
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not on Linux
-        return max(1, os.cpu_count() or 1)
-
-
 def _run_serial(func, cases, todo, results, cache, bar, counts) -> None:
     for done, i in enumerate(todo):
         try:
@@ -465,7 +454,7 @@ def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory
     client = Client(cluster if cluster is not None else scheduler)
     interrupted = False
     try:
-        run = partial(_call_case, func)
+        run = partial(_call_case, func, threads=1)
         keys = [f"case-{i}-{case_key(cases[i])}" for i in todo]
         futures = client.map(run, [cases[i] for i in todo], key=keys, pure=False)
         index = dict(zip(keys, todo, strict=True))
