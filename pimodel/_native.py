@@ -568,3 +568,39 @@ def biquad_rows(b: np.ndarray, a: np.ndarray, x: np.ndarray) -> np.ndarray:
     rows = xc.reshape(-1, xc.shape[-1]) if xc.ndim else xc
     lib.pim_biquad_rows(rows.shape[0], rows.shape[1], bb, aa, rows, out.reshape(rows.shape))
     return out
+
+
+lib.pim_biquad_rows_carry.restype = None
+lib.pim_biquad_rows_carry.argtypes = [c_size, c_size, F64, F64, F64, F64, F64, ctypes.c_int]
+
+
+def biquad_rows_carry(b: np.ndarray, a: np.ndarray, x: np.ndarray,
+                      state: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`biquad_rows` on a chunk of each row, the filter's state carried
+    (``fmu/src/pim_filter.h``): the chunks of a row filtered in turn, each with the state the
+    previous one returned, give the bits of :func:`biquad_rows` on the whole row.
+
+    Parameters
+    ----------
+    b, a : numpy.ndarray
+        Numerator and denominator in powers of ``z^-1``, at most 3 coefficients each.
+    x : numpy.ndarray
+        The chunk, signals as rows, shape (m, L) (1-D: one signal).
+    state : numpy.ndarray or None
+        The states ``s0[k-1], s1[k-1]`` before the chunk, shape (m, 2), as returned for the
+        previous chunk; None: the rows' first chunk (at rest around its first sample).
+
+    Returns
+    -------
+    y, state : numpy.ndarray
+        The filtered chunk (shape of ``x``) and the states after its last sample, (m, 2).
+    """
+    bb, aa = np.zeros(3), np.zeros(3)
+    bb[:len(b)], aa[:len(a)] = b, a
+    xc = np.ascontiguousarray(x, dtype=float)
+    out = np.empty_like(xc)
+    rows = xc.reshape(-1, xc.shape[-1])
+    s = np.zeros((rows.shape[0], 2)) if state is None else np.array(state, float, order="C")
+    lib.pim_biquad_rows_carry(rows.shape[0], rows.shape[1], bb, aa, rows,
+                              out.reshape(rows.shape), s, int(state is None))
+    return out, s

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter, lfilter_zi
 
-from pimodel._native import biquad_rows
+from pimodel._native import biquad_rows, biquad_rows_carry
 from pimodel.diagnosis.effects import mode, mode_coefficients, mode_rows
 from pimodel.diagnosis.lti import element_coefficients
 
@@ -27,6 +27,22 @@ def test_biquad_rows_equals_lfilter(element, rows):
     ref = _reference(b, a, x)
     got = biquad_rows(b, a, x)
     assert np.max(np.abs(got - ref)) <= 1e-12 * np.max(np.abs(ref))
+
+
+@pytest.mark.parametrize("element", [("mode", 300.0, 0.02), ("lowpass", 3e-4)])
+@pytest.mark.parametrize("rows", [1, 7])
+def test_biquad_rows_carry_on_chunks_equals_the_whole_rows_to_the_bit(element, rows):
+    """The chunks of rows filtered in turn, the state carried (the whole-record refit's
+    streamed columns, pimodel.diagnosis.streamed), give the whole rows' bits."""
+    rng = np.random.default_rng(rows)
+    x = np.cumsum(rng.normal(size=(rows, 5000)), axis=1) + 3.0
+    b, a = element_coefficients(element, 1e-4)
+    state, parts = None, []
+    for lo, hi in ((0, 1), (1, 1700), (1700, 1703), (1703, 5000)):
+        y, state = biquad_rows_carry(b, a, x[:, lo:hi], state)
+        parts.append(y)
+        assert state.shape == (rows, 2)
+    assert np.array_equal(np.concatenate(parts, axis=1), biquad_rows(b, a, x))
 
 
 def test_constant_rows_pass_at_the_static_gain():

@@ -22,7 +22,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
-__all__ = ["CHUNK", "ChunkedQR", "NormalEquations", "chunks"]
+__all__ = ["CHUNK", "ChunkedQR", "NormalEquations", "chunks", "combine", "stack_rows"]
 
 CHUNK = 1 << 14  # samples per chunk (16,384: an 80-column chunk of rows is 10 MB)
 
@@ -208,3 +208,37 @@ class ChunkedQR:
         coef, *_ = np.linalg.lstsq(R[:self.p, :self.p], R[:self.p, self.p], rcond=rcond)
         rest = R[:, self.p] - R[:, :self.p] @ coef
         return coef, float(rest @ rest)
+
+
+def stack_rows(parts) -> np.ndarray:
+    """The blocks of rows ``parts`` (each (p_i, N), any layout) stacked, C-contiguous
+    (``np.vstack`` keeps a column-major layout when its inputs have one).
+
+    Examples
+    --------
+    >>> stack_rows([np.zeros((1, 2)), np.ones((2, 2)).T]).tolist()
+    [[0.0, 0.0], [1.0, 1.0], [1.0, 1.0]]
+    """
+    out = np.empty((sum(X.shape[0] for X in parts), parts[0].shape[1]))
+    i = 0
+    for X in parts:
+        out[i:i + X.shape[0]] = X
+        i += X.shape[0]
+    return out
+
+
+def combine(P: tuple, coef: np.ndarray) -> np.ndarray:
+    """``coef @ B`` for the rows ``B`` the blocks ``P`` stack (each block's product, summed
+    in order).
+
+    Examples
+    --------
+    >>> combine((np.ones((1, 2)), np.arange(2.0)[None]), np.array([2.0, 3.0])).tolist()
+    [2.0, 5.0]
+    """
+    out, i = None, 0
+    for X in P:
+        term = coef[i:i + X.shape[0]] @ X
+        out = term if out is None else out + term
+        i += X.shape[0]
+    return out

@@ -60,6 +60,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
+from . import streamed
 from .chunked import NormalEquations
 from .creep import creep_law
 from .delaylike import is_delay_like
@@ -80,6 +81,7 @@ from .gain import gain_note, record_gains
 from .misfit import rate_correction
 from .noise import measure_noise_floor
 from .rate import RATE_KEYS, RateBasis, rate_shapes
+from .streamed import attach_plays, streamable
 from .threads import OnceCache, Pool, default_workers
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
@@ -615,6 +617,25 @@ def _slow_rss(segs: list[Segment], radii, at_rest: bool, V: np.ndarray) -> tuple
     return tuple(float(F[-1, -1] ** 2) if F.shape[0] == F.shape[1] else 0.0 for F in (R, Rp))
 
 
+def _streamed(s: Segment, radii, V: np.ndarray | None, at_rest: bool) -> Segment:
+    """The bare segment ``s`` as a streamed one (:func:`.streamed.attach_plays`): its play
+    rows (``Z V`` when ``V`` is given, as :func:`_projected` builds them; else ``Z``, as
+    :func:`.effects.make_segment`) and the row of ones, chunk by chunk from the input; its
+    rate and Wiener bases kept."""
+    def rows():
+        for c, P in play_chunks(s.v, radii, at_rest=at_rest):
+            if V is None:
+                yield c, P
+                continue
+            out = np.empty((V.shape[1] + 1, P.shape[1]))
+            np.matmul(V.T, P[:-1], out=out[:-1])
+            out[-1] = 1.0
+            yield c, out
+
+    out = Segment(s.t, s.v, s.y, None, s.mask, s.rate_basis, s.wiener_basis)
+    return attach_plays(out, rows, np.size(radii) if V is None else V.shape[1])
+
+
 def _projected(s: Segment, radii, V: np.ndarray, at_rest: bool) -> Segment:
     """The segment with play columns ``Z V``, built chunk by chunk as rows from the input."""
     rows = np.empty((V.shape[1] + 1, s.y.size))
@@ -858,7 +879,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         tr, va, out_va = whole
         if chosen:
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
-                                          lambda s: _with_rows(s, radii, proj, at_rest))
+                                          lambda s: _with_rows(s, radii, proj, at_rest),
+                                          lambda s: _streamed(s, radii, proj, at_rest))
         else:
             current, cur_out = nominal, out_va
         screen = {"samples": SCREEN_SAMPLES,
@@ -908,14 +930,23 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
 
 
 def _whole_fit(chosen: tuple, screened: Model, tr, va, nominal: Model,
-               rows: Callable[[Segment], Segment]) -> tuple:
+               rows: Callable[[Segment], Segment],
+               streams: Callable[[Segment], Segment] | None = None) -> tuple:
     """The model ``screened`` (chosen on the records' first samples) refitted on the whole
     train records, every grid parameter held (``"held"``: no search, the linear part's order
     too), and its outputs on the whole validate records. ``tr`` and ``va`` are the records
     without play rows; ``rows`` gives a record its play rows: the train records' are built
     for the fit and dropped after it, then each validate record's in turn for its prediction
     (all at once for a drift, whose validate levels are read from every record). Keeps the
-    screen's reports its refit does not make (the structures tried, the validate levels)."""
+    screen's reports its refit does not make (the structures tried, the validate levels).
+
+    ``streams`` gives a record streamed play rows instead (module streamed): used for every
+    record longer than ``SCREEN_SAMPLES`` when the model can be streamed
+    (:func:`.streamed.streamable`: not the rate, nor a filter before the hysteresis), so the
+    refit and the predictions hold a chunk of the model's columns at a time, not a record's;
+    the same coefficients, RSS and outputs to the bit."""
+    if streams is not None and streamed.STREAM and streamable(chosen, screened.grid):
+        rows = _long_streamed(rows, streams)
     trw = [rows(s) for s in tr]
     m = fit_effect(chosen[-1], trw, chosen[:-1], {**screened.grid, "held": True}, nominal)
     _release(m, trw)
@@ -928,6 +959,11 @@ def _whole_fit(chosen: tuple, screened: Model, tr, va, nominal: Model,
         out.append(m.predict(w))
         _release(m, [w])
     return m, out
+
+
+def _long_streamed(rows: Callable, streams: Callable) -> Callable:
+    """``streams`` for a record longer than ``SCREEN_SAMPLES``, ``rows`` for the others."""
+    return lambda s: streams(s) if s.y.size > SCREEN_SAMPLES else rows(s)
 
 
 def _creep_law(params: dict) -> dict | None:

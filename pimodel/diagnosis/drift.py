@@ -255,7 +255,7 @@ def settle_bow(times: list[np.ndarray], tau: float, t0: float, points: int = 409
 
 
 def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
-                  n_train: int = 1) -> np.ndarray:
+                  n_train: int = 1, t0: float | None = None) -> np.ndarray:
     """Regressors of the drift for one record, the trend column last.
 
     Parameters
@@ -268,6 +268,9 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
         Index of the record among the train records (None: not a train record).
     n_train : int
         Number of train records.
+    t0 : float or None
+        The record's first time ``t[0]`` when ``t`` is a chunk of it (a record's clock starts
+        there); None: ``t[0]``.
 
     Returns
     -------
@@ -288,7 +291,7 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
     if p["clock"] == "settle":
         trend = settle_column(t, p["settle_tau"], p["settle_t0"])[:, None]
     else:
-        trend = (t if p["clock"] == "absolute" else t - t[0])[:, None]
+        trend = (t if p["clock"] == "absolute" else t - (t[0] if t0 is None else t0))[:, None]
     if not has_levels(p) or n_train < 2:
         return trend
     ind = np.zeros((t.size, n_train - 1))
@@ -366,7 +369,10 @@ def record_levels(model, segments) -> list[float]:
     >>> record_levels(Model("nominal", 0, base_features, np.array([1.0, 0.0])), [seg])
     [0.5]
     """
-    return [float(np.mean((s.y - model.features(s) @ model.coef)[s.used])) for s in segments]
+    # (a record streamed chunk by chunk: the same product, a chunk at a time; module streamed)
+    times = getattr(model.features, "stacked_times", None)
+    return [float(np.mean((s.y - (model.features(s) @ model.coef if times is None else
+                                  times(s, model.coef)))[s.used])) for s in segments]
 
 
 def describe_levels(slope: float, levels, t0s, t0_train: float) -> dict:

@@ -20,6 +20,8 @@ from scipy.optimize import minimize_scalar
 
 from ..operators.pi import PIOperator
 from .chunked import NormalEquations, chunks
+from .chunked import combine as _combine
+from .chunked import stack_rows as _stack_rows
 from .creep import creep_time_constants
 from .drift import (
     DRIFT_VARIANTS,
@@ -49,6 +51,7 @@ from .rate import (
     RATE_TAUS,
     SCALED,
 )
+from .streamed import combo_chunks, is_streamed, n_plays, play_row_chunks, stacked_times
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
 __all__ = [
@@ -377,7 +380,12 @@ class Model:
         >>> Model("nominal", 0, base_features, np.array([3.0, 0.0])).predict(seg).tolist()
         [0.0, 3.0]
         """
-        out = _combine(_row_parts(self.features, seg), self.coef)
+        if is_streamed(seg):  # a long record's rows a chunk at a time (module streamed)
+            out = np.empty(seg.y.size)
+            for c, P in self.features.parts_chunks(seg):
+                out[c] = _combine(P, self.coef)
+        else:
+            out = _combine(_row_parts(self.features, seg), self.coef)
         return out if self.adjust is None else self.adjust(seg, out)
 
 
@@ -387,42 +395,46 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     Gram matrix is small), so a grid search costs one pass over the data per point and no
     temporary larger than a chunk; the residual sum of squares is computed from the residuals
     themselves, chunk by chunk. The regressors are taken as blocks of rows when the builder has
-    them (:func:`_row_parts`): no copy of the play columns at each point of a search."""
-    blocks = [_row_parts(features, s) for s in train]
-    ne = NormalEquations(sum(X.shape[0] for X in blocks[0]))
+    them (:func:`_row_parts`): no copy of the play columns at each point of a search. A
+    streamed segment (a long record in the whole-record refit, module streamed) gives its
+    blocks chunk by chunk (``features.parts_chunks``), built once per pass: the same values
+    as the slices of its whole blocks, so the same sums."""
+    blocks = [None if is_streamed(s) else _row_parts(features, s) for s in train]
+    ne = None
     for P, s in zip(blocks, train, strict=True):
-        first = _first_grams(P[0], s)
-        for j, c in enumerate(chunks(s.y.size)):
-            Pc, y = _used_chunk(P, s, c)
+        first = None if P is None else _first_grams(P[0], s)
+        for j, (c, Pc) in enumerate(_chunk_parts(features, P, s)):
+            Pc, y = _used_chunk(Pc, s, c)
+            if ne is None:
+                ne = NormalEquations(sum(X.shape[0] for X in Pc))
             ne.add_gram(_gram(Pc, None if first is None else first[j]),
                         np.concatenate([X @ y for X in Pc]), y.size)
     coef = ne.solve()
     rss = 0.0
     for P, s in zip(blocks, train, strict=True):
-        for c in chunks(s.y.size):
-            Pc, y = _used_chunk(P, s, c)
+        for c, Pc in _chunk_parts(features, P, s):
+            Pc, y = _used_chunk(Pc, s, c)
             rss += float(np.sum((_combine(Pc, coef) - y) ** 2))
     return Model(name, k, features, coef, params or {}), rss
 
 
-def _used_chunk(P: tuple, s: Segment, c: slice) -> tuple[tuple, np.ndarray]:
-    """The blocks of rows ``P`` and the output of segment ``s`` on the chunk ``c``, its fitted
-    samples only."""
+def _chunk_parts(features, P: tuple | None, s: Segment) -> Iterator[tuple[slice, tuple]]:
+    """``(c, blocks on c)`` for each chunk ``c`` of ``s``: slices of the whole blocks ``P``,
+    or (``P`` None: a streamed segment) ``features.parts_chunks(s)``."""
+    if P is None:
+        yield from features.parts_chunks(s)
+        return
+    for c in chunks(s.y.size):
+        yield c, tuple(X[:, c] for X in P)
+
+
+def _used_chunk(Pc: tuple, s: Segment, c: slice) -> tuple[tuple, np.ndarray]:
+    """The blocks of rows ``Pc`` on the chunk ``c`` of segment ``s`` and its output there,
+    the fitted samples only."""
     if s.mask is None:
-        return tuple(X[:, c] for X in P), s.y[c]
+        return Pc, s.y[c]
     m = s.mask[c]
-    return tuple(X[:, c][:, m] for X in P), s.y[c][m]
-
-
-def _stack_rows(parts) -> np.ndarray:
-    """The blocks of rows ``parts`` (each (p_i, N), any layout) stacked, C-contiguous
-    (``np.vstack`` keeps a column-major layout when its inputs have one)."""
-    out = np.empty((sum(X.shape[0] for X in parts), parts[0].shape[1]))
-    i = 0
-    for X in parts:
-        out[i:i + X.shape[0]] = X
-        i += X.shape[0]
-    return out
+    return tuple(X[:, m] for X in Pc), s.y[c][m]
 
 
 def _row_parts(features, s: Segment) -> tuple:
@@ -449,7 +461,7 @@ def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
     kept = s.__dict__.setdefault("_first_grams", {})  # per thread (module threads)
     memo = kept.get(threading.get_ident())
     if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
-        grams = [X @ X.T for X in (_used_chunk((Z,), s, c)[0][0] for c in cuts)]
+        grams = [X @ X.T for X in (_used_chunk((Z[:, c],), s, c)[0][0] for c in cuts)]
         memo = kept[threading.get_ident()] = (key, Z, grams)
     return memo[2]
 
@@ -465,16 +477,6 @@ def _gram(P: tuple, first: np.ndarray | None = None) -> np.ndarray:
             G[edges[i]:edges[i + 1], edges[j]:edges[j + 1]] = blk
             G[edges[j]:edges[j + 1], edges[i]:edges[i + 1]] = blk.T
     return G
-
-
-def _combine(P: tuple, coef: np.ndarray) -> np.ndarray:
-    """``coef @ B`` for the rows ``B`` the blocks ``P`` stack."""
-    out, i = None, 0
-    for X in P:
-        term = coef[i:i + X.shape[0]] @ X
-        out = term if out is None else out + term
-        i += X.shape[0]
-    return out
 
 
 def _ones(s: Segment) -> np.ndarray:
@@ -508,6 +510,7 @@ def _base_rows(s: Segment) -> np.ndarray:
 
 
 base_features.rows = _base_rows
+base_features.parts_chunks = lambda s: ((c, (rows,)) for c, rows in play_row_chunks(s))
 
 
 def fit_nominal(train) -> Model:
@@ -768,6 +771,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     searched = None if memo is None else memo.get("searched")
     if searched is not None:  # the same search made before (_order_memo)
         best, grid_tried = searched
+    elif held and len(points) == 1:  # one point, fitted below with every play column
+        best, grid_tried = (Model(name, k, None, None, points[0]), None), []
     else:
         best = search(points)
         grid_tried = sorted(tried, key=lambda rp: rp[0])[:SCREEN_CONFIRM]
@@ -992,7 +997,7 @@ def _confirm(search, k: int, points: list[dict], train) -> tuple:
 def _hysteresis_reference(model: Model, train, nominal: Model) -> Model:
     """The hysteresis part ``Z w + c`` of a joint fit as a reference model (``center`` and
     ``half_range`` of its train output, the nominal's other ``params``)."""
-    q = train[0].Z.shape[1]
+    q = n_plays(train[0])
     ref = Model("reference", 0, base_features, model.coef[:q + 1].copy())
     h = np.concatenate([ref.predict(s) for s in train])
     ref.params = {**nominal.params, "center": float(np.mean(h)),
@@ -1092,7 +1097,13 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         for key in [key for key in static if key != "train"]:
             del static[key]
 
+    def parts_chunks(s: Segment):  # a streamed segment's blocks, chunk by chunk (held p)
+        return combo_chunks(effects, p, nominal, s, static["train"].get(id(s)),
+                            len(static["train"]))
+
     feats.parts = rows
+    feats.parts_chunks = parts_chunks
+    feats.stacked_times = lambda s, coef: stacked_times(parts_chunks, feats, s, coef)
     feats.release = release
     return feats
 

@@ -42,3 +42,30 @@ void pim_biquad_rows(size_t m, size_t N, const double *b, const double *a, const
         }
     }
 }
+
+void pim_biquad_rows_carry(size_t m, size_t N, const double *b, const double *a, const double *x,
+                           double *y, double *s, int start)
+{
+    const double b0 = b[0], b1 = b[1], b2 = b[2], a1 = a[1], a2 = a[2];
+    const double B0 = b1 - a1 * b0, B1 = b2 - a2 * b0;
+    const double zi0 = (B0 + B1) / (1.0 + a1 + a2), zi1 = B1 - a2 * zi0;
+    for (size_t i = 0; i < m; ++i) {
+        const double *xr = x + i * N;
+        double *yr = y + i * N, s0, s1;
+        if (start) {
+            s0 = zi0 * xr[0];
+            s1 = zi1 * xr[0];
+        } else {
+            s0 = s[2 * i];
+            s1 = s[2 * i + 1];
+        }
+        for (size_t k = 0; k < N; ++k) {
+            const double xk = xr[k], yk = s0 + b0 * xk;
+            s0 = s1 + xk * b1 - yk * a1;
+            s1 = xk * b2 - yk * a2;
+            yr[k] = yk;
+        }
+        s[2 * i] = s0;
+        s[2 * i + 1] = s1;
+    }
+}

@@ -29,6 +29,14 @@ extern "C" {
 PIM_API void pim_biquad_rows(size_t m, size_t N, const double *b, const double *a,
                              const double *x, double *y);
 
+/* The same filter on a chunk of each row, its state carried: s (m x 2, row-major) holds each
+ * row's s0[k-1], s1[k-1] before the chunk's first sample and is overwritten with them after
+ * its last; start != 0: the chunk is the rows' first, the states are set at rest around its
+ * first sample as pim_biquad_rows sets them (s is then written, not read).  Filtering a row's
+ * consecutive chunks in turn gives the bits of pim_biquad_rows on the whole row. */
+PIM_API void pim_biquad_rows_carry(size_t m, size_t N, const double *b, const double *a,
+                                   const double *x, double *y, double *s, int start);
+
 #ifdef __cplusplus
 }
 #endif
