@@ -580,6 +580,41 @@ def nominal_params(coef: np.ndarray, outputs: list, train) -> dict:
                 train[0].dt, max(float(s.t[-1] - s.t[0]) for s in train))}
 
 
+class TrainRecords:
+    """The train records of a fit, by identity: which record a segment is (a drift's level
+    per train record; validate records get an out-of-fold level).
+
+    Weak: a train segment freed after the fit (the whole-record refit drops its rows) is no
+    longer one, and a new segment that Python puts at its address is not taken for it (keyed
+    by ``id`` alone, a validate record built after the train rows were dropped could get a
+    train record's level column and lose its own level).
+
+    Examples
+    --------
+    >>> a = make_segment(np.arange(2) * 1e-3, np.zeros(2), np.zeros(2), [0.0])
+    >>> train = TrainRecords([a])
+    >>> train.index(a), len(train), a in train
+    (0, 1, True)
+    >>> b = make_segment(np.arange(2) * 1e-3, np.zeros(2), np.zeros(2), [0.0])
+    >>> train.index(b), b in train
+    (None, False)
+    """
+
+    def __init__(self, train) -> None:
+        self._refs = {id(s): (j, weakref.ref(s)) for j, s in enumerate(train)}
+
+    def index(self, seg) -> int | None:
+        """The train record ``seg`` is (0, 1, ...), or None."""
+        hit = self._refs.get(id(seg))
+        return hit[0] if hit is not None and hit[1]() is seg else None
+
+    def __contains__(self, seg) -> bool:
+        return self.index(seg) is not None
+
+    def __len__(self) -> int:
+        return len(self._refs)
+
+
 def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None = None,
                nominal: Model | None = None) -> Model:
     """Fit the nominal model augmented with the effects ``combo + (name,)`` jointly; the grid
@@ -711,7 +746,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
     if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
         k -= RATE_BANDS - 1
-    static: dict = {"train": {id(s): j for j, s in enumerate(train)}}
+    static: dict = {"train": TrainRecords(train)}
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
     # then left a spurious second effect)
@@ -931,8 +966,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
         in_train = static["train"]
 
         def with_level(seg, out):  # a record's own level, out of fold (not for train records)
-            return out if id(seg) in in_train else out + out_of_fold_level(seg.y - out,
-                                                                           seg.mask)
+            return out if seg in in_train else out + out_of_fold_level(seg.y - out, seg.mask)
         model.adjust = with_level
     return model
 
@@ -1084,7 +1118,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                 static[key] = (which, np.ascontiguousarray(s.rate_basis.columns(*which).T), s)
             parts.append(static[key][1])
         if "drift" in effects:  # the trend column last
-            parts.append(drift_columns(s.t, p, static["train"].get(id(s)),
+            parts.append(drift_columns(s.t, p, static["train"].index(s),
                                        len(static["train"])).T)
         # the other rows as they are when there is one block (the static rows, C-contiguous:
         # a mode or delay search then copies nothing of them per point)
@@ -1098,7 +1132,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             del static[key]
 
     def parts_chunks(s: Segment):  # a streamed segment's blocks, chunk by chunk (held p)
-        return combo_chunks(effects, p, nominal, s, static["train"].get(id(s)),
+        return combo_chunks(effects, p, nominal, s, static["train"].index(s),
                             len(static["train"]))
 
     feats.parts = rows
