@@ -231,10 +231,11 @@ def test_chunks_reject_bad_sizes():
 
 LIMIT_GB = 1.4  # peak resident memory of the child (ru_maxrss); 2 x 1M samples reached 15.5 GB
 # before issue 31, 2.6 GB before the screened choice, 1.50 GB while the whole records' play rows
-# were held through the choice, now 0.96 GB on one thread and 1.11 GB on two (the issue's goal:
-# 2 GB). Address space is no measure of it: each thread's malloc arena and BLAS buffer reserve
-# address space they do not use, by amounts that differ between machines and library builds
-# (VmPeak 1.39 GB here on two threads; above 1.4 GB on another machine with the same memory).
+# were held through the choice, 0.96 GB on one thread and 1.11 GB on two, 0.78-0.84 GB on two
+# with the refit streamed (the issue's goal: 2 GB). Address space is no measure of it: each
+# thread's malloc arena and BLAS buffer reserve address space they do not use, by amounts that
+# differ between machines and library builds (VmPeak 1.39 GB here on two threads before the
+# streamed refit; above 1.4 GB on another machine with the same memory).
 GUARD_GB = 4.0  # the child's address-space limit: a runaway fails fast instead of swapping
 
 _CHILD = textwrap.dedent("""
