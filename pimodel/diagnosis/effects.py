@@ -589,6 +589,11 @@ class TrainRecords:
     by ``id`` alone, a validate record built after the train rows were dropped could get a
     train record's level column and lose its own level).
 
+    Parameters
+    ----------
+    train : list of Segment
+        The train records, in order.
+
     Examples
     --------
     >>> a = make_segment(np.arange(2) * 1e-3, np.zeros(2), np.zeros(2), [0.0])
@@ -604,7 +609,24 @@ class TrainRecords:
         self._refs = {id(s): (j, weakref.ref(s)) for j, s in enumerate(train)}
 
     def index(self, seg) -> int | None:
-        """The train record ``seg`` is (0, 1, ...), or None."""
+        """Which train record ``seg`` is.
+
+        Parameters
+        ----------
+        seg : Segment
+            A record.
+
+        Returns
+        -------
+        int or None
+            Its place among the train records (0, 1, ...); None when it is not one of them.
+
+        Examples
+        --------
+        >>> seg = make_segment(np.arange(2) * 1e-3, np.zeros(2), np.zeros(2), [0.0])
+        >>> TrainRecords([seg]).index(seg)
+        0
+        """
         hit = self._refs.get(id(seg))
         return hit[0] if hit is not None and hit[1]() is seg else None
 
