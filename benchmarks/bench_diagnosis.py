@@ -31,15 +31,16 @@ from pimodel.records import Record
 from pimodel.stages.pi_stage import excitation, random_truth
 
 
-def long_record(kind: str, n: int, truth, seed: int) -> Record:
-    """Excitations of ``kind`` (new random steps each) joined to ``n`` samples at 10 kHz."""
+def long_record(kind: str, n: int, truth, seed: int, t0: float = 0.0) -> Record:
+    """Excitations of ``kind`` (new random steps each) joined to ``n`` samples at 10 kHz, the
+    clock starting at ``t0`` [s]."""
     parts, total, s = [], 0, seed
     while total < n:
         parts.append(excitation(kind, seed=s)[1])
         total += parts[-1].size
         s += 1
     v = np.concatenate(parts)[:n]
-    t = np.arange(n) * 1e-4
+    t = t0 + np.arange(n) * 1e-4
     return truth.record(t, v, seed, kind)
 
 

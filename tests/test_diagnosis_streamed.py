@@ -28,24 +28,16 @@ from pimodel.diagnosis.effects import (
     nominal_params,
 )
 from pimodel.records import Record
-from pimodel.stages.pi_stage import excitation, random_truth
+from pimodel.stages.pi_stage import random_truth
 
 sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from bench_diagnosis import long_record as _long  # noqa: E402
 from test_diagnosis import records as short_records  # noqa: E402
 
 dg = importlib.import_module("pimodel.diagnosis.diagnose")  # not the function it exports
 
 N = 2 * CHUNK + 5_003  # longer than two chunks, not a whole number of them
-
-
-def _long(kind: str, n: int, truth, seed: int, t0: float = 0.0) -> Record:
-    parts, total, s = [], 0, seed
-    while total < n:
-        parts.append(excitation(kind, seed=s)[1])
-        total += parts[-1].size
-        s += 1
-    v = np.concatenate(parts)[:n]
-    return truth.record(t0 + np.arange(n) * 1e-4, v, seed, kind)
 
 
 @pytest.fixture(scope="module")

@@ -553,10 +553,7 @@ def _projected_fit(segs: list[Segment], radii, V: np.ndarray, at_rest: bool
     projected rows built from the input one chunk at a time (two passes: the normal equations,
     then the residuals)."""
     def projected_chunks(s):
-        for c, P in play_chunks(s.v, radii, at_rest=at_rest):
-            rows = np.empty((V.shape[1] + 1, P.shape[1]))
-            np.matmul(V.T, P[:-1], out=rows[:-1])
-            rows[-1] = 1.0
+        for c, rows in _play_row_chunks(s, radii, V, at_rest):
             yield (rows, s.y[c]) if s.mask is None else (rows[:, s.mask[c]], s.y[c][s.mask[c]])
 
     ne = NormalEquations(V.shape[1] + 1)
@@ -617,30 +614,35 @@ def _slow_rss(segs: list[Segment], radii, at_rest: bool, V: np.ndarray) -> tuple
     return tuple(float(F[-1, -1] ** 2) if F.shape[0] == F.shape[1] else 0.0 for F in (R, Rp))
 
 
+def _play_row_chunks(s: Segment, radii, V: np.ndarray | None, at_rest: bool):
+    """``(c, rows)`` for each chunk ``c`` of ``s``: its play rows from the input (the plays'
+    states carried, :func:`.effects.play_chunks`), ``V^T z`` when ``V`` is given, then the row
+    of ones, shape (n + 1, len(c))."""
+    for c, P in play_chunks(s.v, radii, at_rest=at_rest):
+        if V is None:
+            yield c, P
+            continue
+        rows = np.empty((V.shape[1] + 1, P.shape[1]))
+        np.matmul(V.T, P[:-1], out=rows[:-1])
+        rows[-1] = 1.0
+        yield c, rows
+
+
 def _streamed(s: Segment, radii, V: np.ndarray | None, at_rest: bool) -> Segment:
     """The bare segment ``s`` as a streamed one (:func:`.streamed.attach_plays`): its play
     rows (``Z V`` when ``V`` is given, as :func:`_projected` builds them; else ``Z``, as
-    :func:`.effects.make_segment`) and the row of ones, chunk by chunk from the input; its
-    rate and Wiener bases kept."""
-    def rows():
-        for c, P in play_chunks(s.v, radii, at_rest=at_rest):
-            if V is None:
-                yield c, P
-                continue
-            out = np.empty((V.shape[1] + 1, P.shape[1]))
-            np.matmul(V.T, P[:-1], out=out[:-1])
-            out[-1] = 1.0
-            yield c, out
-
+    :func:`.effects.make_segment`) and the row of ones, chunk by chunk from the input
+    (:func:`_play_row_chunks`); its rate and Wiener bases kept."""
     out = Segment(s.t, s.v, s.y, None, s.mask, s.rate_basis, s.wiener_basis)
-    return attach_plays(out, rows, np.size(radii) if V is None else V.shape[1])
+    return attach_plays(out, lambda: _play_row_chunks(s, radii, V, at_rest),
+                        np.size(radii) if V is None else V.shape[1])
 
 
 def _projected(s: Segment, radii, V: np.ndarray, at_rest: bool) -> Segment:
     """The segment with play columns ``Z V``, built chunk by chunk as rows from the input."""
     rows = np.empty((V.shape[1] + 1, s.y.size))
-    for c, P in play_chunks(s.v, radii, at_rest=at_rest):
-        np.matmul(V.T, P[:-1], out=rows[:-1, c])
+    for c, chunk in _play_row_chunks(s, radii, V, at_rest):
+        rows[:, c] = chunk
     return segment_of_rows(s.t, s.v, s.y, rows, s.mask)
 
 
