@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,7 +30,7 @@ from ..operators.pi import PIOperator
 from .adaptive.health import EstimatorHealth, estimator_health, refined_health
 from .adaptive.joint import JointEstimator
 from .adaptive.polish import refine_radii
-from .adaptive.radius_estimator import RadiusEstimator, run_tail_average
+from .adaptive.radius_estimator import RadiusEstimator, stream_tail_average
 from .adaptive.settings import _norm2
 from .branches import find_reversals
 from .conventional import fit_conventional
@@ -239,6 +239,38 @@ class Identification:
         return path
 
 
+def _repeated_chunks(v: np.ndarray, y: np.ndarray, offset: float, first: int, passes: int,
+                     chunk: int, progress: Callable[[float], None]
+                     ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The record repeated for ``passes`` passes, in chunks, never joined whole.
+
+    The repeated record is ``vv = [v, v[first:], ..., v[first:]]`` (``passes - 1`` repeats)
+    and ``yy`` the same of ``y - offset``; chunk ``j`` is ``vv[j*chunk:(j+1)*chunk]`` and its
+    ``yy``, the same samples as slicing the joined arrays, so an estimator run over the chunks
+    equals its run over the joined record (to the bit). ``progress(share)`` is called before
+    each chunk with the share of the samples done. Holds one chunk at a time.
+    """
+    pieces = [(0, v.size)] + [(first, v.size)] * (passes - 1)
+    total = sum(b - a for a, b in pieces)
+    done, i, at = 0, 0, 0  # samples yielded; the piece and the position in it
+    while done < total:
+        progress(done / total)
+        parts, need = [], min(chunk, total - done)
+        while need:
+            a, b = pieces[i]
+            lo = max(a, at)
+            take = min(need, b - lo)
+            parts.append(slice(lo, lo + take))
+            need -= take
+            at = lo + take
+            if at == b:
+                i, at = i + 1, 0
+        cv = np.concatenate([v[s] for s in parts]) if len(parts) > 1 else v[parts[0]]
+        cy = np.concatenate([y[s] for s in parts]) if len(parts) > 1 else y[parts[0]]
+        yield cv, cy - offset
+        done += cv.size
+
+
 def _errors(op: PIOperator, v: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     base = op.simulate(v)
     offset = float(np.mean(y - base))
@@ -369,22 +401,24 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     if passes is None:
         passes = min(max(3, int(np.ceil(200.0 / (dt * (v.size - first))))),
                      max(1, max_passes(v.size)))
-    vv = np.concatenate([v] + [v[first:]] * (passes - 1))
-    yy = np.concatenate([y] + [y[first:]] * (passes - 1)) - offset
+    total = v.size + (passes - 1) * (v.size - first)
     guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard
     est = RadiusEstimator(p, dt=dt, gains=g, initial_radii=slopes.radii_guess,
                           linear_play=slopes.linear_play, guard=guard_)
-    progress(f"radius estimator ({passes} passes, {vv.size:,} samples)")
-    if vv.size <= HISTORY_LIMIT:  # keep the history for the health report
+    progress(f"radius estimator ({passes} passes, {total:,} samples)")
+    if total <= HISTORY_LIMIT:  # keep the history for the health report
+        vv = np.concatenate([v] + [v[first:]] * (passes - 1))
+        yy = np.concatenate([y] + [y[first:]] * (passes - 1)) - offset
         run = est.run(vv, yy)
         radii = run.history[vv.size // 2:].mean(axis=0)
         health = estimator_health(vv, p, run.history, linear_play=slopes.linear_play, y=yy,
                                   error=run.error)
-    else:  # long record: bounded memory, health from the final mean only
-        _, radii = run_tail_average(
-            est, vv, yy, tail=0.5, chunk=PROGRESS_CHUNK,
+    else:  # long record: bounded memory (the passes never joined), health from the final mean
+        chunks = _repeated_chunks(
+            v, y, offset, first, passes, PROGRESS_CHUNK,
             progress=lambda share: progress(f"radius estimator ({passes} passes, "
-                                            f"{vv.size:,} samples): {100 * share:.0f} %"))
+                                            f"{total:,} samples): {100 * share:.0f} %"))
+        _, radii = stream_tail_average(est, chunks, total=total, tail=0.5)
         health = estimator_health(v, p, radii[None, :], linear_play=slopes.linear_play)
     radii_from = "average of the estimate over the last half"
     if v.size * p.size <= REFINE_LIMIT:  # the batch refinement holds N x n arrays

@@ -118,16 +118,23 @@ def _pool_branches(v, y, threshold, min_travel_fraction, max_points):
     travel = np.array([abs(v[b.stop - 1] - v[b.start]) for b in branches])
     keep = [b for b, tr in zip(branches, travel, strict=True)
             if tr >= min_travel_fraction * travel.max()]
+    # the pooled samples (branch after branch), thinned to max_points evenly spaced ones: the
+    # indices into the pool are placed branch by branch, so the pool is never built whole
+    sizes = np.array([b.stop - b.start for b in keep])
+    ends = np.cumsum(sizes)
+    total = int(ends[-1])
+    sel = np.linspace(0, total - 1, max_points).astype(int) if total > max_points else None
     xs, Ys, gs = [], [], []
     for g, b in enumerate(keep):
-        sl = slice(b.start, b.stop)
-        xs.append(np.abs(v[sl] - v[b.start]))
-        Ys.append(b.direction * y[sl])
-        gs.append(np.full(b.stop - b.start, g))
+        if sel is None:
+            idx = slice(b.start, b.stop)
+        else:
+            lo, hi = np.searchsorted(sel, [ends[g] - sizes[g], ends[g]])
+            idx = b.start + (sel[lo:hi] - (ends[g] - sizes[g]))
+        xs.append(np.abs(v[idx] - v[b.start]))
+        Ys.append(b.direction * y[idx])
+        gs.append(np.full(xs[-1].size, g))
     x, Y, groups = np.concatenate(xs), np.concatenate(Ys), np.concatenate(gs)
-    if x.size > max_points:
-        sel = np.linspace(0, x.size - 1, max_points).astype(int)
-        x, Y, groups = x[sel], Y[sel], groups[sel]
     return x, Y, groups, len(keep)
 
 
