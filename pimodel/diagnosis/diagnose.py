@@ -709,13 +709,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       f" times that of a plain least-squares PI fit ({base_rms:.4g}; "
                       "report.nominal['baseline']): the effects are measured against a weak "
                       "nominal", UserWarning, stacklevel=3)
-    where = residual_breakdown(whole[1], [s.y - o for s, o in zip(whole[1], out_va,
-                                                                   strict=True)])
     progress("noise floor")
     noise_info = measure_noise_floor([(s.v, s.y) for s in whole[0] + whole[1]],
                                      out_tr + out_va)
     noise = noise_info["value"]
-    del out_tr  # the nominal's train outputs: read by nothing after the noise floor
+    del out_tr  # the nominal's train outputs: read by nothing after the noise floor (so not
+    # held beside where's temporaries, nor through the choice)
+    where = residual_breakdown(whole[1], [s.y - o for s, o in zip(whole[1], out_va,
+                                                                   strict=True)])
     whole.append(out_va)
     if screened:
         out_va = [o[:SCREEN_SAMPLES] for o in out_va]
