@@ -246,12 +246,27 @@ class Record:
         return self.slice(0, k), self.slice(k, None)
 
 
+CHECK_CHUNK = 1 << 16  # samples per block of the time column's checks (their temporaries)
+
+
+def _blocks(n: int):
+    """Slices of ``CHECK_CHUNK`` samples covering ``range(n)``: the checks of a long time
+    column are made a block at a time (a maximum or an "all" does not depend on the
+    grouping), so they hold a few blocks, not columns of the record's length."""
+    return (slice(i, min(i + CHECK_CHUNK, n)) for i in range(0, n, CHECK_CHUNK))
+
+
+def _largest_magnitude(t: np.ndarray) -> float:
+    """``max |t[k]|`` without a column of magnitudes (``max(t)`` or ``-min(t)``: exact)."""
+    return max(float(np.max(t)), -float(np.min(t)))
+
+
 def _resolution(t: np.ndarray) -> float:
     """The time column's resolution [s]: the coarsest decimal step all its values sit on (to a
     few ulps), else a few ulps of its largest value."""
-    ulps = 8.0 * np.spacing(float(np.max(np.abs(t))) or 1.0)
+    ulps = 8.0 * np.spacing(_largest_magnitude(t) or 1.0)
     for digits in range(16):
-        if np.all(np.abs(t - np.round(t, digits)) <= ulps):
+        if all(np.all(np.abs(t[c] - np.round(t[c], digits)) <= ulps) for c in _blocks(t.size)):
             return max(0.5 * 10.0 ** -digits, ulps)
     return ulps
 
@@ -287,17 +302,18 @@ def sample_time(t) -> float:
     (0.0002, True)
     """
     t = np.asarray(t, dtype=float)
-    if t.ndim != 1 or t.size < 2 or not np.all(np.diff(t) > 0):
+    if t.ndim != 1 or t.size < 2 or not all(np.all(t[c.start + 1:c.stop + 1] > t[c])
+                                            for c in _blocks(t.size - 1)):
         raise ValueError(f"t: expected at least 2 strictly increasing times, got {t.size}")
-    k = np.arange(t.size)
     mean = (t[-1] - t[0]) / (t.size - 1)
     # the column's resolution plus the rounding a clock accumulates as t[k] = t[k-1] + Ts
     # (at most one ulp of max |t| per sample), and never more than 1e-3 samples
-    ulp = np.spacing(float(np.max(np.abs(t))) or 1.0)
+    ulp = np.spacing(_largest_magnitude(t) or 1.0)
     tol = min(_resolution(t) + t.size * ulp, 1e-3 * mean)
     for digits in range(1, 16):
         for ts in (float(f"{mean:.{digits}g}"), 1.0 / float(f"{1.0 / mean:.{digits}g}")):
-            if np.max(np.abs(t - (t[0] + k * ts))) <= tol:
+            if max(float(np.max(np.abs(t[c] - (t[0] + np.arange(c.start, c.stop) * ts))))
+                   for c in _blocks(t.size)) <= tol:
                 return ts
     return float(np.median(np.diff(t)))
 
@@ -352,9 +368,13 @@ def _validate_columns(names: list[str], values: list, source: str,
             f"increase strictly (previous {float(t[k - 1])!r})"
             + _resolution_hint(t, float(np.median(np.abs(dt))) or 1.0)
         )
-    med = float(np.median(dt))
-    off = np.flatnonzero(np.abs(dt - med) > SAMPLING_TOLERANCE * med)
-    if off.size:
+    med = float(np.median(dt, overwrite_input=True))  # (dt reordered: not read again)
+    del dt
+    # the intervals off the median, counted a block at a time; found again whole for a message
+    if any(np.any(np.abs(np.diff(t[c.start:c.stop + 1]) - med) > SAMPLING_TOLERANCE * med)
+           for c in _blocks(t.size - 1)):
+        dt = np.diff(t)
+        off = np.flatnonzero(np.abs(dt - med) > SAMPLING_TOLERANCE * med)
         change = np.flatnonzero(np.abs(dt - dt[0]) > SAMPLING_TOLERANCE * med)
         k = int(change[0]) if change.size else int(off[0])
         raise DataError(

@@ -61,7 +61,7 @@ from threadpoolctl import threadpool_limits
 
 from ..records import Record
 from . import streamed
-from .chunked import NormalEquations
+from .chunked import CHUNK, NormalEquations
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
@@ -252,10 +252,31 @@ def _plain(x):
     raise TypeError(type(x))
 
 
+def _residuals(segs: list[Segment], outputs) -> np.ndarray:
+    """The residuals ``y[k] - output[k]`` of the fitted samples of every segment, in one array
+    (the records' in order): written in place, no other column of the records' length."""
+    sizes = [s.y.size if s.mask is None else int(np.count_nonzero(s.mask)) for s in segs]
+    r = np.empty(sum(sizes))
+    pos = 0
+    for s, o, m in zip(segs, outputs, sizes, strict=True):
+        if s.mask is None:
+            np.subtract(s.y, o, out=r[pos:pos + m])
+        else:
+            r[pos:pos + m] = (s.y - o)[s.mask]
+        pos += m
+    return r
+
+
 def _errors(segs: list[Segment], outputs) -> dict:
-    r = np.concatenate([(s.y - o)[s.used] for s, o in zip(segs, outputs, strict=True)])
-    rng = float(np.ptp(np.concatenate([s.y[s.used] for s in segs]))) or 1.0
-    rms, mx = float(np.sqrt(np.mean(r**2))), float(np.max(np.abs(r)))
+    """RMS and largest residual of the fitted samples (and as percent of the fitted outputs'
+    range), the same numbers as from the concatenated residuals, with one column of residuals
+    held (:func:`_residuals`, squared in place) and the range and the largest magnitude taken
+    per record and per chunk (a maximum does not depend on the grouping)."""
+    r = _residuals(segs, outputs)
+    ys = [s.y[s.used] for s in segs]
+    rng = float(np.max([np.max(y) for y in ys]) - np.min([np.min(y) for y in ys])) or 1.0
+    mx = float(np.max([np.max(np.abs(r[i:i + CHUNK])) for i in range(0, r.size, CHUNK)]))
+    rms = float(np.sqrt(np.mean(np.square(r, out=r))))
     return {"rms": rms, "max": mx, "rms_percent": 100 * rms / rng,
             "max_percent": 100 * mx / rng, "range": rng}
 
@@ -263,9 +284,9 @@ def _errors(segs: list[Segment], outputs) -> dict:
 def _bic(segs, outputs, k, n: int | None = None) -> float:
     """``N ln(RSS/N) + k ln N`` of the fitted samples; with ``n``: the BIC of ``n`` samples
     whose mean squared residual is that of ``segs`` (a screen standing for whole records)."""
-    r = np.concatenate([(s.y - o)[s.used] for s, o in zip(segs, outputs, strict=True)])
+    r = _residuals(segs, outputs)
     n = r.size if n is None else n
-    return float(n * np.log(max(np.mean(r**2), 1e-300)) + k * np.log(n))
+    return float(n * np.log(max(np.mean(np.square(r, out=r)), 1e-300)) + k * np.log(n))
 
 
 def _fitted_samples(records: list[Record], initial_state: str) -> int:
@@ -522,8 +543,8 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
     out_va = _plain_outputs(vsegs, radii, coef, at_rest)
     heads = (_bare(train, initial_state, samples), _bare(validate, initial_state, samples))
     if n > PROJECTED:
-        rss_full = sum(float(np.sum((o - s.y)[s.used] ** 2)) for s, o in zip(segs, out_tr,
-                                                                              strict=True))
+        rss_full = sum(float(np.sum(np.square(r, out=r))) for r in (
+            (o - s.y)[s.used] for s, o in zip(segs, out_tr, strict=True)))
         _, vecs = np.linalg.eigh(ne.G[:n, :n])
         w = coef[:n]
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
@@ -688,12 +709,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       f" times that of a plain least-squares PI fit ({base_rms:.4g}; "
                       "report.nominal['baseline']): the effects are measured against a weak "
                       "nominal", UserWarning, stacklevel=3)
-    where = residual_breakdown(whole[1], [s.y - o for s, o in zip(whole[1], out_va,
-                                                                   strict=True)])
     progress("noise floor")
     noise_info = measure_noise_floor([(s.v, s.y) for s in whole[0] + whole[1]],
                                      out_tr + out_va)
     noise = noise_info["value"]
+    del out_tr  # the nominal's train outputs: read by nothing after the noise floor (so not
+    # held beside where's temporaries, nor through the choice)
+    where = residual_breakdown(whole[1], [s.y - o for s, o in zip(whole[1], out_va,
+                                                                   strict=True)])
     whole.append(out_va)
     if screened:
         out_va = [o[:SCREEN_SAMPLES] for o in out_va]

@@ -570,12 +570,25 @@ def nominal_params(coef: np.ndarray, outputs: list, train) -> dict:
     >>> p["center"], p["half_range"], p["slope_sum"], p["rate_scale"]
     (0.6666666666666666, 1.0, 2.0, 1000.0)
     """
-    h = np.concatenate(outputs)
-    rate = np.concatenate([np.abs(np.diff(s.v)) / s.dt for s in train])
+    # (the same numbers as from the concatenated outputs and rates; a record's own array is
+    # used as it is, its rate built in place, the percentile's selection made in place)
+    h = outputs[0] if len(outputs) == 1 else np.concatenate(outputs)
+    center, half_range = float(np.mean(h)), max(float(np.ptp(h)) / 2, 1e-12)
+    del h
+    rates = []
+    for s in train:
+        r = np.diff(s.v)
+        np.abs(r, out=r)
+        r /= s.dt
+        rates.append(r)
+    rate = rates[0] if len(rates) == 1 else np.concatenate(rates)
+    del rates
     moving = rate[rate > 1e-9 * (float(np.ptp(rate)) or 1.0)]
-    return {"center": float(np.mean(h)), "half_range": max(float(np.ptp(h)) / 2, 1e-12),
+    del rate
+    return {"center": center, "half_range": half_range,
             "slope_sum": float(np.sum(coef[:-1])),
-            "rate_scale": float(np.percentile(moving, 95)) if moving.size else 1.0,
+            "rate_scale": float(np.percentile(moving, 95, overwrite_input=True))
+            if moving.size else 1.0,
             "creep_taus": creep_time_constants(
                 train[0].dt, max(float(s.t[-1] - s.t[0]) for s in train))}
 

@@ -68,13 +68,17 @@ def record_gains(records, outputs, noise: float) -> dict | None:
         if yh.shape != y.shape:
             raise ValueError(f"outputs[{i}]: expected shape {y.shape} like the record's y, got "
                              f"{yh.shape}")
-        yc, e = yh - yh.mean(), y - yh
-        ec = e - e.mean()
+        # two columns of the record: the centred output and the residual, centred, then
+        # less the gain's part, in place (the same numbers as the expressions written out)
+        yc = yh - yh.mean()
+        ec = y - yh
+        ec -= ec.mean()
         c = float(ec @ yc / (yc @ yc)) if yc @ yc > 0 else 0.0
         gains.append(c)
         e_level += float(ec @ ec)
-        rest = ec - c * yc
+        rest = np.subtract(ec, np.multiply(c, yc, out=yc), out=ec)  # ec - c * yc
         e_gain += float(rest @ rest)
+        del yc, ec, rest
         n += y.size
     rms_levels, rms_gains = np.sqrt(e_level / max(n, 1)), np.sqrt(e_gain / max(n, 1))
     if not (gains and max(abs(c) for c in gains) >= GAIN_MIN

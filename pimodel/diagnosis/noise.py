@@ -63,6 +63,15 @@ def robust_std(x: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(x - np.median(x))))
 
 
+def _robust_std_inplace(x: np.ndarray) -> float:
+    """:func:`robust_std` of the float array ``x``, reordering and overwriting ``x`` (no copy):
+    the medians are order statistics, the same whatever the order of the samples."""
+    med = np.median(x, overwrite_input=True)
+    np.subtract(x, med, out=x)
+    np.abs(x, out=x)
+    return float(1.4826 * np.median(x, overwrite_input=True))
+
+
 def _candidate_periods(v: np.ndarray) -> list[int]:
     """Most frequent index distances between consecutive input reversals of the same kind at
     the same level (a repeated input repeats its reversals), at least 10 samples."""
@@ -93,13 +102,22 @@ def _repeated_differences(v: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
     used = np.zeros(v.size, bool)
     out = []
     for P in _candidate_periods(v):
-        same = np.abs(v[P:] - v[:-P]) <= tol  # index k: v[k + P] == v[k]
-        # k usable when v repeated over [k - P, k] (same memory) and the period moves the input
-        c = np.concatenate(([0], np.cumsum(~same)))
-        k = np.arange(P, same.size)
-        ok = np.zeros(same.size, bool)
-        ok[k] = (c[k + 1] - c[k - P]) == 0
-        ok &= ~used[: same.size]
+        d = v[P:] - v[:-P]
+        np.abs(d, out=d)
+        same = d <= tol  # index k: v[k + P] == v[k]
+        del d
+        # k usable when v repeated over [k - P, k] (same memory) and the period moves the input:
+        # no sample of [k - P, k] differs, c[k + 1] == c[k - P] with c the count of differing
+        # samples before each index
+        m = same.size
+        c = np.zeros(m + 1, np.int32 if m < 2**31 - 1 else np.int64)
+        np.cumsum(~same, out=c[1:])
+        del same
+        ok = np.zeros(m, bool)
+        if m > P:
+            np.equal(c[P + 1:], c[:m - P], out=ok[P:])
+        del c
+        ok &= ~used[:m]
         if ok.sum() < MIN_REPEATED:
             continue
         idx = np.flatnonzero(ok)
@@ -110,7 +128,7 @@ def _repeated_differences(v: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
             span = float(np.ptp(v[run[0] - P: run[-1] + 1]))
             if span < 0.1 * rng:
                 continue  # a hold repeats trivially; its output creeps
-            d = y[run + P] - y[run]
+            d = y[run[0] + P: run[-1] + P + 1] - y[run[0]: run[-1] + 1]  # run: consecutive
             x = np.arange(run.size, dtype=float)
             d = d - np.polyval(np.polyfit(x, d, 1), x)
             out.append(d)
@@ -202,7 +220,9 @@ def measure_noise_floor(signals, outputs) -> dict:
                                                              np.asarray(y, float))]
     n_rep = sum(d.size for d in diffs)
     if n_rep >= MIN_REPEATED:
-        value = float(robust_std(np.concatenate(diffs)) / np.sqrt(2))
+        d = np.concatenate(diffs)
+        del diffs
+        value = float(_robust_std_inplace(d) / np.sqrt(2))
         return {"value": value, "method": "repeated periods", "samples": n_rep,
                 "detail": "robust std of y[k+P] - y[k] over sample pairs one input period P "
                           "apart (input identical over the period before), detrended per "

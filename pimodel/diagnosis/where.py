@@ -42,40 +42,73 @@ def startup_length(v: np.ndarray) -> int:
     return int(np.argmax(span >= STARTUP_SPAN * float(np.ptp(v))))
 
 
-def _region_masks(t: np.ndarray, v: np.ndarray, fs: float) -> dict[str, np.ndarray]:
+BLOCK = 1 << 16  # samples per block of the masks built from the latest reversal or step
+
+
+def _last_index(n: int, marks) -> np.ndarray:
+    """For each sample ``k`` the largest index in ``marks`` at or before ``k`` (-1: none)."""
+    last = np.full(n, -1, dtype=np.int32 if n < 2**31 - 1 else np.int64)
+    marks = np.asarray(marks, dtype=np.int64)
+    last[marks] = marks
+    return np.maximum.accumulate(last, out=last)
+
+
+def _since_masks(x: np.ndarray, last: np.ndarray, absolute: bool, *tests):
+    """For each ``test``, the mask ``test(d)`` of ``d[k] = x[k] - x[last[k]]`` (its magnitude
+    when ``absolute``; ``inf`` where ``last[k] < 0``), built a block of samples at a time."""
+    masks = [np.empty(x.size, bool) for _ in tests]
+    for i in range(0, x.size, BLOCK):
+        c = slice(i, i + BLOCK)
+        lc = last[c]
+        d = x[c] - x[np.maximum(lc, 0)]
+        if absolute:
+            np.abs(d, out=d)
+        d[lc < 0] = np.inf
+        for m, test in zip(masks, tests, strict=True):
+            m[c] = test(d)
+    return masks
+
+
+def _region_masks(t: np.ndarray, v: np.ndarray, fs: float):
+    """``(region, mask)`` of each region of one record, one mask at a time (each built when
+    asked for, its temporaries freed before the next: a few columns of the record at most).
+
+    "Near a reversal" is the travel ``|v[k] - v[j]|`` from the latest reversal ``j <= k``
+    (:func:`~pimodel.identification.branches.find_reversals`); a hold after a step is timed
+    ``t[k] - t[j]`` from the latest step ``j <= k`` (a sample change above 5 % of the range)."""
     rng = float(np.ptp(v)) or 1.0
     dv = np.diff(v, prepend=v[0])
     moving = np.abs(dv) > 1e-9 * rng
-    rev = find_reversals(v, 0.01 * rng)
-    since_rev = np.full(v.size, np.inf)
-    last = None
-    rset = set(rev)
-    for k in range(v.size):
-        if k in rset:
-            last = v[k]
-        if last is not None:
-            since_rev[k] = abs(v[k] - last)
-    steps = np.flatnonzero(np.abs(dv) > 0.05 * rng)
-    since_step = np.full(v.size, np.inf)
-    for s in steps:
-        end = steps[steps > s][0] if np.any(steps > s) else v.size
-        since_step[s:end] = t[s:end] - t[s]
+    yield "ascending branches", moving & (dv > 0)
+    yield "descending branches", moving & (dv < 0)
+    last = _last_index(v.size, find_reversals(v, 0.01 * rng))
+    near, = _since_masks(v, last, True, lambda d: d < 0.1 * rng)
+    del last
+    yield "near a reversal (travel < 10 % of range)", near
+    del near
     mid = 0.5 * (v.max() + v.min())
+    yield "input extremes (outer 20 % of range)", np.abs(v - mid) > 0.4 * rng
     rate = np.abs(dv) * fs
     fast = rate > np.percentile(rate[moving], 75) if moving.any() else np.zeros_like(moving)
+    del rate
+    yield "fast input (top quarter of |dv/dt|)", fast & moving
+    del fast
+    last = _last_index(v.size, np.flatnonzero(np.abs(dv) > 0.05 * rng))
+    del dv
+    first, after = _since_masks(t, last, False, lambda d: d < 0.05,
+                                lambda d: (d >= 0.05) & np.isfinite(d))
+    del last
+    np.logical_not(moving, out=moving)  # (moving is not read again: now "holding")
+    yield "hold after a step (first 50 ms)", moving & first
+    del first
+    yield "hold after a step (after 50 ms)", moving & after
+    del after, moving
     tt = t - t[0]
-    return {
-        "ascending branches": moving & (dv > 0),
-        "descending branches": moving & (dv < 0),
-        "near a reversal (travel < 10 % of range)": since_rev < 0.1 * rng,
-        "input extremes (outer 20 % of range)": np.abs(v - mid) > 0.4 * rng,
-        "fast input (top quarter of |dv/dt|)": fast & moving,
-        "hold after a step (first 50 ms)": (~moving) & (since_step < 0.05),
-        "hold after a step (after 50 ms)": (~moving) & (since_step >= 0.05) & np.isfinite(
-            since_step),
-        "late in the record (last third)": tt > 2 * tt[-1] / 3,
-        STARTUP_REGION: np.arange(v.size) < startup_length(v),
-    }
+    yield "late in the record (last third)", tt > 2 * tt[-1] / 3
+    del tt
+    start = np.zeros(v.size, bool)
+    start[:startup_length(v)] = True
+    yield STARTUP_REGION, start
 
 
 def residual_breakdown(segments, residuals) -> dict:
@@ -116,13 +149,15 @@ def residual_breakdown(segments, residuals) -> dict:
     ('late in the record (last third)', 3.01)
     """
     regions: dict[str, list[float]] = {}
-    total_e = sum(float(np.sum(r**2)) for r in residuals) or 1e-300
+    total_e = sum(float(np.sum(np.square(r))) for r in residuals) or 1e-300
     total_n = sum(r.size for r in residuals)
     for seg, r in zip(segments, residuals, strict=True):
         fs = 1.0 / seg.dt
-        for name, mask in _region_masks(seg.t, seg.v, fs).items():
+        for name, mask in _region_masks(seg.t, seg.v, fs):
             e, n = regions.get(name, [0.0, 0])
-            regions[name] = [e + float(np.sum(r[mask] ** 2)), n + int(mask.sum())]
+            g = r[mask]
+            regions[name] = [e + float(np.sum(np.square(g, out=g))), n + int(mask.sum())]
+            del g, mask
     ranked = []
     for name, (e, n) in regions.items():
         if n == 0:
@@ -137,27 +172,32 @@ def residual_breakdown(segments, residuals) -> dict:
     band_e = dict.fromkeys(bands, 0.0)
     for seg, r in zip(segments, residuals, strict=True):
         f = np.fft.rfftfreq(r.size, seg.dt)
-        P = np.abs(np.fft.rfft(r - r.mean())) ** 2
+        F = np.fft.rfft(r - r.mean())
+        P = np.abs(F)
+        del F
+        np.square(P, out=P)
         for name, (lo, hi) in bands.items():
             band_e[name] += float(P[(f >= lo) & (f < hi)].sum())
     tot = sum(band_e.values()) or 1e-300
     spectrum = [{"band": k, "energy_share": e / tot} for k, e in band_e.items()]
 
     lags = [0, 1, 2, 5, 10, 20]
-    corr_v, corr_dv = [], []
-    for lag in lags:
-        cv, cd = [], []
-        for seg, r in zip(segments, residuals, strict=True):
-            v = seg.v
-            dv = np.diff(v, prepend=v[0])
+    cv: list[list[float]] = [[] for _ in lags]  # per lag, one value per record
+    cd: list[list[float]] = [[] for _ in lags]
+    for seg, r in zip(segments, residuals, strict=True):
+        v = seg.v
+        dv = np.diff(v, prepend=v[0])
+        for i, lag in enumerate(lags):
             if lag:
-                v, dv, rr = v[:-lag], dv[:-lag], r[lag:]
+                cv[i].append(_corr(r[lag:], v[:-lag]))
+                cd[i].append(_corr(r[lag:], dv[:-lag]))
             else:
-                rr = r
-            cv.append(_corr(rr, v))
-            cd.append(_corr(rr, dv))
-        corr_v.append({"lag_samples": lag, "corr": float(np.mean(cv))})
-        corr_dv.append({"lag_samples": lag, "corr": float(np.mean(cd))})
+                cv[i].append(_corr(r, v))
+                cd[i].append(_corr(r, dv))
+    corr_v = [{"lag_samples": lag, "corr": float(np.mean(c))}
+               for lag, c in zip(lags, cv, strict=True)]
+    corr_dv = [{"lag_samples": lag, "corr": float(np.mean(c))}
+                for lag, c in zip(lags, cd, strict=True)]
     return {"regions": ranked, "spectrum": spectrum, "corr_input": corr_v,
             "corr_input_rate": corr_dv}
 
