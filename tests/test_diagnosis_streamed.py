@@ -40,6 +40,12 @@ dg = importlib.import_module("pimodel.diagnosis.diagnose")  # not the function i
 N = 2 * CHUNK + 5_003  # longer than two chunks, not a whole number of them
 
 
+def test_chunks_hold_whole_groups_of_four_samples():
+    # the bit-equality of streamed and full rows rests on the products' kernels seeing the same
+    # groups of samples in each chunk as in the whole record
+    assert CHUNK % 4 == 0
+
+
 @pytest.fixture(scope="module")
 def recs():
     truth = random_truth(["creep", "dynamics"], 0)
@@ -132,7 +138,7 @@ def test_rate_and_a_filter_before_the_hysteresis_are_not_streamed():
                                {"fn": 1.0, "zeta": 0.1, "d": 1, "lti": LTI})
 
 
-def _refit_peak(recs, stream_on: bool, monkeypatch) -> tuple[float, Model, list]:
+def _refit_peak(recs, stream_on: bool) -> tuple[float, Model, list]:
     """Peak traced memory [bytes] of the whole-record refit of dynamics + creep (held grid,
     projected plays) over what the records take, and its model and validate outputs."""
     train, validate = recs
@@ -146,31 +152,30 @@ def _refit_peak(recs, stream_on: bool, monkeypatch) -> tuple[float, Model, list]
     nominal.params = nominal_params(nominal.coef, dg._plain_outputs(tr, radii, coef), tr)
     screened = Model("dynamics+creep", 0, None, None, {},
                      {"fn": 900.0, "zeta": 0.08, "lti": LTI[:1]})
-    monkeypatch.setattr(streamed, "STREAM", stream_on)
     tracemalloc.start()
     base = tracemalloc.get_traced_memory()[0]
     with threadpool_limits(1, user_api="blas"):
         m, out = dg._whole_fit(("dynamics", "creep"), screened, tr, va, nominal,
                                lambda s: dg._with_rows(s, radii, V, True),
-                               lambda s: dg._streamed(s, radii, V, True))
+                               (lambda s: dg._streamed(s, radii, V, True)) if stream_on else None)
     peak = tracemalloc.get_traced_memory()[1] - base
     tracemalloc.stop()
     return peak, m, out
 
 
 @pytest.mark.slow
-def test_the_streamed_refit_holds_a_few_columns_not_the_models(monkeypatch):
+def test_the_streamed_refit_holds_a_few_columns_not_the_models():
     truth = random_truth(["creep", "dynamics"], 0)
     n = 300_000
     recs = ([_long("train", n, truth, 1)], [_long("validate", n, truth, 100)])
-    peak, m, out = _refit_peak(recs, True, monkeypatch)
+    peak, m, out = _refit_peak(recs, True)
     column, chunk_row = 8 * n, 8 * CHUNK  # bytes of a column of the record, of a chunk's row
     # the validate output and a chunk of the model's rows with their temporaries (the plays,
     # the projected and filtered rows: about 200 rows of 16,384 samples), not the model's
     # ~35 rows on the whole record (the full rows' path: about 54 columns here)
     bound = 4 * column + 256 * chunk_row
     assert peak < bound, (peak / column, bound / column)
-    peak_full, m_full, out_full = _refit_peak(recs, False, monkeypatch)
+    peak_full, m_full, out_full = _refit_peak(recs, False)
     assert peak_full > 2 * bound, (peak_full / column, bound / column)  # the bound tells
     assert np.array_equal(m.coef, m_full.coef)
     assert all(np.array_equal(a, b) for a, b in zip(out, out_full, strict=True))
@@ -203,15 +208,12 @@ def test_a_whole_diagnosis_is_the_same_with_the_streamed_refit(effects, seed, mo
     whole_fit, refits = dg._whole_fit, []
 
     def both(*args):
-        streamed.STREAM = False
-        full = whole_fit(*args)
-        streamed.STREAM = True
+        full = whole_fit(*args[:-1], None)  # the last argument: the streamed rows
         got = whole_fit(*args)
         refits.append((got, full))
         return got
 
     monkeypatch.setattr(dg, "_whole_fit", both)
-    monkeypatch.setattr(streamed, "STREAM", True)
     rep = dg.diagnose(train, validate, workers=1)
     assert "screen" in rep.verdict
     assert refits, "the diagnosis made no whole-record refit"
@@ -224,7 +226,7 @@ def test_a_whole_diagnosis_is_the_same_with_the_streamed_refit(effects, seed, mo
     assert all(np.array_equal(x, y) for x, y in zip(rep.after, refits[-1][0][1], strict=True))
 
 
-def _whole_refit(recs, chosen: tuple, grid: dict, stream_on: bool, monkeypatch):
+def _whole_refit(recs, chosen: tuple, grid: dict, stream_on: bool):
     """``_whole_fit`` of ``chosen`` (grid held) on whole records, as the diagnosis calls it
     (bare segments, the rows or streamed rows of a 40-play grid)."""
     train, validate = recs
@@ -235,15 +237,15 @@ def _whole_refit(recs, chosen: tuple, grid: dict, stream_on: bool, monkeypatch):
     nominal = Model("nominal", 0, base_features, coef,
                     nominal_params(coef, dg._plain_outputs(tr, radii, coef), tr))
     screened = Model("+".join(chosen), 0, None, None, {}, grid)
-    monkeypatch.setattr(streamed, "STREAM", stream_on)
     with threadpool_limits(1, user_api="blas"):
         return dg._whole_fit(chosen, screened, tr, va, nominal,
                              lambda s: dg._with_rows(s, radii, None, True),
-                             lambda s: dg._streamed(s, radii, None, True))
+                             (lambda s: dg._streamed(s, radii, None, True)) if stream_on
+                             else None)
 
 
 @pytest.mark.parametrize("clock", ["record", "levels"])
-def test_a_whole_refit_with_a_drift_reads_the_same_levels_streamed(clock, monkeypatch):
+def test_a_whole_refit_with_a_drift_reads_the_same_levels_streamed(clock):
     """The refit's drift branch (every validate record's rows at once, their levels read from
     all of them) on records longer than SCREEN_SAMPLES: streamed as with the full rows."""
     truth = random_truth(["delay", "drift"], 0)
@@ -251,8 +253,8 @@ def test_a_whole_refit_with_a_drift_reads_the_same_levels_streamed(clock, monkey
     recs = ([_long("train", n, truth, 1), _long("train", n - 500, truth, 5, 8.0)],
             [_long("validate", n + 77, truth, 100, 20.0), _long("validate", n, truth, 3, 30.0)])
     chosen, grid = ("delay", "drift"), {"d": 2.5, "clock": clock}
-    m, out = _whole_refit(recs, chosen, grid, True, monkeypatch)
-    m_full, out_full = _whole_refit(recs, chosen, grid, False, monkeypatch)
+    m, out = _whole_refit(recs, chosen, grid, True)
+    m_full, out_full = _whole_refit(recs, chosen, grid, False)
     assert np.array_equal(m.coef, m_full.coef)
     assert _text_of(m.params) == _text_of(m_full.params)
     assert all(np.array_equal(x, y) for x, y in zip(out, out_full, strict=True))

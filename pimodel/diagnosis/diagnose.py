@@ -60,7 +60,6 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
-from . import streamed
 from .chunked import CHUNK, NormalEquations
 from .creep import creep_law
 from .delaylike import is_delay_like
@@ -969,8 +968,8 @@ def _whole_fit(chosen: tuple, screened: Model, tr, va, nominal: Model,
     record longer than ``SCREEN_SAMPLES`` when the model can be streamed
     (:func:`.streamed.streamable`: not the rate, nor a filter before the hysteresis), so the
     refit and the predictions hold a chunk of the model's columns at a time, not a record's;
-    the same coefficients, RSS and outputs to the bit."""
-    if streams is not None and streamed.STREAM and streamable(chosen, screened.grid):
+    the same coefficients, RSS and outputs to the bit (``streams=None``: the full rows)."""
+    if streams is not None and streamable(chosen, screened.grid):
         rows = _long_streamed(rows, streams)
     trw = [rows(s) for s in tr]
     m = fit_effect(chosen[-1], trw, chosen[:-1], {**screened.grid, "held": True}, nominal)

@@ -39,16 +39,13 @@ import numpy as np
 from scipy.signal import lfilter
 
 from .._native import biquad_rows_carry
-from .chunked import CHUNK, combine, stack_rows
+from .chunked import combine, stack_rows
 from .drift import drift_columns
 from .filters import mode_coefficients, shift
 from .lti import element_coefficients
 
-__all__ = ["STREAM", "attach_plays", "combo_chunks", "is_streamed", "n_plays",
+__all__ = ["attach_plays", "combo_chunks", "is_streamed", "n_plays",
            "play_row_chunks", "stacked_times", "streamable"]
-
-STREAM = True  # the whole-record refit streams its held model (False: full rows, as before)
-
 
 def attach_plays(s, rows: Callable[[], Iterator[tuple[slice, np.ndarray]]], n: int):
     """Make the segment ``s`` (``Z`` None: :func:`pimodel.diagnosis.diagnose._bare`) a streamed
@@ -184,5 +181,3 @@ def stacked_times(parts_chunks, feats, s, coef: np.ndarray) -> np.ndarray:
         out[c] = stack_rows(P).T @ coef
     return out
 
-
-assert CHUNK % 4 == 0  # whole groups of samples per chunk (the products' kernels: module tests)
