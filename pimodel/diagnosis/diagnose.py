@@ -252,16 +252,25 @@ def _plain(x):
 
 
 def _residuals(segs: list[Segment], outputs) -> np.ndarray:
-    """The residuals ``y[k] - output[k]`` of the fitted samples of every segment, in one array
-    (the records' in order): written in place, no other column of the records' length."""
-    sizes = [s.y.size if s.mask is None else int(np.count_nonzero(s.mask)) for s in segs]
+    """The residuals ``y[k] - output[k]`` of the fitted samples (``s.used``: a slice or a
+    mask) of every segment, in one array (the records' in order): written in place, no other
+    column of the records' length."""
+    def size(s) -> int:
+        u = s.used
+        if isinstance(u, slice):
+            return len(range(*u.indices(s.y.size)))
+        u = np.asarray(u)
+        return int(np.count_nonzero(u)) if u.dtype == bool else u.size
+
+    sizes = [size(s) for s in segs]
     r = np.empty(sum(sizes))
     pos = 0
     for s, o, m in zip(segs, outputs, sizes, strict=True):
-        if s.mask is None:
-            np.subtract(s.y, o, out=r[pos:pos + m])
+        u = s.used
+        if isinstance(u, slice):
+            np.subtract(s.y[u], np.asarray(o)[u], out=r[pos:pos + m])
         else:
-            r[pos:pos + m] = (s.y - o)[s.mask]
+            r[pos:pos + m] = (s.y - o)[u]
         pos += m
     return r
 
