@@ -60,7 +60,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
-from .chunked import CHUNK, NormalEquations
+from .chunked import NormalEquations
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
@@ -257,10 +257,7 @@ def _residuals(segs: list[Segment], outputs) -> np.ndarray:
     column of the records' length."""
     def size(s) -> int:
         u = s.used
-        if isinstance(u, slice):
-            return len(range(*u.indices(s.y.size)))
-        u = np.asarray(u)
-        return int(np.count_nonzero(u)) if u.dtype == bool else u.size
+        return s.y[u].size if isinstance(u, slice) else int(np.count_nonzero(u))
 
     sizes = [size(s) for s in segs]
     r = np.empty(sum(sizes))
@@ -279,11 +276,11 @@ def _errors(segs: list[Segment], outputs) -> dict:
     """RMS and largest residual of the fitted samples (and as percent of the fitted outputs'
     range), the same numbers as from the concatenated residuals, with one column of residuals
     held (:func:`_residuals`, squared in place) and the range and the largest magnitude taken
-    per record and per chunk (a maximum does not depend on the grouping)."""
+    per record (a maximum does not depend on the grouping)."""
     r = _residuals(segs, outputs)
     ys = [s.y[s.used] for s in segs]
     rng = float(np.max([np.max(y) for y in ys]) - np.min([np.min(y) for y in ys])) or 1.0
-    mx = float(np.max([np.max(np.abs(r[i:i + CHUNK])) for i in range(0, r.size, CHUNK)]))
+    mx = max(float(np.max(r)), -float(np.min(r)))  # max |r| without a column of |r|
     rms = float(np.sqrt(np.mean(np.square(r, out=r))))
     return {"rms": rms, "max": mx, "rms_percent": 100 * rms / rng,
             "max_percent": 100 * mx / rng, "range": rng}

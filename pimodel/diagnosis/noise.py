@@ -39,7 +39,7 @@ MIN_REPEATED = 400  # samples of repeated input needed for the "repeated periods
 MAX_PERIODS_TRIED = 6
 
 
-def robust_std(x: np.ndarray) -> float:
+def robust_std(x: np.ndarray, overwrite_input: bool = False) -> float:
     """1.4826 times the median absolute deviation: the standard deviation for Gaussian ``x``.
 
     Insensitive to a few outliers, unlike :func:`numpy.std`.
@@ -48,6 +48,10 @@ def robust_std(x: np.ndarray) -> float:
     ----------
     x : array_like
         Samples (any shape; flattened by the median).
+    overwrite_input : bool, optional
+        Reorder and overwrite ``x`` (a float array) instead of a copy, as
+        :func:`numpy.median`'s: the same value (the medians are order statistics), no
+        temporary of ``x``'s size. Default False.
 
     Returns
     -------
@@ -59,13 +63,7 @@ def robust_std(x: np.ndarray) -> float:
     >>> robust_std([1.0, 2.0, 3.0, 4.0, 100.0])
     1.4826
     """
-    x = np.asarray(x, float)
-    return float(1.4826 * np.median(np.abs(x - np.median(x))))
-
-
-def _robust_std_inplace(x: np.ndarray) -> float:
-    """:func:`robust_std` of the float array ``x``, reordering and overwriting ``x`` (no copy):
-    the medians are order statistics, the same whatever the order of the samples."""
+    x = np.asarray(x, float) if overwrite_input else np.array(x, float)
     med = np.median(x, overwrite_input=True)
     np.subtract(x, med, out=x)
     np.abs(x, out=x)
@@ -222,7 +220,7 @@ def measure_noise_floor(signals, outputs) -> dict:
     if n_rep >= MIN_REPEATED:
         d = np.concatenate(diffs)
         del diffs
-        value = float(_robust_std_inplace(d) / np.sqrt(2))
+        value = float(robust_std(d, overwrite_input=True) / np.sqrt(2))
         return {"value": value, "method": "repeated periods", "samples": n_rep,
                 "detail": "robust std of y[k+P] - y[k] over sample pairs one input period P "
                           "apart (input identical over the period before), detrended per "
