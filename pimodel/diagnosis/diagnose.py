@@ -742,24 +742,35 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     cache: dict = {}
     once = OnceCache() if pool.workers > 1 else None  # several threads: each key fitted once
 
-    def fit(name, combo=(), fixed_=None):
-        """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
+    def variants(name, combo=(), fixed_=None) -> list[tuple]:
+        """The single fits ``fit(name, combo, fixed_)`` scores, in its order: ``(key, fx)``
+        (a drift's clocks, a rate's shapes; one for most effects)."""
         if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
-        best = None
         shapes = rate_shapes((*combo, name), fixed_ or {})
+        out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):
             fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},
                   **var, **shape}
-            key = (combo, name, tuple(sorted(fx.items())))
-            if once is not None:
-                m, o = once.get(key, lambda name=name, fx=fx: fit_one(name, combo, fx))
-            else:
-                if key not in cache:
-                    cache[key] = fit_one(name, combo, fx)
-                m, o = cache[key]
+            out.append(((combo, name, tuple(sorted(fx.items()))), fx))
+        return out
+
+    def single(key, fx):
+        """The single fit ``key`` (made once: kept in the cache)."""
+        combo, name = key[:2]
+        if once is not None:
+            return once.get(key, lambda: fit_one(name, combo, fx))
+        if key not in cache:
+            cache[key] = fit_one(name, combo, fx)
+        return cache[key]
+
+    def fit(name, combo=(), fixed_=None):
+        """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
+        best = None
+        for key, fx in variants(name, combo, fixed_):
+            m, o = single(key, fx)
             score = _bic(va, o, m.k)
             if _flat_settling(m, tr, va, noise):  # a settling no bow tells from a trend
                 continue
@@ -775,12 +786,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return out
 
     def prefetch(calls) -> None:
-        """With several threads: make the fits ``calls`` (``fit``'s arguments) on the pool, the
-        longest kinds first; the loops after them take them from the cache in their own
-        order, so every comparison and tie is decided as on one thread."""
+        """With several threads: make the single fits of ``calls`` (``fit``'s arguments; each
+        variant a fit of its own) on the pool, the longest first; the loops after them take
+        them from the cache in their own order, so every comparison and tie is decided as on
+        one thread."""
         if pool.workers > 1:
-            calls = sorted(calls, key=lambda c: -_cost(c[0], c[1] if len(c) > 1 else ()))
-            pool.map(lambda c: fit(*c), calls)
+            fits = {key: fx for c in calls for key, fx in variants(*c)}
+            pool.map(lambda kf: single(*kf),
+                     sorted(fits.items(), key=lambda kf: -_cost(kf[0][1], kf[0][0], kf[1])))
 
     prefetch([(name,) for name in EFFECTS])
     candidates = []
@@ -818,6 +831,21 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         misfit set aside (``aside``): the revision's drop test."""
         return _passes(va, new, old) or aside(new, old, old_effects, fixed_, added)
 
+    def lag_ahead(chosen, fixed_) -> None:
+        """With several threads, beside a round's fits: the fits :func:`_research_lag` needs
+        if the round adds the effect that came first alone among those not chosen that would
+        need them (a guess: the lag's re-search is the round's longest fit and can only start
+        once the round's best is known; a wrong guess costs CPU, never the result)."""
+        ahead = next((c["effect"] for c in candidates if c["effect"] not in chosen
+                      and _lag_calls((*chosen, c["effect"]), fixed_)), None)
+        if ahead is None:
+            return
+        then = (*chosen, ahead)
+        grid = fit(ahead, chosen, fixed_)[0].grid
+        for call in _lag_calls(then, {**fixed_, **grid}):
+            for key, fx in variants(*call):
+                single(key, fx)
+
     def choose(start=None):
         """The greedy rounds, the revision and the delay preference; ``start`` forces
         the first round's effect. Returns ``(chosen, fixed, model, validate outputs)``."""
@@ -831,6 +859,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if rms_now <= NOISE_STOP * noise:
                 break
             best = None
+            if chosen and pool.workers > 1:  # started first: a thread of its own
+                pool.submit(lag_ahead, chosen, dict(fixed))
             prefetch([(name, chosen, dict(fixed) if chosen else None)
                       for name in (EFFECTS if chosen or start is None else (start,))
                       if name not in chosen])
@@ -883,7 +913,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         progress("revising the choice")
         chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
                                            (nominal, out_va), noise, beside,
-                                           pool.map if pool.workers > 1 else None)
+                                           prefetch)
         chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
         return chosen, fixed, current, cur_out
 
@@ -1014,7 +1044,8 @@ def _release(model: Model, segs: list[Segment]) -> None:
                 basis.release()
 
 
-def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=None, pmap=None):
+def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=None,
+            prefetch=None):
     """Revise the greedy choice on the terms it was made on (each effect must lower the
     validate BIC by ``MIN_BIC_DROP`` and cut the validate RMS by ``MIN_RMS_CUT`` given the
     others). Greedy rounds judge a candidate beside the effects chosen so far only, so an
@@ -1026,19 +1057,20 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     noise floor); ``beside(new, old, old_effects, fixed, dropped)`` is that drop test (None:
     :func:`_passes`; the diagnosis sets a chosen rate's own misfit aside, module misfit, as
     when the effect was added). Other effects keep their grid parameters; returns ``(chosen,
-    model, validate outputs)``. ``pmap(refit, combinations)`` (None: none) makes a step's
-    refits beforehand, on several threads (``fit`` keeps them; the step then takes them in
-    its own order)."""
+    model, validate outputs)``. ``prefetch(calls)`` (None: none) makes a step's refits
+    (``fit``'s arguments) beforehand, on several threads (``fit`` keeps them; the step then
+    takes them in its own order)."""
     def keys_of(e):  # grid parameters of an effect, as its single fit reports them (a drift's
         # and a rate's all of their kind: a single fit of another family or variant lacks some,
         # e.g. rate_growth, which a held SCALED rate needs)
         return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS}.get(e, ()))
 
-    def refit(effects):
-        if not effects:
-            return nominal
+    def call(effects):  # fit's arguments for the combination ``effects`` (not empty)
         kept = {k: x for k, x in fixed.items() if any(k in keys_of(e) for e in effects)}
-        return fit(effects[-1], effects[:-1], kept or None)
+        return effects[-1], effects[:-1], kept or None
+
+    def refit(effects):
+        return fit(*call(effects)) if effects else nominal
 
     def passes(new, old):
         return _passes(va, new, old)
@@ -1046,9 +1078,9 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     cur = (current, cur_out)
     for _ in range(len(EFFECTS)):  # swaps, the best first
         best = None
-        if pmap is not None:
-            pmap(refit, [(*(c for c in chosen if c != e), x) for e in chosen
-                         for x in EFFECTS if x not in chosen])
+        if prefetch is not None:
+            prefetch([call((*(c for c in chosen if c != e), x)) for e in chosen
+                      for x in EFFECTS if x not in chosen])
         for e in chosen:
             rest = tuple(c for c in chosen if c != e)
             for x in (x for x in EFFECTS if x not in chosen):
@@ -1062,8 +1094,9 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
         fixed.update(cur[0].grid)
     while chosen:  # drops, the least needed first
         worst = None
-        if pmap is not None:
-            pmap(refit, [tuple(c for c in chosen if c != e) for e in chosen])
+        if prefetch is not None:
+            prefetch([call(rest) for rest in (tuple(c for c in chosen if c != e)
+                                              for e in chosen) if rest])
         for e in chosen:
             rest = tuple(c for c in chosen if c != e)
             without = refit(rest)
@@ -1150,11 +1183,13 @@ def _lag_calls(chosen, fixed) -> list[tuple]:
             for option in (chosen, tuple(other if e == lags[0] else e for e in chosen))]
 
 
-def _cost(name: str, combo: tuple) -> int:
-    """A rough rank of a fit's cost (the pool starts the longest first): a mode search or a
-    rate's exact-shape search costs tens to hundreds of passes, a creep or asymmetry a few."""
+def _cost(name: str, combo: tuple, fx: dict) -> int:
+    """A rough rank of a single fit's cost (the pool starts the longest first): a mode search,
+    a rate's exact-shape search or a lag searched again with every play column costs tens to
+    hundreds of passes, a creep or asymmetry a few."""
     return sum({"dynamics": 4, "rate": 4, "drift": 2, "delay": 2}.get(e, 1)
-               for e in (*combo, name))
+               for e in (*combo, name)) + 4 * bool(fx.get("rate_shape")) \
+        + 4 * bool(fx.get("search_all"))
 
 
 def _research_lag(chosen, cur, fixed, fit, va):
