@@ -524,7 +524,7 @@ def _baseline(train, validate, initial_state) -> dict:
 
 
 def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
-                      samples: int | None = None):
+                      samples: int | None = None, pool: Pool | None = None):
     """The nominal on the chosen grid and the segments the candidates are fitted on, the play
     outputs streamed (:func:`_plain_fit`): the nominal's train and validate outputs, then its
     play columns replaced by a few combinations (the nominal's own weights, then the 32 leading
@@ -538,14 +538,18 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
     samples. Returns the train and validate segments, the nominal fitted on them (with the full
     model's ``params``), the full nominal, the projection ``V`` (play columns = ``Z @ V``;
     None: not compressed), the full nominal's train and validate outputs (every sample) and
-    the whole records as segments without play rows (:func:`_bare`, for :func:`_with_rows`)."""
+    the whole records as segments without play rows (:func:`_bare`, for :func:`_with_rows`).
+    With a ``pool`` of several threads, the validate outputs and the slow-drift check are made
+    on it beside the train passes (the same values)."""
     n = radii.size
+    threads = pool is not None and pool.workers > 1
     segs, ne = _plain_fit(train, radii, initial_state, at_rest)
     coef = ne.solve()
+    vsegs = _bare(validate, initial_state)
+    out_va = pool.submit(_plain_outputs, vsegs, radii, coef, at_rest) if threads else None
     out_tr = _plain_outputs(segs, radii, coef, at_rest)
     full = Model("nominal", 0, base_features, coef, nominal_params(coef, out_tr, segs))
-    vsegs = _bare(validate, initial_state)
-    out_va = _plain_outputs(vsegs, radii, coef, at_rest)
+    out_va = out_va.result() if threads else _plain_outputs(vsegs, radii, coef, at_rest)
     heads = (_bare(train, initial_state, samples), _bare(validate, initial_state, samples))
     if n > PROJECTED:
         rss_full = sum(float(np.sum(np.square(r, out=r))) for r in (
@@ -553,16 +557,18 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
         _, vecs = np.linalg.eigh(ne.G[:n, :n])
         w = coef[:n]
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
+        screen = _bare(train, initial_state, SCREEN_SAMPLES)
+        slow = pool.submit(_slow_rss, screen, radii, at_rest, V) if threads else None
         m, rss = _projected_fit(segs, radii, V, at_rest)
         # beside a slow drift too, within 1 % plus what the dropped directions fit of the noise
         # (a drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can
         # hide directions a drift model needs)
         # (on the records' first SCREEN_SAMPLES samples, where the effects are chosen)
-        screen = _bare(train, initial_state, SCREEN_SAMPLES)
         n_fit = sum(s.y.size if s.mask is None else int(np.sum(s.mask)) for s in screen)
         keep = rss <= 1.01 * rss_full
         if keep:
-            slow_full, slow_projected = _slow_rss(screen, radii, at_rest, V)
+            slow_full, slow_projected = slow.result() if threads else \
+                _slow_rss(screen, radii, at_rest, V)
             keep = slow_projected <= (1.01 + (n - V.shape[1]) / n_fit) * slow_full
         if keep:
             m.params = dict(full.params)
@@ -695,7 +701,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     baseline = pool.submit(_baseline, train, validate, initial_state) if pool.workers > 1 \
         else None
     tr, va, nominal, full_nominal, proj, out_tr, out_va, *whole = _nominal_segments(
-        train, validate, radii, initial_state, at_rest, SCREEN_SAMPLES if screened else None)
+        train, validate, radii, initial_state, at_rest, SCREEN_SAMPLES if screened else None,
+        pool)
     before = _errors(whole[1], out_va)
     progress("plain least-squares baseline")
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
@@ -831,21 +838,6 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         misfit set aside (``aside``): the revision's drop test."""
         return _passes(va, new, old) or aside(new, old, old_effects, fixed_, added)
 
-    def lag_ahead(chosen, fixed_) -> None:
-        """With several threads, beside a round's fits: the fits :func:`_research_lag` needs
-        if the round adds the effect that came first alone among those not chosen that would
-        need them (a guess: the lag's re-search is the round's longest fit and can only start
-        once the round's best is known; a wrong guess costs CPU, never the result)."""
-        ahead = next((c["effect"] for c in candidates if c["effect"] not in chosen
-                      and _lag_calls((*chosen, c["effect"]), fixed_)), None)
-        if ahead is None:
-            return
-        then = (*chosen, ahead)
-        grid = fit(ahead, chosen, fixed_)[0].grid
-        for call in _lag_calls(then, {**fixed_, **grid}):
-            for key, fx in variants(*call):
-                single(key, fx)
-
     def choose(start=None):
         """The greedy rounds, the revision and the delay preference; ``start`` forces
         the first round's effect. Returns ``(chosen, fixed, model, validate outputs)``."""
@@ -859,8 +851,6 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if rms_now <= NOISE_STOP * noise:
                 break
             best = None
-            if chosen and pool.workers > 1:  # started first: a thread of its own
-                pool.submit(lag_ahead, chosen, dict(fixed))
             prefetch([(name, chosen, dict(fixed) if chosen else None)
                       for name in (EFFECTS if chosen or start is None else (start,))
                       if name not in chosen])
