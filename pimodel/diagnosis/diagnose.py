@@ -721,6 +721,17 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                       f" times that of a plain least-squares PI fit ({base_rms:.4g}; "
                       "report.nominal['baseline']): the effects are measured against a weak "
                       "nominal", UserWarning, stacklevel=3)
+    progress("noise floor")
+    noise_info = measure_noise_floor([(s.v, s.y) for s in whole[0] + whole[1]],
+                                     out_tr + out_va)
+    noise = noise_info["value"]
+    del out_tr  # the nominal's train outputs: read by nothing after the noise floor (so not
+    # held beside where's temporaries, nor through the choice)
+    where = residual_breakdown(whole[1], [s.y - o for s, o in zip(whole[1], out_va,
+                                                                   strict=True)])
+    whole.append(out_va)
+    if screened:
+        out_va = [o[:SCREEN_SAMPLES] for o in out_va]
     segs = tr + va
     # the rate columns from the full play outputs (computed chunk by chunk from the input
     # when needed), weighted as the model will hold them; the step rule on the whole input
@@ -781,34 +792,17 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         _release(m, segs)  # (the bases' memos of this thread: module threads)
         return out
 
-    def prefetch(calls, wait: bool = True) -> None:
+    def prefetch(calls) -> None:
         """With several threads: make the single fits of ``calls`` (``fit``'s arguments; each
-        variant a fit of its own) on the pool, the longest first (``wait=False``: return once
-        they are queued); the loops after them take them from the cache in their own order,
-        so every comparison and tie is decided as on one thread."""
+        variant a fit of its own) on the pool, the longest first; the loops after them take
+        them from the cache in their own order, so every comparison and tie is decided as on
+        one thread."""
         if pool.workers > 1:
             fits = {key: fx for c in calls for key, fx in variants(*c)}
-            jobs = [pool.submit(single, *kf) for kf in
-                    sorted(fits.items(), key=lambda kf: -_cost(kf[0][1], kf[0][0], kf[1]))]
-            for job in jobs if wait else ():
-                job.result()
+            pool.map(lambda kf: single(*kf),
+                     sorted(fits.items(), key=lambda kf: -_cost(kf[0][1], kf[0][0], kf[1])))
 
-    # the candidates' fits start on the pool while this thread measures the noise floor
-    prefetch([(name,) for name in EFFECTS], wait=False)
-    progress("noise floor")
-    noise_info = measure_noise_floor([(s.v, s.y) for s in whole[0] + whole[1]],
-                                     out_tr + out_va)
-    noise = noise_info["value"]
-    del out_tr  # the nominal's train outputs: read by nothing after the noise floor (so not
-    # held through the choice)
-    whole.append(out_va)
-    if screened:
-        out_va = [o[:SCREEN_SAMPLES] for o in out_va]
-
-    def breakdown() -> dict:  # where the nominal's validate gap sits (whole records)
-        return residual_breakdown(whole[1], [s.y - o for s, o in zip(whole[1], whole[2],
-                                                                      strict=True)])
-
+    prefetch([(name,) for name in EFFECTS])
     candidates = []
     for i, name in enumerate(EFFECTS):
         progress(f"candidate {name} ({i + 1}/{len(EFFECTS)})")
@@ -933,9 +927,6 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             s.forget_grams()
         pool.close()  # the refit is one thread's: the others end, with what they held
         tr, va, out_va = whole
-        # where the gap sits, beside the refit (on one thread: first, in this thread)
-        side = Pool(min(pool.workers, 2))
-        where = side.submit(breakdown)
         if chosen:
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
                                           lambda s: _with_rows(s, radii, proj, at_rest),
@@ -945,10 +936,6 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         screen = {"samples": SCREEN_SAMPLES,
                   "confirmed": bool(not chosen or _passes(va, (current, cur_out),
                                                           (nominal, out_va)))}
-        where = where.result()
-        side.close()
-    else:
-        where = breakdown()
     after = _errors(va, cur_out)
     regions = {r["region"]: r for r in where["regions"]}
     bands = {b["band"]: b["energy_share"] for b in where["spectrum"]}
