@@ -524,7 +524,7 @@ def _baseline(train, validate, initial_state) -> dict:
 
 
 def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
-                      samples: int | None = None):
+                      samples: int | None = None, pool: Pool | None = None):
     """The nominal on the chosen grid and the segments the candidates are fitted on, the play
     outputs streamed (:func:`_plain_fit`): the nominal's train and validate outputs, then its
     play columns replaced by a few combinations (the nominal's own weights, then the 32 leading
@@ -538,14 +538,18 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
     samples. Returns the train and validate segments, the nominal fitted on them (with the full
     model's ``params``), the full nominal, the projection ``V`` (play columns = ``Z @ V``;
     None: not compressed), the full nominal's train and validate outputs (every sample) and
-    the whole records as segments without play rows (:func:`_bare`, for :func:`_with_rows`)."""
+    the whole records as segments without play rows (:func:`_bare`, for :func:`_with_rows`).
+    With a ``pool`` of several threads, the validate outputs and the slow-drift check are made
+    on it beside the train passes (the same values)."""
     n = radii.size
+    threads = pool is not None and pool.workers > 1
     segs, ne = _plain_fit(train, radii, initial_state, at_rest)
     coef = ne.solve()
+    vsegs = _bare(validate, initial_state)
+    out_va = pool.submit(_plain_outputs, vsegs, radii, coef, at_rest) if threads else None
     out_tr = _plain_outputs(segs, radii, coef, at_rest)
     full = Model("nominal", 0, base_features, coef, nominal_params(coef, out_tr, segs))
-    vsegs = _bare(validate, initial_state)
-    out_va = _plain_outputs(vsegs, radii, coef, at_rest)
+    out_va = out_va.result() if threads else _plain_outputs(vsegs, radii, coef, at_rest)
     heads = (_bare(train, initial_state, samples), _bare(validate, initial_state, samples))
     if n > PROJECTED:
         rss_full = sum(float(np.sum(np.square(r, out=r))) for r in (
@@ -553,16 +557,18 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
         _, vecs = np.linalg.eigh(ne.G[:n, :n])
         w = coef[:n]
         V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
+        screen = _bare(train, initial_state, SCREEN_SAMPLES)
+        slow = pool.submit(_slow_rss, screen, radii, at_rest, V) if threads else None
         m, rss = _projected_fit(segs, radii, V, at_rest)
         # beside a slow drift too, within 1 % plus what the dropped directions fit of the noise
         # (a drift the nominal leaves in its residual inflates its RSS, so that 1 % of it can
         # hide directions a drift model needs)
         # (on the records' first SCREEN_SAMPLES samples, where the effects are chosen)
-        screen = _bare(train, initial_state, SCREEN_SAMPLES)
         n_fit = sum(s.y.size if s.mask is None else int(np.sum(s.mask)) for s in screen)
         keep = rss <= 1.01 * rss_full
         if keep:
-            slow_full, slow_projected = _slow_rss(screen, radii, at_rest, V)
+            slow_full, slow_projected = slow.result() if threads else \
+                _slow_rss(screen, radii, at_rest, V)
             keep = slow_projected <= (1.01 + (n - V.shape[1]) / n_fit) * slow_full
         if keep:
             m.params = dict(full.params)
@@ -695,7 +701,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     baseline = pool.submit(_baseline, train, validate, initial_state) if pool.workers > 1 \
         else None
     tr, va, nominal, full_nominal, proj, out_tr, out_va, *whole = _nominal_segments(
-        train, validate, radii, initial_state, at_rest, SCREEN_SAMPLES if screened else None)
+        train, validate, radii, initial_state, at_rest, SCREEN_SAMPLES if screened else None,
+        pool)
     before = _errors(whole[1], out_va)
     progress("plain least-squares baseline")
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
@@ -742,24 +749,35 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     cache: dict = {}
     once = OnceCache() if pool.workers > 1 else None  # several threads: each key fitted once
 
-    def fit(name, combo=(), fixed_=None):
-        """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
+    def variants(name, combo=(), fixed_=None) -> list[tuple]:
+        """The single fits ``fit(name, combo, fixed_)`` scores, in its order: ``(key, fx)``
+        (a drift's clocks, a rate's shapes; one for most effects)."""
         if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
-        best = None
         shapes = rate_shapes((*combo, name), fixed_ or {})
+        out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):
             fx = {**{k: x for k, x in (fixed_ or {}).items() if not (var and k in DRIFT_KEYS)},
                   **var, **shape}
-            key = (combo, name, tuple(sorted(fx.items())))
-            if once is not None:
-                m, o = once.get(key, lambda name=name, fx=fx: fit_one(name, combo, fx))
-            else:
-                if key not in cache:
-                    cache[key] = fit_one(name, combo, fx)
-                m, o = cache[key]
+            out.append(((combo, name, tuple(sorted(fx.items()))), fx))
+        return out
+
+    def single(key, fx):
+        """The single fit ``key`` (made once: kept in the cache)."""
+        combo, name = key[:2]
+        if once is not None:
+            return once.get(key, lambda: fit_one(name, combo, fx))
+        if key not in cache:
+            cache[key] = fit_one(name, combo, fx)
+        return cache[key]
+
+    def fit(name, combo=(), fixed_=None):
+        """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
+        best = None
+        for key, fx in variants(name, combo, fixed_):
+            m, o = single(key, fx)
             score = _bic(va, o, m.k)
             if _flat_settling(m, tr, va, noise):  # a settling no bow tells from a trend
                 continue
@@ -775,12 +793,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return out
 
     def prefetch(calls) -> None:
-        """With several threads: make the fits ``calls`` (``fit``'s arguments) on the pool, the
-        longest kinds first; the loops after them take them from the cache in their own
-        order, so every comparison and tie is decided as on one thread."""
+        """With several threads: make the single fits of ``calls`` (``fit``'s arguments; each
+        variant a fit of its own) on the pool, the longest first; the loops after them take
+        them from the cache in their own order, so every comparison and tie is decided as on
+        one thread."""
         if pool.workers > 1:
-            calls = sorted(calls, key=lambda c: -_cost(c[0], c[1] if len(c) > 1 else ()))
-            pool.map(lambda c: fit(*c), calls)
+            fits = {key: fx for c in calls for key, fx in variants(*c)}
+            pool.map(lambda kf: single(*kf),
+                     sorted(fits.items(), key=lambda kf: -_cost(kf[0][1], kf[0][0], kf[1])))
 
     prefetch([(name,) for name in EFFECTS])
     candidates = []
@@ -883,7 +903,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         progress("revising the choice")
         chosen, current, cur_out = _revise(chosen, current, cur_out, fixed, fit, va,
                                            (nominal, out_va), noise, beside,
-                                           pool.map if pool.workers > 1 else None)
+                                           prefetch)
         chosen, current, cur_out = _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt)
         return chosen, fixed, current, cur_out
 
@@ -1014,7 +1034,8 @@ def _release(model: Model, segs: list[Segment]) -> None:
                 basis.release()
 
 
-def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=None, pmap=None):
+def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=None,
+            prefetch=None):
     """Revise the greedy choice on the terms it was made on (each effect must lower the
     validate BIC by ``MIN_BIC_DROP`` and cut the validate RMS by ``MIN_RMS_CUT`` given the
     others). Greedy rounds judge a candidate beside the effects chosen so far only, so an
@@ -1026,19 +1047,20 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     noise floor); ``beside(new, old, old_effects, fixed, dropped)`` is that drop test (None:
     :func:`_passes`; the diagnosis sets a chosen rate's own misfit aside, module misfit, as
     when the effect was added). Other effects keep their grid parameters; returns ``(chosen,
-    model, validate outputs)``. ``pmap(refit, combinations)`` (None: none) makes a step's
-    refits beforehand, on several threads (``fit`` keeps them; the step then takes them in
-    its own order)."""
+    model, validate outputs)``. ``prefetch(calls)`` (None: none) makes a step's refits
+    (``fit``'s arguments) beforehand, on several threads (``fit`` keeps them; the step then
+    takes them in its own order)."""
     def keys_of(e):  # grid parameters of an effect, as its single fit reports them (a drift's
         # and a rate's all of their kind: a single fit of another family or variant lacks some,
         # e.g. rate_growth, which a held SCALED rate needs)
         return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS}.get(e, ()))
 
-    def refit(effects):
-        if not effects:
-            return nominal
+    def call(effects):  # fit's arguments for the combination ``effects`` (not empty)
         kept = {k: x for k, x in fixed.items() if any(k in keys_of(e) for e in effects)}
-        return fit(effects[-1], effects[:-1], kept or None)
+        return effects[-1], effects[:-1], kept or None
+
+    def refit(effects):
+        return fit(*call(effects)) if effects else nominal
 
     def passes(new, old):
         return _passes(va, new, old)
@@ -1046,9 +1068,9 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     cur = (current, cur_out)
     for _ in range(len(EFFECTS)):  # swaps, the best first
         best = None
-        if pmap is not None:
-            pmap(refit, [(*(c for c in chosen if c != e), x) for e in chosen
-                         for x in EFFECTS if x not in chosen])
+        if prefetch is not None:
+            prefetch([call((*(c for c in chosen if c != e), x)) for e in chosen
+                      for x in EFFECTS if x not in chosen])
         for e in chosen:
             rest = tuple(c for c in chosen if c != e)
             for x in (x for x in EFFECTS if x not in chosen):
@@ -1062,8 +1084,9 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
         fixed.update(cur[0].grid)
     while chosen:  # drops, the least needed first
         worst = None
-        if pmap is not None:
-            pmap(refit, [tuple(c for c in chosen if c != e) for e in chosen])
+        if prefetch is not None:
+            prefetch([call(rest) for rest in (tuple(c for c in chosen if c != e)
+                                              for e in chosen) if rest])
         for e in chosen:
             rest = tuple(c for c in chosen if c != e)
             without = refit(rest)
@@ -1150,11 +1173,13 @@ def _lag_calls(chosen, fixed) -> list[tuple]:
             for option in (chosen, tuple(other if e == lags[0] else e for e in chosen))]
 
 
-def _cost(name: str, combo: tuple) -> int:
-    """A rough rank of a fit's cost (the pool starts the longest first): a mode search or a
-    rate's exact-shape search costs tens to hundreds of passes, a creep or asymmetry a few."""
+def _cost(name: str, combo: tuple, fx: dict) -> int:
+    """A rough rank of a single fit's cost (the pool starts the longest first): a mode search,
+    a rate's exact-shape search or a lag searched again with every play column costs tens to
+    hundreds of passes, a creep or asymmetry a few."""
     return sum({"dynamics": 4, "rate": 4, "drift": 2, "delay": 2}.get(e, 1)
-               for e in (*combo, name))
+               for e in (*combo, name)) + 4 * bool(fx.get("rate_shape")) \
+        + 4 * bool(fx.get("search_all"))
 
 
 def _research_lag(chosen, cur, fixed, fit, va):
