@@ -111,3 +111,25 @@ def test_cli_workers_option(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main([*args[:-3], "--json", str(tmp_path / "e.json"), "--workers", "0"])
     assert ">= 1" in capsys.readouterr().err
+
+
+def test_a_fits_variants_run_on_the_pool_each_on_its_own(monkeypatch):
+    """The rate candidate's two shapes (first order and exact) are two fits the pool makes
+    at once: each waits at a barrier for the other. When the variants of one ``fit`` ran one
+    after the other on one thread, the first waited alone and the barrier broke."""
+    import importlib
+    diagnose_module = importlib.import_module("pimodel.diagnosis.diagnose")
+    real = diagnose_module.fit_effect
+    barrier = threading.Barrier(2, timeout=120)
+    met = []
+
+    def fit_effect(name, train, combo, fixed, nominal):
+        if name == "rate" and not combo:  # the candidate alone: its two shapes
+            met.append(barrier.wait())
+        return real(name, train, combo, fixed, nominal)
+
+    monkeypatch.setattr(diagnose_module, "fit_effect", fit_effect)
+    train, validate = records(("rate",), 0)
+    rep = diagnose(train, validate, workers=2, max_effects=1)
+    assert sorted(met) == [0, 1]  # both shapes passed the barrier together
+    assert "rate" in [c["effect"] for c in rep.candidates]
