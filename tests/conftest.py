@@ -11,12 +11,27 @@ from fmpy.fmi1 import printLogMessage
 from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.logging import addLoggerProxy
 from hypothesis import settings
+from threadpoolctl import threadpool_limits
 
 # No per-example deadline (a loaded 2-core machine makes timings noisy); in CI the examples are
 # derandomised so that a run is reproducible.
 settings.register_profile("default", deadline=None)
 settings.register_profile("ci", deadline=None, derandomize=True)
 settings.load_profile("ci" if os.environ.get("CI") else "default")
+
+# One BLAS/OpenMP thread per test process. quickstart.sh runs one pytest-xdist worker per core, so
+# with OpenBLAS' default (a thread per core) each worker's BLAS threads compete with the other
+# workers' for the same cores, and OpenBLAS' threads spin while they wait: a small least-squares
+# problem (identify's piecewise-linear fits, a few hundred samples) then took 5-10 times longer
+# (measured: 4.9-7.1 s instead of 0.6-0.8 s for one identify on a 251-sample record, with another
+# process busy on the second core). The library's own pools already do the same
+# (pimodel.diagnosis.diagnose, pimodel.experiments.sweeps). Set before any test runs, and in the
+# environment for the subprocesses the tests start (the CLI, the docs build, the studies).
+THREAD_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+for _name in THREAD_ENV:
+    os.environ[_name] = "1"
+_BLAS_LIMIT = threadpool_limits(limits=1)
+
 
 # fmpy's native logger proxy (fmpy/logging, addLoggerProxy) keeps the last logger it was given in
 # one process-wide pointer, and simulate_fmu(logger=...) gives it a ctypes callback that is freed

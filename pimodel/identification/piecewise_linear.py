@@ -123,11 +123,15 @@ def _dp_breakpoints(x: np.ndarray, Y: np.ndarray, m: int, bins: int) -> np.ndarr
     cost = np.full((m + 1, G + 1), np.inf)
     arg = np.zeros((m + 1, G + 1), dtype=int)
     cost[0, 0] = 0.0
+    cols = np.arange(1, G + 1)
+    before = np.arange(G + 1)[:, None] < cols  # start bin i before end bin j
     for s in range(1, m + 1):
-        for j in range(1, G + 1):
-            cand = cost[s - 1, :j] + seg[:j, j]
-            arg[s, j] = int(np.argmin(cand))
-            cost[s, j] = cand[arg[s, j]]
+        # every end bin j at once: column j holds cost[s - 1, i] + seg[i, j] for i < j and inf
+        # below, so the first minimum over the column is the first minimum over i < j, as a loop
+        # over j finds it (the same sums, the same index, a NaN included)
+        cand = np.where(before, cost[s - 1, :, None] + seg[:, 1:], np.inf)
+        arg[s, 1:] = np.argmin(cand, axis=0)
+        cost[s, 1:] = cand[arg[s, 1:], cols - 1]
     cuts, j = [], G
     for s in range(m, 0, -1):
         j = arg[s, j]
