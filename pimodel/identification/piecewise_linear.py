@@ -100,6 +100,13 @@ def _design(x: np.ndarray, groups: np.ndarray, n_groups: int, bps: np.ndarray) -
 
 def _dp_breakpoints(x: np.ndarray, Y: np.ndarray, m: int, bins: int) -> np.ndarray:
     """Breakpoints of the optimal m-segment (discontinuous) linear fit on binned data."""
+    edges, seg = _segment_costs(x, Y, bins)
+    return np.array([edges[c] for c in _best_cuts(seg, m)])
+
+
+def _segment_costs(x: np.ndarray, Y: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """The bin edges (quantiles of ``x``, ``bins`` at most) and ``seg[i, j]``: the residual sum
+    of squares of one straight line over bins ``i..j-1`` (inf for ``j <= i``)."""
     order = np.argsort(x)
     xs, ys = x[order], Y[order]
     edges = np.unique(np.quantile(xs, np.linspace(0, 1, bins + 1)))
@@ -120,15 +127,23 @@ def _dp_breakpoints(x: np.ndarray, Y: np.ndarray, m: int, bins: int) -> np.ndarr
         seg = np.maximum(var_y - explained, 0.0)
     seg = np.where(n < 2, 0.0, seg)
     seg[np.tril_indices(G + 1)] = np.inf  # j <= i: empty
+    return edges, seg
+
+
+def _best_cuts(seg: np.ndarray, m: int) -> list[int]:
+    """The inner bin edges of the lowest-cost ``m``-segment cut of bins ``0..G`` (``seg[i, j]``:
+    the cost of one segment over bins ``i..j-1``, inf for ``j <= i``), sorted: the dynamic
+    programme over the number of segments, every end bin at once (column ``j`` holds
+    ``cost[s - 1, i] + seg[i, j]`` for ``i < j`` and inf below, so the first minimum over the
+    column is the first minimum over ``i < j``, as a loop over ``j`` finds it: the same sums,
+    the same index, a NaN included)."""
+    G = seg.shape[0] - 1
     cost = np.full((m + 1, G + 1), np.inf)
     arg = np.zeros((m + 1, G + 1), dtype=int)
     cost[0, 0] = 0.0
     cols = np.arange(1, G + 1)
     before = np.arange(G + 1)[:, None] < cols  # start bin i before end bin j
     for s in range(1, m + 1):
-        # every end bin j at once: column j holds cost[s - 1, i] + seg[i, j] for i < j and inf
-        # below, so the first minimum over the column is the first minimum over i < j, as a loop
-        # over j finds it (the same sums, the same index, a NaN included)
         cand = np.where(before, cost[s - 1, :, None] + seg[:, 1:], np.inf)
         arg[s, 1:] = np.argmin(cand, axis=0)
         cost[s, 1:] = cand[arg[s, 1:], cols - 1]
@@ -136,8 +151,7 @@ def _dp_breakpoints(x: np.ndarray, Y: np.ndarray, m: int, bins: int) -> np.ndarr
     for s in range(m, 0, -1):
         j = arg[s, j]
         cuts.append(j)
-    cuts = sorted(cuts)[1:]  # drop the leading 0
-    return np.array([edges[c] for c in cuts])
+    return sorted(cuts)[1:]  # the leading 0 dropped
 
 
 def _bin(x, Y, bins):
