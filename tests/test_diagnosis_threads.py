@@ -14,7 +14,7 @@ import pytest
 
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.rate import RateBasis
-from pimodel.diagnosis.threads import OnceCache, Pool
+from pimodel.diagnosis.threads import OnceCache, Pool, helped_map, lend
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_diagnosis import records  # noqa: E402 (train and validate records, one each)
@@ -93,6 +93,54 @@ def test_once_cache_computes_each_key_once_across_threads():
         second = pool.submit(cache.get, "k", lambda: 0)
         gate.set()
         assert (first.result(), second.result(), len(calls)) == (42, 42, 1)
+
+
+def test_helped_map_gives_the_results_in_order_and_lets_an_idle_thread_help():
+    """A search's points (module effects) on the pool lent to the calling thread: the
+    results in the points' order whichever thread made each, and the pool's idle threads
+    take some; without a lent pool (or on one worker) the caller makes them all."""
+    def square(x):
+        names.add(threading.current_thread().name)
+        for _ in range(200):  # long enough for the helper to start
+            np.linalg.norm(np.ones(2000))
+        return x * x
+
+    items = list(range(40))
+    names: set = set()
+    assert helped_map(square, items) == [x * x for x in items]
+    assert names == {threading.current_thread().name}
+    with Pool(2) as pool:
+        names.clear()
+        got = pool.submit(lambda: _lent(pool, square, items)).result(timeout=60)
+    assert got == [x * x for x in items]
+    assert len(names) == 2  # the caller (a pool thread) and the idle one
+    with Pool(1) as pool, lend(pool):
+        names.clear()
+        assert helped_map(square, items) == [x * x for x in items]
+        assert names == {threading.current_thread().name}
+
+
+def _lent(pool, fn, items):
+    with lend(pool):
+        return helped_map(fn, items)
+
+
+def test_helped_map_never_waits_for_a_helper_that_has_not_started():
+    """The pool's other thread blocked on the caller's own result (a fit waiting in
+    ``OnceCache`` for the one being made): the caller makes every point itself, no deadlock."""
+    cache, inside, started = OnceCache(), threading.Event(), threading.Event()
+
+    def fit():
+        inside.set()
+        started.wait(10.0)  # the other thread now waits on this key
+        with lend(pool):
+            return helped_map(lambda x: x + 1, range(10))
+
+    with Pool(2) as pool:
+        first = pool.submit(cache.get, "k", fit)
+        inside.wait(10.0)
+        second = pool.submit(lambda: started.set() or cache.get("k", lambda: None))
+        assert first.result(timeout=30) == second.result(timeout=30) == list(range(1, 11))
 
 
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)

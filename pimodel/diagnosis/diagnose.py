@@ -81,7 +81,7 @@ from .misfit import rate_correction
 from .noise import measure_noise_floor
 from .rate import RATE_KEYS, RateBasis, rate_shapes
 from .streamed import attach_plays, streamable
-from .threads import OnceCache, Pool, default_workers
+from .threads import OnceCache, Pool, default_workers, lend
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
 
@@ -786,7 +786,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return best[1], best[2]
 
     def fit_one(name, combo, fx):
-        m = fit_effect(name, tr, combo, fx, nominal)
+        with lend(pool):  # a search's points may go to the pool's idle threads
+            m = fit_effect(name, tr, combo, fx, nominal)
         out = (m, [m.predict(s) for s in va])
         m.params.update(level_report(m, va, tr))
         _release(m, segs)  # (the bases' memos of this thread: module threads)

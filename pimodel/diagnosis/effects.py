@@ -19,7 +19,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..operators.pi import PIOperator
-from .chunked import NormalEquations, chunks
+from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
 from .creep import creep_time_constants
@@ -52,6 +52,7 @@ from .rate import (
     SCALED,
 )
 from .streamed import combo_chunks, is_streamed, n_plays, play_row_chunks, stacked_times
+from .threads import helped_map
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
 __all__ = [
@@ -796,9 +797,11 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     tried: list = []  # (train RSS, grid point) of the first search, for the confirmation
 
     def search(points, best=None):
-        for p in points:
-            model, rss = _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
-                              train, p)
+        # the points are independent fits: idle threads of the diagnosis' pool may take some
+        # (module threads); the best is then taken in the points' order, as on one thread
+        fits = helped_map(lambda p: _fit(name, k, _combo_features(effects, p, nominal, static,
+                                                                  ncols), train, p), points)
+        for p, (model, rss) in zip(points, fits, strict=True):
             tried.append((rss, p))
             if best is None or rss < best[1]:
                 best = (model, rss)
@@ -1150,7 +1153,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"))
             key = ("rate", id(s))
             if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
-                static[key] = (which, np.ascontiguousarray(s.rate_basis.columns(*which).T), s)
+                static[key] = (which, transposed(s.rate_basis.columns(*which)), s)
             parts.append(static[key][1])
         if "drift" in effects:  # the trend column last
             parts.append(drift_columns(s.t, p, static["train"].index(s),
@@ -1177,6 +1180,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     return feats
 
 
+_LTI_LOCK = threading.Lock()  # the element columns' memo of _lti_block
+
+
 def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     """The columns ``(E_j - M_1)[h0]`` of the elements ``p["lti"]`` (delayed by ``p["d"]`` when
     the delay is fitted too); ``h0`` is memoised per segment in ``static``."""
@@ -1196,12 +1202,15 @@ def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     cols = np.empty((h0.size, len(p["lti"])))
     for j, el in enumerate(p["lti"]):
         key = tuple(el)
-        col = known[1].pop(key, None)  # reinserted last: the least recently used goes first
+        with _LTI_LOCK:  # the points of one search may run on two threads (module threads)
+            col = known[1].pop(key, None)  # reinserted last: the least recently used goes first
         if col is None:
             col = lti_columns(h0, p["fn"], p["zeta"], (el,), s.dt, base=base[1])[:, 0]
-        known[1][key] = cols[:, j] = col
-        if len(known[1]) > LTI_MEMO:
-            del known[1][next(iter(known[1]))]
+        cols[:, j] = col
+        with _LTI_LOCK:
+            known[1][key] = col
+            while len(known[1]) > LTI_MEMO:
+                del known[1][next(iter(known[1]))]
     return shift(cols, p["d"]) if "d" in p else cols
 
 

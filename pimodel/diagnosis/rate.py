@@ -70,7 +70,7 @@ from scipy.signal import lfilter
 
 from .. import _native
 from ..operators.pi import PIOperator
-from .chunked import chunks
+from .chunked import chunks, transposed
 from .threads import drop_threads, per_thread
 
 RATE_TAUS = (0.0, 1e-3, 3e-3, 10e-3, 30e-3)  # s: low-pass of the input rate, half decades
@@ -440,8 +440,7 @@ class RateBasis:
             z0 = float(self.v[0]) if self.at_rest else 0.0
             Zs = scaled_plays(self.v, self.radii, self.dt, self.rate_scale, tau, saturation,
                               growth, z0)
-            rows = np.ascontiguousarray((Zs if self.projection is None else
-                                         Zs @ self.projection).T)
+            rows = transposed(Zs if self.projection is None else Zs @ self.projection)
             self._cache.clear()
             self._cache[key] = rows
         return self._cache[key]

@@ -12,12 +12,13 @@ caller's order: the serial path, unchanged.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
+from contextlib import contextmanager
 
 from ..cores import available_cores
 
-__all__ = ["Pool", "OnceCache", "per_thread", "default_workers"]
+__all__ = ["Pool", "OnceCache", "per_thread", "default_workers", "lend", "helped_map"]
 
 MAX_DEFAULT_WORKERS = 2  # the default pool: the cores, at most this many
 
@@ -115,6 +116,75 @@ class Pool:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+_LENT = threading.local()  # the pool lent to this thread's calls (lend)
+
+
+@contextmanager
+def lend(pool: Pool) -> Iterator[None]:
+    """Within the block, :func:`helped_map` on this thread may hand items to ``pool``'s idle
+    threads (the pool of the diagnosis that makes this call; restored on exit).
+
+    Examples
+    --------
+    >>> with Pool(2) as pool, lend(pool):
+    ...     helped_map(lambda x: x + 1, [1, 2, 3])
+    [2, 3, 4]
+    """
+    before = getattr(_LENT, "pool", None)
+    _LENT.pool = pool
+    try:
+        yield
+    finally:
+        _LENT.pool = before
+
+
+def helped_map(fn: Callable, items: Iterable) -> list:
+    """``[fn(x) for x in items]``, results in order, the calling thread taking the items one by
+    one while the threads of the pool lent to it (:func:`lend`) that are idle take some too.
+
+    The caller never waits for a helper that has not started: a helper is a call queued on the
+    pool behind the batch under way, so it starts only when a thread has nothing else to do
+    (the tail of a batch, a long fit alone); once the caller has taken the last item, the
+    helpers not yet started are cancelled and it waits only for the items helpers are
+    computing. So no deadlock with :class:`OnceCache` (a thread waiting for this very call is
+    never needed to finish it), and without a lent pool, or with one worker, this is the plain
+    loop. ``fn`` must give the same result on any thread (no per-thread state in its result)."""
+    items = list(items)
+    pool = getattr(_LENT, "pool", None)
+    executor = None if pool is None else pool._executor
+    if executor is None or len(items) < 2:
+        return [fn(x) for x in items]
+    results: list = [None] * len(items)
+    lock = threading.Lock()
+    state = {"next": 0, "stop": False}
+
+    def take() -> int | None:
+        with lock:
+            i = state["next"]
+            if state["stop"] or i >= len(items):
+                return None
+            state["next"] = i + 1
+            return i
+
+    def work() -> None:
+        while (i := take()) is not None:
+            results[i] = fn(items[i])
+
+    try:
+        helpers = [executor.submit(work) for _ in range(pool.workers - 1)]
+    except RuntimeError:  # the pool is closing: this thread alone
+        helpers = []
+    try:
+        work()
+    finally:
+        with lock:
+            state["stop"] = True
+        for h in helpers:
+            if not h.cancel():
+                h.result()  # running: it ends with the item it holds
+    return results
 
 
 class OnceCache:
