@@ -1152,9 +1152,10 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "rate" in effects and not scaled:
             which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"))
             key = ("rate", id(s))
-            if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
-                static[key] = (which, transposed(s.rate_basis.columns(*which)), s)
-            parts.append(static[key][1])
+            kept = static.get(key)  # the latest filter only, per segment; read once: two
+            if kept is None or kept[0] != which:  # points of a search may run on two threads
+                kept = static[key] = (which, transposed(s.rate_basis.columns(*which)), s)
+            parts.append(kept[1])
         if "drift" in effects:  # the trend column last
             parts.append(drift_columns(s.t, p, static["train"].index(s),
                                        len(static["train"])).T)
