@@ -921,6 +921,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if path[0] and score < best[0] - MIN_BIC_DROP:
                 best = (score, path)
         chosen, fixed, current, cur_out = best[1]
+    for s in segs:  # the choice is made: the rate bases' band sums and last contacts, kept
+        if s.rate_basis is not None:  # for every fit of it, are done with
+            s.rate_basis.forget()
     screen = None
     if screened:  # the choice, refitted on the whole records; the verdict's figures whole
         progress("the chosen model on the whole records")
