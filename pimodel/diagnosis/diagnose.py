@@ -935,6 +935,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
                                           lambda s: _with_rows(s, radii, proj, at_rest),
                                           lambda s: _streamed(s, radii, proj, at_rest))
+            for s in tr + va:  # what a rate refit kept of a whole record (its contacts)
+                if s.rate_basis is not None:
+                    s.rate_basis.forget()
         else:
             current, cur_out = nominal, out_va
         screen = {"samples": SCREEN_SAMPLES,
