@@ -181,3 +181,43 @@ def test_a_fits_variants_run_on_the_pool_each_on_its_own(monkeypatch):
     rep = diagnose(train, validate, workers=2, max_effects=1)
     assert sorted(met) == [0, 1]  # both shapes passed the barrier together
     assert "rate" in [c["effect"] for c in rep.candidates]
+
+
+class _StoresMeet(dict):
+    """A fit's memo whose stores of a segment's latest rate filter wait until both threads of
+    the test have stored theirs (the order in which two points of one search interleave)."""
+
+    def __init__(self, barrier: threading.Barrier):
+        super().__init__()
+        self.barrier = barrier
+
+    def __setitem__(self, key, value):
+        super().__setitem__(key, value)
+        if isinstance(key, tuple) and key[0] == "rate":
+            self.barrier.wait(timeout=30)
+
+
+def test_two_points_of_one_search_on_two_threads_each_get_their_own_rate_filter():
+    """Two points of a rate search (two filters) built at once on one segment, as when an idle
+    thread takes a search's point (``threads.helped_map``): each point's rows are those of its
+    own filter, also when the other thread stores its filter as the segment's latest between
+    this thread's store and its read (forced here by a barrier after each store)."""
+    from pimodel.diagnosis.effects import _combo_features, fit_nominal, make_segment
+
+    rng = np.random.default_rng(46)
+    t = np.arange(4000) * 1e-3
+    v = np.cumsum(rng.normal(0.0, 0.05, t.size))
+    radii = np.linspace(0.0, 0.8, 8)
+    seg = make_segment(t, v, np.zeros_like(v), radii)
+    nominal = fit_nominal([seg])
+    seg.rate_basis = RateBasis(None, radii, v, 1e-3, 1.0, np.ones(8), at_rest=True)
+    points = [{"rate_family": "radius", "rate_tau": tau, "rate_saturation": None}
+              for tau in (3e-3, 30e-3)]
+    want = [_combo_features(("rate",), p, nominal, {}).parts(seg)[1] for p in points]
+    assert not np.array_equal(want[0], want[1])  # two filters, two sets of columns
+    static = _StoresMeet(threading.Barrier(2))
+    with Pool(2) as pool:
+        got = pool.map(lambda p: _combo_features(("rate",), p, nominal, static).parts(seg)[1],
+                       points)
+    for g, w in zip(got, want, strict=True):
+        assert np.array_equal(g, w)
