@@ -387,7 +387,9 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     if shared:
         warnings.warn(f"validate: {shared} also in train; nothing is held out, so the validate "
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
-    with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool:
+    # the pool lent to this thread too: its passes over long records read their next chunk of
+    # play outputs on an idle thread (module threads)
+    with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
         return _diagnose(train, validate, max_effects, initial_state,
                          progress or (lambda message: None), pool)
 

@@ -52,7 +52,7 @@ from .rate import (
     SCALED,
 )
 from .streamed import combo_chunks, is_streamed, n_plays, play_row_chunks, stacked_times
-from .threads import helped_map
+from .threads import helped_map, read_ahead
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
 __all__ = [
@@ -239,6 +239,8 @@ def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
 def play_chunks(v, radii, *, at_rest: bool = True) -> Iterator[tuple[slice, np.ndarray]]:
     """The play outputs of ``radii`` chunk by chunk (:func:`~.chunked.chunks`), their states
     carried over from one chunk to the next, so a pass over a record holds one chunk of them.
+    Within :func:`.threads.lend`, the next chunk is made on an idle thread of the lent pool
+    while the caller works on this one (:func:`.threads.read_ahead`; the same chunks).
 
     Parameters
     ----------
@@ -263,12 +265,16 @@ def play_chunks(v, radii, *, at_rest: bool = True) -> Iterator[tuple[slice, np.n
     radii = np.asarray(radii, float)
     v = np.asarray(v, float)
     op = PIOperator(np.ones(radii.size), radii, initial_state=float(v[0]) if at_rest else 0.0)
-    state = None
-    for c in chunks(v.size):
-        Zc = op.play_outputs(v[c], state=state)
-        rows = np.empty((radii.size + 1, Zc.shape[0]))
-        rows[:-1], rows[-1], state = Zc.T, 1.0, Zc[-1]
-        yield c, rows
+
+    def each():
+        state = None
+        for c in chunks(v.size):
+            Zc = op.play_outputs(v[c], state=state)
+            rows = np.empty((radii.size + 1, Zc.shape[0]))
+            rows[:-1], rows[-1], state = Zc.T, 1.0, Zc[-1]
+            yield c, rows
+
+    return read_ahead(each())  # the next chunk on an idle thread of a lent pool (module threads)
 
 
 def segment_of_rows(t, v, y, rows: np.ndarray, mask=None) -> Segment:

@@ -18,7 +18,8 @@ from contextlib import contextmanager
 
 from ..cores import available_cores
 
-__all__ = ["Pool", "OnceCache", "per_thread", "default_workers", "lend", "helped_map"]
+__all__ = ["Pool", "OnceCache", "per_thread", "default_workers", "lend", "helped_map",
+           "read_ahead"]
 
 MAX_DEFAULT_WORKERS = 2  # the default pool: the cores, at most this many
 
@@ -123,8 +124,9 @@ _LENT = threading.local()  # the pool lent to this thread's calls (lend)
 
 @contextmanager
 def lend(pool: Pool) -> Iterator[None]:
-    """Within the block, :func:`helped_map` on this thread may hand items to ``pool``'s idle
-    threads (the pool of the diagnosis that makes this call; restored on exit).
+    """Within the block, :func:`helped_map` and :func:`read_ahead` on this thread may hand
+    work to ``pool``'s idle threads (the pool of the diagnosis that makes this call; restored
+    on exit).
 
     Examples
     --------
@@ -185,6 +187,58 @@ def helped_map(fn: Callable, items: Iterable) -> list:
             if not h.cancel():
                 h.result()  # running: it ends with the item it holds
     return results
+
+
+def read_ahead(items: Iterable) -> Iterator:
+    """The items of ``items`` in order, each next item made on an idle thread of the pool lent
+    to this thread (:func:`lend`) while the caller works on the one before: a pass over a long
+    record whose chunks of play outputs (the C core) are made beside the caller's sums over the
+    chunk before.
+
+    The item ahead is a call queued on the pool; when the caller wants it and no thread has
+    started it, the caller cancels it and makes the item itself, so it never waits for a call
+    that has not started (no deadlock with :class:`OnceCache`), and ``items`` is never advanced
+    by two threads at once. Without a lent pool, or with one worker, the plain iteration. The
+    pool is the one lent when this is called. ``items`` must give the same items on any thread.
+
+    Examples
+    --------
+    >>> with Pool(2) as pool, lend(pool):
+    ...     list(read_ahead(x * x for x in range(4)))
+    [0, 1, 4, 9]
+    """
+    pool = getattr(_LENT, "pool", None)
+    executor = None if pool is None else pool._executor
+    it = iter(items)
+    if executor is None:
+        return it
+    return _ahead(it, executor)
+
+
+def _ahead(it: Iterator, executor: ThreadPoolExecutor) -> Iterator:
+    done = object()
+
+    def next_item():
+        return next(it, done)
+
+    def submit() -> Future | None:
+        try:
+            return executor.submit(next_item)
+        except RuntimeError:  # the pool is closing: this thread alone
+            return None
+
+    ahead = submit()
+    try:
+        while True:
+            item = next_item() if ahead is None or ahead.cancel() else ahead.result()
+            ahead = None
+            if item is done:
+                return
+            ahead = submit()
+            yield item
+    finally:
+        if ahead is not None and not ahead.cancel():
+            ahead.exception()  # running: wait for it to end before the items are dropped
 
 
 class OnceCache:
