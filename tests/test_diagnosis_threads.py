@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ import pytest
 
 from pimodel.diagnosis import diagnose
 from pimodel.diagnosis.rate import RateBasis
-from pimodel.diagnosis.threads import OnceCache, Pool, helped_map, lend
+from pimodel.diagnosis.threads import OnceCache, Pool, helped_map, lend, read_ahead
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_diagnosis import records  # noqa: E402 (train and validate records, one each)
@@ -141,6 +142,81 @@ def test_helped_map_never_waits_for_a_helper_that_has_not_started():
         inside.wait(10.0)
         second = pool.submit(lambda: started.set() or cache.get("k", lambda: None))
         assert first.result(timeout=30) == second.result(timeout=30) == list(range(1, 11))
+
+
+def _chunks(names: list, n: int = 30):
+    """A pass's chunks (module effects: play_chunks), noting the thread that made each."""
+    for j in range(n):
+        names.append(threading.current_thread().name)
+        time.sleep(0.002)  # the C core's plays (the GIL released)
+        yield j, np.full(3, float(j))
+
+
+def test_read_ahead_gives_the_items_in_order_and_makes_the_next_on_an_idle_thread():
+    """The items as the plain iteration gives them, each made once; with a lent pool whose
+    other thread is idle that thread makes some while the caller works on the one before;
+    without a lent pool, or with one worker, the caller makes them all."""
+    want = [(j, [float(j)] * 3) for j in range(30)]
+    names: list = []
+    assert [(j, x.tolist()) for j, x in read_ahead(_chunks(names))] == want
+    assert set(names) == {threading.current_thread().name}
+
+    def consume():
+        caller.append(threading.current_thread().name)
+        with lend(pool):
+            out = []
+            for j, x in read_ahead(_chunks(names)):
+                time.sleep(0.01)  # the caller's sums over the chunk (BLAS: the GIL released)
+                out.append((j, x.tolist()))
+            return out
+
+    caller: list = []
+    with Pool(2) as pool:
+        names.clear()
+        assert pool.submit(consume).result(timeout=60) == want
+    assert len(names) == 30  # each item made once
+    assert any(name != caller[0] for name in names)  # the idle thread made some
+    with Pool(1) as pool, lend(pool):
+        names.clear()
+        assert [(j, x.tolist()) for j, x in read_ahead(_chunks(names))] == want
+        assert set(names) == {threading.current_thread().name}
+
+
+def test_read_ahead_never_waits_for_a_read_that_has_not_started():
+    """Every thread of the lent pool blocked until the caller's pass has ended (fits waiting in
+    ``OnceCache`` for the one reading): the caller makes every item itself, no deadlock; a
+    pass left early waits for the read under way, and an error in the items reaches it."""
+    release = threading.Event()
+    with Pool(2) as pool:
+        blocked = [pool.submit(release.wait, 30.0) for _ in range(2)]
+        names: list = []
+        got: list = []
+
+        def one_pass():
+            with lend(pool):
+                got.extend(j for j, _ in read_ahead(_chunks(names, 10)))
+
+        reader = threading.Thread(target=one_pass, daemon=True)
+        reader.start()
+        reader.join(30.0)  # a read-ahead waiting for a queued read would never end
+        finished = not reader.is_alive()
+        release.set()
+        assert finished and got == list(range(10))
+        assert set(names) == {reader.name}
+        assert all(b.result(timeout=30) for b in blocked)
+
+    def failing():
+        yield 1
+        raise RuntimeError("chunk 2")
+
+    with Pool(2) as pool, lend(pool):
+        for j, _ in read_ahead(_chunks([], 10)):
+            if j == 2:
+                break
+        it = read_ahead(failing())
+        assert next(it) == 1
+        with pytest.raises(RuntimeError, match="chunk 2"):
+            next(it)
 
 
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
