@@ -161,18 +161,22 @@ def helped_map(fn: Callable, items: Iterable) -> list:
     results: list = [None] * len(items)
     lock = threading.Lock()
     state = {"next": 0, "stop": False}
+    # what the helpers reach, dropped once the map is done: a cancelled helper stays queued
+    # on the pool until a thread takes it, and would keep the results alive until then
+    job = {"fn": fn, "items": items, "results": results}
+    n = len(items)
 
     def take() -> int | None:
         with lock:
             i = state["next"]
-            if state["stop"] or i >= len(items):
+            if state["stop"] or i >= n:
                 return None
             state["next"] = i + 1
             return i
 
     def work() -> None:
         while (i := take()) is not None:
-            results[i] = fn(items[i])
+            job["results"][i] = job["fn"](job["items"][i])
 
     try:
         helpers = [executor.submit(work) for _ in range(pool.workers - 1)]
@@ -183,9 +187,12 @@ def helped_map(fn: Callable, items: Iterable) -> list:
     finally:
         with lock:
             state["stop"] = True
-        for h in helpers:
-            if not h.cancel():
-                h.result()  # running: it ends with the item it holds
+        try:
+            for h in helpers:
+                if not h.cancel():
+                    h.result()  # running: it ends with the item it holds
+        finally:
+            job.clear()
     return results
 
 
@@ -217,9 +224,12 @@ def read_ahead(items: Iterable) -> Iterator:
 
 def _ahead(it: Iterator, executor: ThreadPoolExecutor) -> Iterator:
     done = object()
+    # the items reached through a cell emptied at the end: a cancelled read stays queued on
+    # the pool until a thread takes it, and would keep the iterator (its last item) alive
+    cell = [it]
 
     def next_item():
-        return next(it, done)
+        return next(cell[0], done)
 
     def submit() -> Future | None:
         try:
@@ -239,6 +249,7 @@ def _ahead(it: Iterator, executor: ThreadPoolExecutor) -> Iterator:
     finally:
         if ahead is not None and not ahead.cancel():
             ahead.exception()  # running: wait for it to end before the items are dropped
+        cell.clear()
 
 
 class OnceCache:
