@@ -12,7 +12,7 @@ from __future__ import annotations
 import copy
 import threading
 import weakref
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -405,34 +405,48 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     them (:func:`_row_parts`): no copy of the play columns at each point of a search. A
     streamed segment (a long record in the whole-record refit, module streamed) gives its
     blocks chunk by chunk (``features.parts_chunks``), built once per pass: the same values
-    as the slices of its whole blocks, so the same sums."""
+    as the slices of its whole blocks, so the same sums. With a pool lent to the caller
+    (module threads), idle threads make some chunks' terms of whole blocks; every sum is
+    still taken in the chunks' order (:func:`_per_chunk`)."""
     blocks = [None if is_streamed(s) else _row_parts(features, s) for s in train]
     ne = None
     for P, s in zip(blocks, train, strict=True):
         first = None if P is None else _first_grams(P[0], s)
-        for j, (c, Pc) in enumerate(_chunk_parts(features, P, s)):
-            Pc, y = _used_chunk(Pc, s, c)
+        for G, Xy, m in _per_chunk(features, P, s, lambda j, c, Pc, s=s, first=first:
+                                   _normal_terms(Pc, s, c, None if first is None else first[j])):
             if ne is None:
-                ne = NormalEquations(sum(X.shape[0] for X in Pc))
-            ne.add_gram(_gram(Pc, None if first is None else first[j]),
-                        np.concatenate([X @ y for X in Pc]), y.size)
+                ne = NormalEquations(G.shape[0])
+            ne.add_gram(G, Xy, m)
     coef = ne.solve()
     rss = 0.0
     for P, s in zip(blocks, train, strict=True):
-        for c, Pc in _chunk_parts(features, P, s):
-            Pc, y = _used_chunk(Pc, s, c)
-            rss += float(np.sum((_combine(Pc, coef) - y) ** 2))
+        for r in _per_chunk(features, P, s, lambda j, c, Pc, s=s: _chunk_rss(Pc, s, c, coef)):
+            rss += r  # summed in the chunks' order, whichever thread made each
     return Model(name, k, features, coef, params or {}), rss
 
 
-def _chunk_parts(features, P: tuple | None, s: Segment) -> Iterator[tuple[slice, tuple]]:
-    """``(c, blocks on c)`` for each chunk ``c`` of ``s``: slices of the whole blocks ``P``,
-    or (``P`` None: a streamed segment) ``features.parts_chunks(s)``."""
+def _per_chunk(features, P: tuple | None, s: Segment, fn: Callable) -> Iterable:
+    """``fn(j, c, Pc)`` for each chunk ``c`` (the ``j``-th) of ``s`` with the blocks ``Pc`` on
+    it, in the chunks' order: for whole blocks ``P`` the chunks are independent and idle
+    threads of a lent pool may make some (:func:`.threads.helped_map`: each chunk's value the
+    same on any thread); a streamed segment's (``P`` None) are made in turn as its blocks
+    are built."""
     if P is None:
-        yield from features.parts_chunks(s)
-        return
-    for c in chunks(s.y.size):
-        yield c, tuple(X[:, c] for X in P)
+        return (fn(j, c, Pc) for j, (c, Pc) in enumerate(features.parts_chunks(s)))
+    return helped_map(lambda jc: fn(*jc, tuple(X[:, jc[1]] for X in P)),
+                      list(enumerate(chunks(s.y.size))))
+
+
+def _normal_terms(Pc: tuple, s: Segment, c: slice, first: np.ndarray | None):
+    """The Gram matrix, ``X y`` and the sample count of the fitted samples of chunk ``c``."""
+    Pc, y = _used_chunk(Pc, s, c)
+    return _gram(Pc, first), np.concatenate([X @ y for X in Pc]), y.size
+
+
+def _chunk_rss(Pc: tuple, s: Segment, c: slice, coef: np.ndarray) -> float:
+    """The residual sum of squares of the fitted samples of chunk ``c``."""
+    Pc, y = _used_chunk(Pc, s, c)
+    return float(np.sum((_combine(Pc, coef) - y) ** 2))
 
 
 def _used_chunk(Pc: tuple, s: Segment, c: slice) -> tuple[tuple, np.ndarray]:
@@ -468,9 +482,13 @@ def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
     kept = s.__dict__.setdefault("_first_grams", {})  # per thread (module threads)
     memo = kept.get(threading.get_ident())
     if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
-        grams = [X @ X.T for X in (_used_chunk((Z[:, c],), s, c)[0][0] for c in cuts)]
+        grams = helped_map(lambda c: _square(_used_chunk((Z[:, c],), s, c)[0][0]), cuts)
         memo = kept[threading.get_ident()] = (key, Z, grams)
     return memo[2]
+
+
+def _square(X: np.ndarray) -> np.ndarray:
+    return X @ X.T
 
 
 def _gram(P: tuple, first: np.ndarray | None = None) -> np.ndarray:
