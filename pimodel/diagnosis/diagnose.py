@@ -931,7 +931,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         progress("the chosen model on the whole records")
         for s in segs:  # the screen's kept play-row Grams (and rows) are done with
             s.forget_grams()
-        pool.close()  # the refit is one thread's: the others end, with what they held
+        # the pool's threads end, with what they held per thread; fresh ones read the refit's
+        # next chunks and make some of its chunk terms (module threads)
+        pool.renew()
         tr, va, out_va = whole
         if chosen:
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,

@@ -389,7 +389,7 @@ class Model:
         """
         if is_streamed(seg):  # a long record's rows a chunk at a time (module streamed)
             out = np.empty(seg.y.size)
-            for c, P in self.features.parts_chunks(seg):
+            for c, P in read_ahead(self.features.parts_chunks(seg)):  # (module threads)
                 out[c] = _combine(P, self.coef)
         else:
             out = _combine(_row_parts(self.features, seg), self.coef)
@@ -430,9 +430,10 @@ def _per_chunk(features, P: tuple | None, s: Segment, fn: Callable) -> Iterable:
     it, in the chunks' order: for whole blocks ``P`` the chunks are independent and idle
     threads of a lent pool may make some (:func:`.threads.helped_map`: each chunk's value the
     same on any thread); a streamed segment's (``P`` None) are made in turn as its blocks
-    are built."""
+    are built, the next chunk's blocks built on an idle thread meanwhile
+    (:func:`.threads.read_ahead`)."""
     if P is None:
-        return (fn(j, c, Pc) for j, (c, Pc) in enumerate(features.parts_chunks(s)))
+        return (fn(j, c, Pc) for j, (c, Pc) in enumerate(read_ahead(features.parts_chunks(s))))
     return helped_map(lambda jc: fn(*jc, tuple(X[:, jc[1]] for X in P)),
                       list(enumerate(chunks(s.y.size))))
 

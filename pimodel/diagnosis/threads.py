@@ -90,8 +90,7 @@ class Pool:
 
     def __init__(self, workers: int):
         self.workers = int(workers)
-        self._executor = ThreadPoolExecutor(self.workers, thread_name_prefix="pimodel-diagnose") \
-            if self.workers > 1 else None
+        self._executor = self._threads()
 
     def map(self, fn: Callable, items: Iterable) -> list:
         """``[fn(x) for x in items]``, the calls spread over the threads, results in order."""
@@ -111,6 +110,23 @@ class Pool:
         """Wait for the calls under way and end the threads."""
         if self._executor is not None:
             self._executor.shutdown(wait=True, cancel_futures=True)
+
+    def renew(self) -> None:
+        """End the threads, and with them what they memoised per thread (:func:`per_thread`),
+        then start fresh ones.
+
+        Examples
+        --------
+        >>> with Pool(2) as pool:
+        ...     pool.renew(); pool.map(abs, [-1, 2])
+        [1, 2]
+        """
+        self.close()
+        self._executor = self._threads()
+
+    def _threads(self) -> ThreadPoolExecutor | None:
+        return ThreadPoolExecutor(self.workers, thread_name_prefix="pimodel-diagnose") \
+            if self.workers > 1 else None
 
     def __enter__(self) -> Pool:
         return self
