@@ -13,7 +13,13 @@ import pytest
 from numpy.polynomial.legendre import legvander
 from scipy.signal import lfilter
 
-from pimodel.diagnosis.chunked import ChunkedQR, NormalEquations, chunks
+from pimodel.diagnosis.chunked import (
+    TRANSPOSE_BLOCK,
+    ChunkedQR,
+    NormalEquations,
+    chunks,
+    transposed,
+)
 from pimodel.diagnosis.effects import fit_nominal, make_segment
 from pimodel.operators.pi import PIOperator
 from pimodel.stages.pi_stage import excitation, random_truth
@@ -356,3 +362,14 @@ def test_fits_that_hold_the_play_rows_reuse_their_gram_and_new_rows_do_not():
     m3, _ = _fit("a", 0, features(Z3), [seg])
     assert np.max(np.abs(m3.coef - reference(Z3))) < 1e-8 * np.max(np.abs(reference(Z3)))
     assert np.max(np.abs(m3.coef - m1.coef)) > 1e-3
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (3, 5), (TRANSPOSE_BLOCK, 2),
+                                   (3 * TRANSPOSE_BLOCK + 7, 33)])
+def test_transposed_is_the_contiguous_transpose(shape):
+    """The blocked copy of the rate's and the Wiener basis' columns to rows: the values of
+    ``np.ascontiguousarray(M.T)``, C-contiguous, from a C- or a column-major ``M``."""
+    M = np.random.default_rng(3).normal(size=shape)
+    for src in (M, np.asfortranarray(M), M[::1, :]):
+        out = transposed(src)
+        assert out.flags.c_contiguous and np.array_equal(out, np.ascontiguousarray(src.T))

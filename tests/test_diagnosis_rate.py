@@ -142,3 +142,40 @@ def test_inverse_of_an_instantaneous_rate_beats_ignoring_it():
     assert rms(v_ff - v) < 0.5 * rms(v0 - v)
     miss = m.simulate(v_ff, input_range=span) - y
     assert rms(miss) < 0.5 * rms(y - rate_free.simulate(v))
+
+
+def test_a_screens_contacts_and_band_sums_are_found_once_for_every_fit(monkeypatch):
+    """The last contacts and band sums of a screen's basis do not depend on the filter: a
+    fit's ``release()`` keeps them for the next fit and other threads (found once, the
+    columns the same to the bit), ``forget()`` drops them; a long record's are not kept."""
+    import threading
+
+    from pimodel.diagnosis import rate
+
+    v = np.sin(np.linspace(0.0, 20.0, 3000)) + 0.1 * np.sin(np.linspace(0.0, 300.0, 3000))
+    radii = np.linspace(0.0, 0.8, 8)
+    calls = []
+    found = RateBasis._contact_chunks
+    monkeypatch.setattr(RateBasis, "_contact_chunks",
+                        lambda self: calls.append(1) or found(self))
+    basis = RateBasis(None, radii, v, 1e-3, 1.0, np.ones(8), at_rest=True)
+    first = {(tau, fam): basis.columns(tau, fam).copy() for tau in (1e-3, 3e-2)
+             for fam in ("radius", "weight")}
+    basis.release()
+    other = []
+    t = threading.Thread(target=lambda: other.append(basis.columns(1e-3, "radius").copy()))
+    t.start()
+    t.join()
+    again = {(tau, fam): basis.columns(tau, fam).copy() for tau in (1e-3, 3e-2)
+             for fam in ("radius", "weight")}
+    assert len(calls) == 1 and np.array_equal(other[0], first[1e-3, "radius"])
+    assert all(np.array_equal(first[k], again[k]) for k in first)
+    basis.forget()
+    assert np.array_equal(basis.columns(3e-2, "radius"), first[3e-2, "radius"])
+    assert len(calls) == 2
+    monkeypatch.setattr(rate, "CONTACT_BYTES", 1000)  # a long record: found at each call
+    long = RateBasis(None, radii, v, 1e-3, 1.0, np.ones(8), at_rest=True)
+    long.columns(1e-3, "radius")
+    long.release()
+    long.columns(1e-3, "radius")
+    assert len(calls) == 4 and long._shared == {}

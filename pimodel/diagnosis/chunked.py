@@ -22,7 +22,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
-__all__ = ["CHUNK", "ChunkedQR", "NormalEquations", "chunks", "combine", "stack_rows"]
+__all__ = ["CHUNK", "ChunkedQR", "NormalEquations", "chunks", "combine", "stack_rows",
+           "transposed"]
 
 CHUNK = 1 << 14  # samples per chunk (16,384: an 80-column chunk of rows is 10 MB)
 
@@ -224,6 +225,26 @@ def stack_rows(parts) -> np.ndarray:
     for X in parts:
         out[i:i + X.shape[0]] = X
         i += X.shape[0]
+    return out
+
+
+TRANSPOSE_BLOCK = 512  # samples per block of transposed (a block of 80 columns: 320 kB)
+
+
+def transposed(M: np.ndarray) -> np.ndarray:
+    """``M.T`` as a new C-contiguous array, copied a block of ``TRANSPOSE_BLOCK`` rows of ``M``
+    at a time (the same values as ``np.ascontiguousarray(M.T)``: a copy, no arithmetic; each
+    block stays in the cache, where one strided copy of a screen's columns to rows did not:
+    about 1.7x faster on 65,536 x 33).
+
+    Examples
+    --------
+    >>> transposed(np.arange(6.0).reshape(3, 2)).tolist()
+    [[0.0, 2.0, 4.0], [1.0, 3.0, 5.0]]
+    """
+    out = np.empty(M.shape[::-1], dtype=M.dtype)
+    for i in range(0, M.shape[0], TRANSPOSE_BLOCK):
+        out[:, i:i + TRANSPOSE_BLOCK] = M[i:i + TRANSPOSE_BLOCK].T
     return out
 
 

@@ -81,7 +81,7 @@ from .misfit import rate_correction
 from .noise import measure_noise_floor
 from .rate import RATE_KEYS, RateBasis, rate_shapes
 from .streamed import attach_plays, streamable
-from .threads import OnceCache, Pool, default_workers
+from .threads import OnceCache, Pool, default_workers, lend
 from .where import residual_breakdown, startup_length
 from .wiener import WienerBasis, position_hint
 
@@ -387,7 +387,9 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     if shared:
         warnings.warn(f"validate: {shared} also in train; nothing is held out, so the validate "
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
-    with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool:
+    # the pool lent to this thread too: its passes over long records read their next chunk of
+    # play outputs on an idle thread (module threads)
+    with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
         return _diagnose(train, validate, max_effects, initial_state,
                          progress or (lambda message: None), pool)
 
@@ -786,7 +788,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return best[1], best[2]
 
     def fit_one(name, combo, fx):
-        m = fit_effect(name, tr, combo, fx, nominal)
+        with lend(pool):  # a search's points may go to the pool's idle threads
+            m = fit_effect(name, tr, combo, fx, nominal)
         out = (m, [m.predict(s) for s in va])
         m.params.update(level_report(m, va, tr))
         _release(m, segs)  # (the bases' memos of this thread: module threads)
@@ -920,17 +923,25 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if path[0] and score < best[0] - MIN_BIC_DROP:
                 best = (score, path)
         chosen, fixed, current, cur_out = best[1]
+    for s in segs:  # the choice is made: the rate bases' band sums and last contacts, kept
+        if s.rate_basis is not None:  # for every fit of it, are done with
+            s.rate_basis.forget()
     screen = None
     if screened:  # the choice, refitted on the whole records; the verdict's figures whole
         progress("the chosen model on the whole records")
         for s in segs:  # the screen's kept play-row Grams (and rows) are done with
             s.forget_grams()
-        pool.close()  # the refit is one thread's: the others end, with what they held
+        # the pool's threads end, with what they held per thread; fresh ones read the refit's
+        # next chunks and make some of its chunk terms (module threads)
+        pool.renew()
         tr, va, out_va = whole
         if chosen:
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
                                           lambda s: _with_rows(s, radii, proj, at_rest),
                                           lambda s: _streamed(s, radii, proj, at_rest))
+            for s in tr + va:  # what a rate refit kept of a whole record (its contacts)
+                if s.rate_basis is not None:
+                    s.rate_basis.forget()
         else:
             current, cur_out = nominal, out_va
         screen = {"samples": SCREEN_SAMPLES,

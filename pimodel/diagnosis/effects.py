@@ -12,14 +12,14 @@ from __future__ import annotations
 import copy
 import threading
 import weakref
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..operators.pi import PIOperator
-from .chunked import NormalEquations, chunks
+from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
 from .creep import creep_time_constants
@@ -52,6 +52,7 @@ from .rate import (
     SCALED,
 )
 from .streamed import combo_chunks, is_streamed, n_plays, play_row_chunks, stacked_times
+from .threads import helped_map, read_ahead
 from .wiener import describe_wiener, polish_filter, search_filter, wiener_k
 
 __all__ = [
@@ -238,6 +239,8 @@ def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
 def play_chunks(v, radii, *, at_rest: bool = True) -> Iterator[tuple[slice, np.ndarray]]:
     """The play outputs of ``radii`` chunk by chunk (:func:`~.chunked.chunks`), their states
     carried over from one chunk to the next, so a pass over a record holds one chunk of them.
+    Within :func:`.threads.lend`, the next chunk is made on an idle thread of the lent pool
+    while the caller works on this one (:func:`.threads.read_ahead`; the same chunks).
 
     Parameters
     ----------
@@ -262,12 +265,16 @@ def play_chunks(v, radii, *, at_rest: bool = True) -> Iterator[tuple[slice, np.n
     radii = np.asarray(radii, float)
     v = np.asarray(v, float)
     op = PIOperator(np.ones(radii.size), radii, initial_state=float(v[0]) if at_rest else 0.0)
-    state = None
-    for c in chunks(v.size):
-        Zc = op.play_outputs(v[c], state=state)
-        rows = np.empty((radii.size + 1, Zc.shape[0]))
-        rows[:-1], rows[-1], state = Zc.T, 1.0, Zc[-1]
-        yield c, rows
+
+    def each():
+        state = None
+        for c in chunks(v.size):
+            Zc = op.play_outputs(v[c], state=state)
+            rows = np.empty((radii.size + 1, Zc.shape[0]))
+            rows[:-1], rows[-1], state = Zc.T, 1.0, Zc[-1]
+            yield c, rows
+
+    return read_ahead(each())  # the next chunk on an idle thread of a lent pool (module threads)
 
 
 def segment_of_rows(t, v, y, rows: np.ndarray, mask=None) -> Segment:
@@ -382,7 +389,7 @@ class Model:
         """
         if is_streamed(seg):  # a long record's rows a chunk at a time (module streamed)
             out = np.empty(seg.y.size)
-            for c, P in self.features.parts_chunks(seg):
+            for c, P in read_ahead(self.features.parts_chunks(seg)):  # (module threads)
                 out[c] = _combine(P, self.coef)
         else:
             out = _combine(_row_parts(self.features, seg), self.coef)
@@ -398,34 +405,49 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     them (:func:`_row_parts`): no copy of the play columns at each point of a search. A
     streamed segment (a long record in the whole-record refit, module streamed) gives its
     blocks chunk by chunk (``features.parts_chunks``), built once per pass: the same values
-    as the slices of its whole blocks, so the same sums."""
+    as the slices of its whole blocks, so the same sums. With a pool lent to the caller
+    (module threads), idle threads make some chunks' terms of whole blocks; every sum is
+    still taken in the chunks' order (:func:`_per_chunk`)."""
     blocks = [None if is_streamed(s) else _row_parts(features, s) for s in train]
     ne = None
     for P, s in zip(blocks, train, strict=True):
         first = None if P is None else _first_grams(P[0], s)
-        for j, (c, Pc) in enumerate(_chunk_parts(features, P, s)):
-            Pc, y = _used_chunk(Pc, s, c)
+        for G, Xy, m in _per_chunk(features, P, s, lambda j, c, Pc, s=s, first=first:
+                                   _normal_terms(Pc, s, c, None if first is None else first[j])):
             if ne is None:
-                ne = NormalEquations(sum(X.shape[0] for X in Pc))
-            ne.add_gram(_gram(Pc, None if first is None else first[j]),
-                        np.concatenate([X @ y for X in Pc]), y.size)
+                ne = NormalEquations(G.shape[0])
+            ne.add_gram(G, Xy, m)
     coef = ne.solve()
     rss = 0.0
     for P, s in zip(blocks, train, strict=True):
-        for c, Pc in _chunk_parts(features, P, s):
-            Pc, y = _used_chunk(Pc, s, c)
-            rss += float(np.sum((_combine(Pc, coef) - y) ** 2))
+        for r in _per_chunk(features, P, s, lambda j, c, Pc, s=s: _chunk_rss(Pc, s, c, coef)):
+            rss += r  # summed in the chunks' order, whichever thread made each
     return Model(name, k, features, coef, params or {}), rss
 
 
-def _chunk_parts(features, P: tuple | None, s: Segment) -> Iterator[tuple[slice, tuple]]:
-    """``(c, blocks on c)`` for each chunk ``c`` of ``s``: slices of the whole blocks ``P``,
-    or (``P`` None: a streamed segment) ``features.parts_chunks(s)``."""
+def _per_chunk(features, P: tuple | None, s: Segment, fn: Callable) -> Iterable:
+    """``fn(j, c, Pc)`` for each chunk ``c`` (the ``j``-th) of ``s`` with the blocks ``Pc`` on
+    it, in the chunks' order: for whole blocks ``P`` the chunks are independent and idle
+    threads of a lent pool may make some (:func:`.threads.helped_map`: each chunk's value the
+    same on any thread); a streamed segment's (``P`` None) are made in turn as its blocks
+    are built, the next chunk's blocks built on an idle thread meanwhile
+    (:func:`.threads.read_ahead`)."""
     if P is None:
-        yield from features.parts_chunks(s)
-        return
-    for c in chunks(s.y.size):
-        yield c, tuple(X[:, c] for X in P)
+        return (fn(j, c, Pc) for j, (c, Pc) in enumerate(read_ahead(features.parts_chunks(s))))
+    return helped_map(lambda jc: fn(*jc, tuple(X[:, jc[1]] for X in P)),
+                      list(enumerate(chunks(s.y.size))))
+
+
+def _normal_terms(Pc: tuple, s: Segment, c: slice, first: np.ndarray | None):
+    """The Gram matrix, ``X y`` and the sample count of the fitted samples of chunk ``c``."""
+    Pc, y = _used_chunk(Pc, s, c)
+    return _gram(Pc, first), np.concatenate([X @ y for X in Pc]), y.size
+
+
+def _chunk_rss(Pc: tuple, s: Segment, c: slice, coef: np.ndarray) -> float:
+    """The residual sum of squares of the fitted samples of chunk ``c``."""
+    Pc, y = _used_chunk(Pc, s, c)
+    return float(np.sum((_combine(Pc, coef) - y) ** 2))
 
 
 def _used_chunk(Pc: tuple, s: Segment, c: slice) -> tuple[tuple, np.ndarray]:
@@ -461,9 +483,13 @@ def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
     kept = s.__dict__.setdefault("_first_grams", {})  # per thread (module threads)
     memo = kept.get(threading.get_ident())
     if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
-        grams = [X @ X.T for X in (_used_chunk((Z[:, c],), s, c)[0][0] for c in cuts)]
+        grams = helped_map(lambda c: _square(_used_chunk((Z[:, c],), s, c)[0][0]), cuts)
         memo = kept[threading.get_ident()] = (key, Z, grams)
     return memo[2]
+
+
+def _square(X: np.ndarray) -> np.ndarray:
+    return X @ X.T
 
 
 def _gram(P: tuple, first: np.ndarray | None = None) -> np.ndarray:
@@ -796,9 +822,11 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     tried: list = []  # (train RSS, grid point) of the first search, for the confirmation
 
     def search(points, best=None):
-        for p in points:
-            model, rss = _fit(name, k, _combo_features(effects, p, nominal, static, ncols),
-                              train, p)
+        # the points are independent fits: idle threads of the diagnosis' pool may take some
+        # (module threads); the best is then taken in the points' order, as on one thread
+        fits = helped_map(lambda p: _fit(name, k, _combo_features(effects, p, nominal, static,
+                                                                  ncols), train, p), points)
+        for p, (model, rss) in zip(points, fits, strict=True):
             tried.append((rss, p))
             if best is None or rss < best[1]:
                 best = (model, rss)
@@ -1149,9 +1177,10 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         if "rate" in effects and not scaled:
             which = (p["rate_tau"], p["rate_family"], p.get("rate_saturation"))
             key = ("rate", id(s))
-            if static.get(key, (None,))[0] != which:  # the latest filter only, per segment
-                static[key] = (which, np.ascontiguousarray(s.rate_basis.columns(*which).T), s)
-            parts.append(static[key][1])
+            kept = static.get(key)  # the latest filter only, per segment; read once: two
+            if kept is None or kept[0] != which:  # points of a search may run on two threads
+                kept = static[key] = (which, transposed(s.rate_basis.columns(*which)), s)
+            parts.append(kept[1])
         if "drift" in effects:  # the trend column last
             parts.append(drift_columns(s.t, p, static["train"].index(s),
                                        len(static["train"])).T)
@@ -1177,6 +1206,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     return feats
 
 
+_LTI_LOCK = threading.Lock()  # the element columns' memo of _lti_block
+
+
 def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     """The columns ``(E_j - M_1)[h0]`` of the elements ``p["lti"]`` (delayed by ``p["d"]`` when
     the delay is fitted too); ``h0`` is memoised per segment in ``static``."""
@@ -1196,12 +1228,15 @@ def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     cols = np.empty((h0.size, len(p["lti"])))
     for j, el in enumerate(p["lti"]):
         key = tuple(el)
-        col = known[1].pop(key, None)  # reinserted last: the least recently used goes first
+        with _LTI_LOCK:  # the points of one search may run on two threads (module threads)
+            col = known[1].pop(key, None)  # reinserted last: the least recently used goes first
         if col is None:
             col = lti_columns(h0, p["fn"], p["zeta"], (el,), s.dt, base=base[1])[:, 0]
-        known[1][key] = cols[:, j] = col
-        if len(known[1]) > LTI_MEMO:
-            del known[1][next(iter(known[1]))]
+        cols[:, j] = col
+        with _LTI_LOCK:
+            known[1][key] = col
+            while len(known[1]) > LTI_MEMO:
+                del known[1][next(iter(known[1]))]
     return shift(cols, p["d"]) if "d" in p else cols
 
 

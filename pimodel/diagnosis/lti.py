@@ -51,6 +51,7 @@ from scipy.signal import (
 
 from .._native import biquad_rows
 from .filters import mode_coefficients
+from .threads import helped_map
 
 __all__ = [
     "MAX_MODES",
@@ -530,19 +531,21 @@ def _best_addition(blocks: list, ys: list, column: Callable, chosen: tuple, fmax
                                                              EXTRA_MODE_HZ[1])
                 for z in EXTRA_DAMPING if _admissible(("mode", f, z), fmax, damping_range,
                                                       modes)]
-        if grid:
-            rss = proj.rss_with_each([column(e) for e in grid])
+        if grid:  # the columns on idle threads too (module threads; the same columns)
+            rss = proj.rss_with_each(helped_map(column, grid))
             options.append((grid[int(np.argmin(rss))], float(np.min(rss))))
     if ("lowpass" in SELECTED and not any(_kind(e) == "lowpass" for e in chosen) and
             LOWPASS_MIN_HZ < fmax):
         grid = [("lowpass", float(1 / (2 * np.pi * f)))
                 for f in np.geomspace(LOWPASS_MIN_HZ, fmax, LOWPASS_GRID)]
-        options.append(min(((e, rss_of(e)) for e in grid), key=lambda o: o[1]))
+        options.append(min(zip(grid, helped_map(rss_of, grid), strict=True),
+                           key=lambda o: o[1]))
     if "direct" in SELECTED and not any(_kind(e) == "direct" for e in chosen):
         options.append((("direct",), rss_of(("direct",))))
     if not options:
         return None
-    options = [_refine(rss_of, e, fmax, damping_range, modes) for e, _ in options]
+    # each kind's refinement is its own (the projection is only read): one per thread
+    options = helped_map(lambda o: _refine(rss_of, o[0], fmax, damping_range, modes), options)
     return min(options, key=lambda o: n * np.log(max(o[1], 1e-300)) + lti_k([o[0]]) * np.log(n))
 
 

@@ -70,7 +70,7 @@ from scipy.signal import lfilter
 
 from .. import _native
 from ..operators.pi import PIOperator
-from .chunked import chunks
+from .chunked import chunks, transposed
 from .threads import drop_threads, per_thread
 
 RATE_TAUS = (0.0, 1e-3, 3e-3, 10e-3, 30e-3)  # s: low-pass of the input rate, half decades
@@ -305,10 +305,21 @@ class RateBasis:
 
     _cache = per_thread("cache", dict)
     _weighted = per_thread("weighted", lambda: None)
-    _contacts = per_thread("contacts", lambda: None)
 
     def __getstate__(self) -> dict:
-        return drop_threads(self.__dict__)
+        return {k: x for k, x in drop_threads(self.__dict__).items() if k != "_kept"}
+
+    @property
+    def _shared(self) -> dict:
+        """What a screen's basis keeps for every thread and every fit (:meth:`_keeps`): the
+        band sums and the last contacts, each stored whole once built (never half-built),
+        dropped by :meth:`forget` only."""
+        return self.__dict__.setdefault("_kept", {})
+
+    def _keeps(self) -> bool:
+        """Whether the last contacts (12 B per sample and play) fit ``CONTACT_BYTES``: a
+        record's screen, not a long record."""
+        return self.v.size * self.radii.size * 12 <= CONTACT_BYTES
 
     def __init__(self, Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float,
                  weights, bands: int = RATE_BANDS, *, input_range: float | None = None,
@@ -388,8 +399,8 @@ class RateBasis:
         return self._cache[key]
 
     def release(self) -> None:
-        """Drop the memoised columns (rebuilt on the next use), keeping only what the basis
-        was built from.
+        """Drop this thread's memoised columns (rebuilt on the next use); a screen's band sums
+        and last contacts, which no filter changes, stay for the next fit (:meth:`forget`).
 
         Examples
         --------
@@ -401,17 +412,41 @@ class RateBasis:
         """
         self._cache.clear()
         self._weighted = None
-        self._contacts = None
+
+    def forget(self) -> None:
+        """:meth:`release`, and drop what the basis keeps for every fit and every thread (the
+        band sums and last contacts of a screen; the diagnosis, before the whole-record refit).
+
+        Examples
+        --------
+        >>> v = np.array([0.0, 0.01, 0.02, 0.02])
+        >>> basis = RateBasis(v[:, None], [0.0], v, 1.0, 0.01, [2.0], 1)
+        >>> a = basis.columns(1.0, "radius"); basis.release(); sorted(basis._shared)
+        ['contacts']
+        >>> basis.forget(); basis._shared
+        {}
+        """
+        self.release()
+        self.__dict__.pop("_kept", None)
+        self.__dict__.pop("_threads", None)  # every thread's memos (module threads)
 
     def _band_sums(self) -> np.ndarray:
-        """Band sums ``sum_{i in b} w0_i z_i[k]`` of the nominal plays (built on first use)."""
+        """Band sums ``sum_{i in b} w0_i z_i[k]`` of the nominal plays (built on first use;
+        a screen's kept for every fit, :meth:`_keeps`)."""
+        kept = self._shared.get("weighted")
+        if kept is not None:
+            return kept
         if self._weighted is None:
             member = np.zeros((self.radii.size, len(self.bands)))
             for b, g in enumerate(self.bands):
                 member[g, b] = self.weights[g]
-            self._weighted = np.empty((self.v.size, member.shape[1]))
+            weighted = np.empty((self.v.size, member.shape[1]))
             for c, Zc in self._play_chunks():
-                self._weighted[c] = Zc @ member
+                weighted[c] = Zc @ member
+            if self._keeps():
+                self._shared["weighted"] = weighted
+                return weighted
+            self._weighted = weighted
         return self._weighted
 
     def scaled_rows(self, tau: float, saturation: float | None, growth: float) -> np.ndarray:
@@ -440,8 +475,7 @@ class RateBasis:
             z0 = float(self.v[0]) if self.at_rest else 0.0
             Zs = scaled_plays(self.v, self.radii, self.dt, self.rate_scale, tau, saturation,
                               growth, z0)
-            rows = np.ascontiguousarray((Zs if self.projection is None else
-                                         Zs @ self.projection).T)
+            rows = transposed(Zs if self.projection is None else Zs @ self.projection)
             self._cache.clear()
             self._cache[key] = rows
         return self._cache[key]
@@ -465,14 +499,16 @@ class RateBasis:
         """Band sums of ``rho_f[last contact of play i] * (-s_i r_i)``, chunk by chunk. The
         last contacts and their signs do not depend on the filter: they are found once per
         basis (:meth:`_contact_chunks`) and kept while they take at most ``CONTACT_BYTES``
-        (a record's screen), so a search over filters costs a gather and a band sum per
-        point; longer records find them again at each call (nothing of size N x n kept)."""
+        (a record's screen), for every thread and every fit until :meth:`forget`, so a search
+        over filters costs a gather and a band sum per point; longer records find them again
+        at each call (nothing of size N x n kept)."""
         out = np.empty((self.v.size, len(self.bands)))
-        contacts = self._contacts
+        contacts = self._shared.get("contacts")
         if contacts is None:
             contacts = self._contact_chunks()
-            if self.v.size * self.radii.size * 12 <= CONTACT_BYTES:
-                contacts = self._contacts = list(contacts)
+            if self._keeps():
+                contacts = list(contacts)
+                self._shared["contacts"] = contacts
         for c, last, signed in contacts:
             per_play = np.take(rho, last)
             per_play *= signed

@@ -12,12 +12,14 @@ caller's order: the serial path, unchanged.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
+from contextlib import contextmanager
 
 from ..cores import available_cores
 
-__all__ = ["Pool", "OnceCache", "per_thread", "default_workers"]
+__all__ = ["Pool", "OnceCache", "per_thread", "default_workers", "lend", "helped_map",
+           "read_ahead"]
 
 MAX_DEFAULT_WORKERS = 2  # the default pool: the cores, at most this many
 
@@ -88,8 +90,7 @@ class Pool:
 
     def __init__(self, workers: int):
         self.workers = int(workers)
-        self._executor = ThreadPoolExecutor(self.workers, thread_name_prefix="pimodel-diagnose") \
-            if self.workers > 1 else None
+        self._executor = self._threads()
 
     def map(self, fn: Callable, items: Iterable) -> list:
         """``[fn(x) for x in items]``, the calls spread over the threads, results in order."""
@@ -110,11 +111,161 @@ class Pool:
         if self._executor is not None:
             self._executor.shutdown(wait=True, cancel_futures=True)
 
+    def renew(self) -> None:
+        """End the threads, and with them what they memoised per thread (:func:`per_thread`),
+        then start fresh ones.
+
+        Examples
+        --------
+        >>> with Pool(2) as pool:
+        ...     pool.renew(); pool.map(abs, [-1, 2])
+        [1, 2]
+        """
+        self.close()
+        self._executor = self._threads()
+
+    def _threads(self) -> ThreadPoolExecutor | None:
+        return ThreadPoolExecutor(self.workers, thread_name_prefix="pimodel-diagnose") \
+            if self.workers > 1 else None
+
     def __enter__(self) -> Pool:
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+_LENT = threading.local()  # the pool lent to this thread's calls (lend)
+
+
+@contextmanager
+def lend(pool: Pool) -> Iterator[None]:
+    """Within the block, :func:`helped_map` and :func:`read_ahead` on this thread may hand
+    work to ``pool``'s idle threads (the pool of the diagnosis that makes this call; restored
+    on exit).
+
+    Examples
+    --------
+    >>> with Pool(2) as pool, lend(pool):
+    ...     helped_map(lambda x: x + 1, [1, 2, 3])
+    [2, 3, 4]
+    """
+    before = getattr(_LENT, "pool", None)
+    _LENT.pool = pool
+    try:
+        yield
+    finally:
+        _LENT.pool = before
+
+
+def helped_map(fn: Callable, items: Iterable) -> list:
+    """``[fn(x) for x in items]``, results in order, the calling thread taking the items one by
+    one while the threads of the pool lent to it (:func:`lend`) that are idle take some too.
+
+    The caller never waits for a helper that has not started: a helper is a call queued on the
+    pool behind the batch under way, so it starts only when a thread has nothing else to do
+    (the tail of a batch, a long fit alone); once the caller has taken the last item, the
+    helpers not yet started are cancelled and it waits only for the items helpers are
+    computing. So no deadlock with :class:`OnceCache` (a thread waiting for this very call is
+    never needed to finish it), and without a lent pool, or with one worker, this is the plain
+    loop. ``fn`` must give the same result on any thread (no per-thread state in its result)."""
+    items = list(items)
+    pool = getattr(_LENT, "pool", None)
+    executor = None if pool is None else pool._executor
+    if executor is None or len(items) < 2:
+        return [fn(x) for x in items]
+    results: list = [None] * len(items)
+    lock = threading.Lock()
+    state = {"next": 0, "stop": False}
+    # what the helpers reach, dropped once the map is done: a cancelled helper stays queued
+    # on the pool until a thread takes it, and would keep the results alive until then
+    job = {"fn": fn, "items": items, "results": results}
+    n = len(items)
+
+    def take() -> int | None:
+        with lock:
+            i = state["next"]
+            if state["stop"] or i >= n:
+                return None
+            state["next"] = i + 1
+            return i
+
+    def work() -> None:
+        while (i := take()) is not None:
+            job["results"][i] = job["fn"](job["items"][i])
+
+    try:
+        helpers = [executor.submit(work) for _ in range(pool.workers - 1)]
+    except RuntimeError:  # the pool is closing: this thread alone
+        helpers = []
+    try:
+        work()
+    finally:
+        with lock:
+            state["stop"] = True
+        try:
+            for h in helpers:
+                if not h.cancel():
+                    h.result()  # running: it ends with the item it holds
+        finally:
+            job.clear()
+    return results
+
+
+def read_ahead(items: Iterable) -> Iterator:
+    """The items of ``items`` in order, each next item made on an idle thread of the pool lent
+    to this thread (:func:`lend`) while the caller works on the one before: a pass over a long
+    record whose chunks of play outputs (the C core) are made beside the caller's sums over the
+    chunk before.
+
+    The item ahead is a call queued on the pool; when the caller wants it and no thread has
+    started it, the caller cancels it and makes the item itself, so it never waits for a call
+    that has not started (no deadlock with :class:`OnceCache`), and ``items`` is never advanced
+    by two threads at once. Without a lent pool, or with one worker, the plain iteration. The
+    pool is the one lent when this is called. ``items`` must give the same items on any thread.
+
+    Examples
+    --------
+    >>> with Pool(2) as pool, lend(pool):
+    ...     list(read_ahead(x * x for x in range(4)))
+    [0, 1, 4, 9]
+    """
+    pool = getattr(_LENT, "pool", None)
+    executor = None if pool is None else pool._executor
+    it = iter(items)
+    if executor is None:
+        return it
+    return _ahead(it, executor)
+
+
+def _ahead(it: Iterator, executor: ThreadPoolExecutor) -> Iterator:
+    done = object()
+    # the items reached through a cell emptied at the end: a cancelled read stays queued on
+    # the pool until a thread takes it, and would keep the iterator (its last item) alive
+    cell = [it]
+
+    def next_item():
+        return next(cell[0], done)
+
+    def submit() -> Future | None:
+        try:
+            return executor.submit(next_item)
+        except RuntimeError:  # the pool is closing: this thread alone
+            return None
+
+    ahead = submit()
+    try:
+        while True:
+            item = next_item() if ahead is None or ahead.cancel() else ahead.result()
+            ahead = None
+            if item is done:
+                return
+            ahead = submit()
+            yield item
+    finally:
+        if ahead is not None and not ahead.cancel():
+            ahead.exception()  # running: wait for it to end before the items are dropped
+        cell.clear()
 
 
 class OnceCache:

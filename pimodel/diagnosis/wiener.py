@@ -38,6 +38,7 @@ import numpy as np
 from scipy.signal import bilinear_zpk, lfilter, lfilter_zi, sosfilt, sosfilt_zi, zpk2sos
 
 from ..operators.pi import PIOperator
+from .chunked import transposed
 from .lti import INVERSE_FILTER, element_coefficients, nelder_mead
 from .threads import drop_threads, per_thread
 
@@ -220,7 +221,7 @@ class WienerBasis:
                 Z = Z[:, :ncols]
             if len(self._cache) >= KEPT_COLUMNS:
                 self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = np.ascontiguousarray(Z.T)  # kept as rows, the fits' layout
+            self._cache[key] = transposed(Z)  # kept as rows, the fits' layout
         return self._cache[key].T
 
     def release(self) -> None:
