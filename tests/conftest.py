@@ -24,9 +24,10 @@ settings.load_profile("ci" if os.environ.get("CI") else "default")
 # workers' for the same cores, and OpenBLAS' threads spin while they wait: a small least-squares
 # problem (identify's piecewise-linear fits, a few hundred samples) then took 5-10 times longer
 # (measured: 4.9-7.1 s instead of 0.6-0.8 s for one identify on a 251-sample record, with another
-# process busy on the second core). The library's own pools already do the same
-# (pimodel.diagnosis.diagnose, pimodel.experiments.sweeps). Set before any test runs, and in the
-# environment for the subprocesses the tests start (the CLI, the docs build, the studies).
+# process busy on the second core). The library does the same where it runs such fits
+# (pimodel.identify, pimodel.diagnosis.diagnose, pimodel.experiments.sweeps). Set before any
+# test runs, and in the environment for the subprocesses the tests start (the CLI, the docs
+# build, the studies).
 THREAD_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 for _name in THREAD_ENV:
     os.environ[_name] = "1"

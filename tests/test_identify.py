@@ -197,3 +197,32 @@ def test_identify_reports_progress_on_a_long_record(monkeypatch):
     quiet = identify(v, y, dt=2e-3, n_plays=3, passes=2)
     assert np.array_equal(quiet.radii, ident.radii) and np.array_equal(quiet.weights,
                                                                        ident.weights)
+
+
+def test_identify_runs_blas_on_one_thread_and_restores_the_callers_setting(monkeypatch):
+    """Within ``identify`` NumPy's BLAS runs on one thread (its small least squares; a thread
+    per core spins on a busy machine, docs/identification.md); the caller's setting is back
+    when it returns."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    import pimodel.identification.chain as chain
+
+    def blas_threads() -> list[int]:
+        return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+    seen: list = []
+    slopes = chain.identify_slopes
+
+    def watched(*args, **kwargs):
+        seen.append(blas_threads())
+        return slopes(*args, **kwargs)
+
+    monkeypatch.setattr(chain, "identify_slopes", watched)
+    t, v = triangle(2.0, 1.0, fs=1000, duration=6.0)
+    y = PIOperator([1.0, 0.5], [0.0, 0.4]).simulate(v)
+    with threadpool_limits(2, user_api="blas"):  # the caller's own setting (the tests run one)
+        before = blas_threads()
+        identify(v, y, dt=1e-3, n_plays=2, passes=2)
+        after = blas_threads()
+    assert before and seen and all(n == 1 for n in seen[0])
+    assert after == before

@@ -7,6 +7,12 @@ cores busy. What a fit memoises on objects that the threads share is kept per th
 (:func:`per_thread`), so no thread sees another's half-built memo and each thread's
 ``release()`` drops its own. :class:`Pool` with one worker runs everything inline, in the
 caller's order: the serial path, unchanged.
+
+A fit that runs while a thread of the pool is idle lends it small pieces of its own work
+(:func:`lend`): the points of a search (:func:`helped_map`) and the next chunk of a pass over a
+record (:func:`read_ahead`). Either is a call queued on the pool that the caller cancels and
+does itself when no thread has started it, so the caller never waits for work that has not
+begun, and the results are taken in the caller's order: the same values as on one thread.
 """
 
 from __future__ import annotations

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .._native import LIMITS
 from ..checks import as_signal, integer_in, positive_scalar
@@ -353,94 +354,97 @@ def identify(v, y, *, dt: float, n_plays: int | None = None, method: str = "adap
     >>> ident.weights.round(3), ident.radii.round(3), ident.health.ok
     (array([1. , 0.5]), array([0. , 0.4]), True)
     """
-    v = as_signal(v, "v", min_length=10)
-    y = as_signal(y, "y", min_length=10)
-    if v.size != y.size:
-        raise ValueError(f"v and y: expected equal lengths, got {v.size} and {y.size}")
-    dt = positive_scalar(dt, "dt")
-    if method not in METHODS:
-        raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
-    if np.ptp(v) == 0:
-        raise ValueError("v: the input is constant; identification needs a varying input")
-    if n_plays is not None:
-        n_plays = integer_in(n_plays, "n_plays", 1, MAX_PLAYS)
-    if passes is not None:
-        passes = integer_in(passes, "passes", 1, max_passes(v.size))
-    max_segments = integer_in(max_segments, "max_segments", 1, MAX_PLAYS + 1)
-    progress = progress or (lambda message: None)
+    # numpy's BLAS on one thread: the fits here are small least squares, which a BLAS thread per
+    # core makes slower, up to 1.9x with another process busy (docs/identification.md)
+    with threadpool_limits(1, user_api="blas"):
+        v = as_signal(v, "v", min_length=10)
+        y = as_signal(y, "y", min_length=10)
+        if v.size != y.size:
+            raise ValueError(f"v and y: expected equal lengths, got {v.size} and {y.size}")
+        dt = positive_scalar(dt, "dt")
+        if method not in METHODS:
+            raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
+        if np.ptp(v) == 0:
+            raise ValueError("v: the input is constant; identification needs a varying input")
+        if n_plays is not None:
+            n_plays = integer_in(n_plays, "n_plays", 1, MAX_PLAYS)
+        if passes is not None:
+            passes = integer_in(passes, "passes", 1, max_passes(v.size))
+        max_segments = integer_in(max_segments, "max_segments", 1, MAX_PLAYS + 1)
+        progress = progress or (lambda message: None)
 
-    if method == "conventional":
-        progress("conventional fit")
-        n = 10 if n_plays is None else n_plays
-        fit = fit_conventional(v, y, n, span=conventional_span)
-        exc = check_excitation(v, fit.operator.weights, fit.operator.radii)
-        offset, rms, mx = _errors(fit.operator, v, y)
-        return Identification(fit.operator, offset, method, rms, mx, float(np.ptp(y)), exc,
-                              settings={"n_plays": n, "span": fit.span})
+        if method == "conventional":
+            progress("conventional fit")
+            n = 10 if n_plays is None else n_plays
+            fit = fit_conventional(v, y, n, span=conventional_span)
+            exc = check_excitation(v, fit.operator.weights, fit.operator.radii)
+            offset, rms, mx = _errors(fit.operator, v, y)
+            return Identification(fit.operator, offset, method, rms, mx, float(np.ptp(y)), exc,
+                                  settings={"n_plays": n, "span": fit.span})
 
-    progress("loop slopes (number and weights of plays)")
-    slopes = identify_slopes(v, y, n_plays=n_plays, linear_play=linear_play,
-                             max_segments=max_segments)
-    _warn_if_no_loop(slopes)
-    if method == "joint":
-        progress("joint estimation of weights and radii")
-        return _identify_jointly(v, y, slopes, n_plays)
-    p = slopes.weights
-    exc = check_excitation(v, p, slopes.radii_guess)
-    guess = PIOperator(p, slopes.radii_guess)
-    offset, _, _ = _errors(guess, v, y)
+        progress("loop slopes (number and weights of plays)")
+        slopes = identify_slopes(v, y, n_plays=n_plays, linear_play=linear_play,
+                                 max_segments=max_segments)
+        _warn_if_no_loop(slopes)
+        if method == "joint":
+            progress("joint estimation of weights and radii")
+            return _identify_jointly(v, y, slopes, n_plays)
+        p = slopes.weights
+        exc = check_excitation(v, p, slopes.radii_guess)
+        guess = PIOperator(p, slopes.radii_guess)
+        offset, _, _ = _errors(guess, v, y)
 
-    if gains is None:
-        try:
-            pp = _norm2(p)
-        except ValueError as err:  # weights taken from y's loop slopes: y's scale is at fault
-            raise ValueError(f"y: the loop slopes' {err}") from None
-    g = 20.0 / pp if gains is None else gains
-    rev = find_reversals(v, 0.01 * float(np.ptp(v)))
-    first = rev[0] if rev else 0
-    if passes is None:
-        passes = min(max(3, int(np.ceil(200.0 / (dt * (v.size - first))))),
-                     max(1, max_passes(v.size)))
-    total = v.size + (passes - 1) * (v.size - first)
-    guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard
-    est = RadiusEstimator(p, dt=dt, gains=g, initial_radii=slopes.radii_guess,
-                          linear_play=slopes.linear_play, guard=guard_)
-    progress(f"radius estimator ({passes} passes, {total:,} samples)")
-    if total <= HISTORY_LIMIT:  # keep the history for the health report
-        vv = np.concatenate([v] + [v[first:]] * (passes - 1))
-        yy = np.concatenate([y] + [y[first:]] * (passes - 1)) - offset
-        run = est.run(vv, yy)
-        radii = run.history[vv.size // 2:].mean(axis=0)
-        health = estimator_health(vv, p, run.history, linear_play=slopes.linear_play, y=yy,
-                                  error=run.error)
-    else:  # long record: bounded memory (the passes never joined), health from the final mean
-        chunks = _repeated_chunks(
-            v, y, offset, first, passes, PROGRESS_CHUNK,
-            progress=lambda share: progress(f"radius estimator ({passes} passes, "
-                                            f"{total:,} samples): {100 * share:.0f} %"))
-        _, radii = stream_tail_average(est, chunks, total=total, tail=0.5)
-        health = estimator_health(v, p, radii[None, :], linear_play=slopes.linear_play)
-    radii_from = "average of the estimate over the last half"
-    if v.size * p.size <= REFINE_LIMIT:  # the batch refinement holds N x n arrays
-        progress("batch refinement of the radii")
-        offset = float(np.mean(y - PIOperator(p, radii).simulate(v)))
-        # the last half, as the online mean: a real stage's start-up (creep from its initial
-        # state) is not in the model (shared real record, held-out RMS: 0.113 um fitting all
-        # of it, 0.086 um fitting the last half, 0.089 um for the online mean alone)
-        radii = refine_radii(v, y - offset, p, radii, tail=0.5, linear_play=slopes.linear_play)
-        health = refined_health(v, y - offset, p, radii, linear_play=slopes.linear_play)
-        radii_from = ("batch refinement (refine_radii, last half of the record) from the "
-                      "average over the last half")
-    if not health.ok:
-        warnings.warn("identify: radius estimate health: " + "; ".join(health.messages),
-                      UserWarning, stacklevel=2)
-    progress("errors on the record")
-    op = PIOperator(p, radii)
-    offset, rms, mx = _errors(op, v, y)
-    settings = {"gains": np.broadcast_to(g, p.shape).tolist(), "passes": passes,
-                "guard": guard_, "radii_from": radii_from}
-    return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings,
-                          health)
+        if gains is None:
+            try:
+                pp = _norm2(p)
+            except ValueError as err:  # weights taken from y's loop slopes: y's scale is at fault
+                raise ValueError(f"y: the loop slopes' {err}") from None
+        g = 20.0 / pp if gains is None else gains
+        rev = find_reversals(v, 0.01 * float(np.ptp(v)))
+        first = rev[0] if rev else 0
+        if passes is None:
+            passes = min(max(3, int(np.ceil(200.0 / (dt * (v.size - first))))),
+                         max(1, max_passes(v.size)))
+        total = v.size + (passes - 1) * (v.size - first)
+        guard_ = 0.002 * float(np.ptp(v)) if guard is None else guard
+        est = RadiusEstimator(p, dt=dt, gains=g, initial_radii=slopes.radii_guess,
+                              linear_play=slopes.linear_play, guard=guard_)
+        progress(f"radius estimator ({passes} passes, {total:,} samples)")
+        if total <= HISTORY_LIMIT:  # keep the history for the health report
+            vv = np.concatenate([v] + [v[first:]] * (passes - 1))
+            yy = np.concatenate([y] + [y[first:]] * (passes - 1)) - offset
+            run = est.run(vv, yy)
+            radii = run.history[vv.size // 2:].mean(axis=0)
+            health = estimator_health(vv, p, run.history, linear_play=slopes.linear_play, y=yy,
+                                      error=run.error)
+        else:  # long record: bounded memory (the passes never joined), health from the final mean
+            chunks = _repeated_chunks(
+                v, y, offset, first, passes, PROGRESS_CHUNK,
+                progress=lambda share: progress(f"radius estimator ({passes} passes, "
+                                                f"{total:,} samples): {100 * share:.0f} %"))
+            _, radii = stream_tail_average(est, chunks, total=total, tail=0.5)
+            health = estimator_health(v, p, radii[None, :], linear_play=slopes.linear_play)
+        radii_from = "average of the estimate over the last half"
+        if v.size * p.size <= REFINE_LIMIT:  # the batch refinement holds N x n arrays
+            progress("batch refinement of the radii")
+            offset = float(np.mean(y - PIOperator(p, radii).simulate(v)))
+            # the last half, as the online mean: a real stage's start-up (creep from its initial
+            # state) is not in the model (shared real record, held-out RMS: 0.113 um fitting all
+            # of it, 0.086 um fitting the last half, 0.089 um for the online mean alone)
+            radii = refine_radii(v, y - offset, p, radii, tail=0.5, linear_play=slopes.linear_play)
+            health = refined_health(v, y - offset, p, radii, linear_play=slopes.linear_play)
+            radii_from = ("batch refinement (refine_radii, last half of the record) from the "
+                          "average over the last half")
+        if not health.ok:
+            warnings.warn("identify: radius estimate health: " + "; ".join(health.messages),
+                          UserWarning, stacklevel=2)
+        progress("errors on the record")
+        op = PIOperator(p, radii)
+        offset, rms, mx = _errors(op, v, y)
+        settings = {"gains": np.broadcast_to(g, p.shape).tolist(), "passes": passes,
+                    "guard": guard_, "radii_from": radii_from}
+        return Identification(op, offset, method, rms, mx, float(np.ptp(y)), exc, slopes, settings,
+                              health)
 
 
 def _identify_jointly(v: np.ndarray, y: np.ndarray, slopes: SlopeIdentification,
