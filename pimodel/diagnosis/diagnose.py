@@ -923,9 +923,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if path[0] and score < best[0] - MIN_BIC_DROP:
                 best = (score, path)
         chosen, fixed, current, cur_out = best[1]
-    for s in segs:  # the choice is made: the rate bases' band sums and last contacts, kept
-        if s.rate_basis is not None:  # for every fit of it, are done with
-            s.rate_basis.forget()
+    _forget_rates(segs)  # the choice is made: the band sums and contacts kept for its fits
     screen = None
     if screened:  # the choice, refitted on the whole records; the verdict's figures whole
         progress("the chosen model on the whole records")
@@ -939,9 +937,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             current, cur_out = _whole_fit(chosen, current, tr, va, nominal,
                                           lambda s: _with_rows(s, radii, proj, at_rest),
                                           lambda s: _streamed(s, radii, proj, at_rest))
-            for s in tr + va:  # what a rate refit kept of a whole record (its contacts)
-                if s.rate_basis is not None:
-                    s.rate_basis.forget()
+            _forget_rates(tr + va)  # what a rate refit kept of a whole record (its contacts)
         else:
             current, cur_out = nominal, out_va
         screen = {"samples": SCREEN_SAMPLES,
@@ -1032,6 +1028,13 @@ def _creep_law(params: dict) -> dict | None:
         return creep_law(params["creep_lag_gains"], params["creep_time_constants_s"])
     except ValueError:
         return None
+
+
+def _forget_rates(segs: list[Segment]) -> None:
+    """Drop what the segments' rate bases keep for every fit and thread (``RateBasis.forget``)."""
+    for s in segs:
+        if s.rate_basis is not None:
+            s.rate_basis.forget()
 
 
 def _release(model: Model, segs: list[Segment]) -> None:

@@ -176,9 +176,8 @@ def helped_map(fn: Callable, items: Iterable) -> list:
     never needed to finish it), and without a lent pool, or with one worker, this is the plain
     loop. ``fn`` must give the same result on any thread (no per-thread state in its result)."""
     items = list(items)
-    pool = getattr(_LENT, "pool", None)
-    executor = None if pool is None else pool._executor
-    if executor is None or len(items) < 2:
+    pool = _lent_pool()
+    if pool is None or len(items) < 2:
         return [fn(x) for x in items]
     results: list = [None] * len(items)
     lock = threading.Lock()
@@ -200,10 +199,7 @@ def helped_map(fn: Callable, items: Iterable) -> list:
         while (i := take()) is not None:
             job["results"][i] = job["fn"](job["items"][i])
 
-    try:
-        helpers = [executor.submit(work) for _ in range(pool.workers - 1)]
-    except RuntimeError:  # the pool is closing: this thread alone
-        helpers = []
+    helpers = [h for h in (_queued(pool, work) for _ in range(pool.workers - 1)) if h]
     try:
         work()
     finally:
@@ -236,15 +232,27 @@ def read_ahead(items: Iterable) -> Iterator:
     ...     list(read_ahead(x * x for x in range(4)))
     [0, 1, 4, 9]
     """
-    pool = getattr(_LENT, "pool", None)
-    executor = None if pool is None else pool._executor
+    pool = _lent_pool()
     it = iter(items)
-    if executor is None:
-        return it
-    return _ahead(it, executor)
+    return it if pool is None else _ahead(it, pool)
 
 
-def _ahead(it: Iterator, executor: ThreadPoolExecutor) -> Iterator:
+def _lent_pool() -> Pool | None:
+    """The pool lent to this thread (:func:`lend`) when it has threads of its own, else None."""
+    pool = getattr(_LENT, "pool", None)
+    return None if pool is None or pool._executor is None else pool
+
+
+def _queued(pool: Pool, fn: Callable) -> Future | None:
+    """``fn()`` queued on the pool's threads; None when the pool is closing (no thread will
+    take it: the caller does the work alone)."""
+    try:
+        return pool._executor.submit(fn)
+    except RuntimeError:
+        return None
+
+
+def _ahead(it: Iterator, pool: Pool) -> Iterator:
     done = object()
     # the items reached through a cell emptied at the end: a cancelled read stays queued on
     # the pool until a thread takes it, and would keep the iterator (its last item) alive
@@ -254,10 +262,7 @@ def _ahead(it: Iterator, executor: ThreadPoolExecutor) -> Iterator:
         return next(cell[0], done)
 
     def submit() -> Future | None:
-        try:
-            return executor.submit(next_item)
-        except RuntimeError:  # the pool is closing: this thread alone
-            return None
+        return _queued(pool, next_item)
 
     ahead = submit()
     try:
