@@ -8,15 +8,16 @@ double pim_pi_step(size_t n, const double *p, const double *r, double *z, double
     return pim_pi_step_inline(n, p, r, z, v);
 }
 
-void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
-                const double *v, double *y, double *zhist)
+/* pim_pi_run with the play outputs stored at zhist[k*sk + i*si] (sk, si: the strides). */
+static void pi_run_strided(size_t N, size_t n, const double *p, const double *r, double *z,
+                           const double *v, double *y, double *zhist, size_t sk, size_t si)
 {
     double zl[PIM_MAX_PLAYS];
     if (n > PIM_MAX_PLAYS) { /* general path, state in caller memory */
         for (size_t k = 0; k < N; ++k) {
             y[k] = pim_pi_step(n, p, r, z, v[k]);
             if (zhist) {
-                for (size_t i = 0; i < n; ++i) zhist[k * n + i] = z[i];
+                for (size_t i = 0; i < n; ++i) zhist[k * sk + i * si] = z[i];
             }
         }
         return;
@@ -25,10 +26,22 @@ void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
     for (size_t k = 0; k < N; ++k) {
         y[k] = pim_pi_step_inline(n, p, r, zl, v[k]);
         if (zhist) {
-            for (size_t i = 0; i < n; ++i) zhist[k * n + i] = zl[i];
+            for (size_t i = 0; i < n; ++i) zhist[k * sk + i * si] = zl[i];
         }
     }
     for (size_t i = 0; i < n; ++i) z[i] = zl[i];
+}
+
+void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
+                const double *v, double *y, double *zhist)
+{
+    pi_run_strided(N, n, p, r, z, v, y, zhist, n, 1);
+}
+
+void pim_pi_run_rows(size_t N, size_t n, const double *p, const double *r, double *z,
+                     const double *v, double *y, double *zrows, size_t ld)
+{
+    pi_run_strided(N, n, p, r, z, v, y, zrows, 1, ld);
 }
 
 void pim_tdpi_run(size_t N, size_t n, const double *p, const double *R, double *z,
