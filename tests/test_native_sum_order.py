@@ -118,10 +118,12 @@ def test_python_path_sums_in_the_stated_order(seed):
 def test_play_outputs_as_rows_are_the_runs_own(seed):
     """pim_pi_run_rows (the diagnosis' play rows, module effects.play_chunks) writes exactly
     pim_pi_run's play outputs, transposed, with the same outputs and final states, for n up to
-    and beyond the fixed-size limit (its general path); a wrong shape is refused by name."""
+    and beyond the fixed-size limit (its general path), through its buffer in blocks of
+    samples (777 samples: a last block shorter) and stored straight (600 plays); a wrong shape
+    is refused by name."""
     from pimodel import _native
     rng = np.random.default_rng(seed)
-    for n in (1, 7, 80, _native.LIMITS["PIM_MAX_PLAYS"] + 3):
+    for n in (1, 7, 80, _native.LIMITS["PIM_MAX_PLAYS"] + 3, 600):
         p, r = rng.uniform(0.1, 1.0, n), np.sort(rng.uniform(0.0, 3.0, n))
         v = np.cumsum(rng.normal(0.0, 0.3, 777))
         z0 = rng.uniform(-1.0, 1.0, n)
