@@ -300,49 +300,6 @@ def test_a_fits_variants_run_on_the_pool_each_on_its_own(monkeypatch):
     assert "rate" in [c["effect"] for c in rep.candidates]
 
 
-def _fits_made(monkeypatch, workers: int, slow_lag: float = 0.0) -> list[tuple]:
-    """Creep + dynamics diagnosed on ``workers`` threads: each fit made, as ``(key, stage)``
-    (the progress stage under way when it started); the lag's re-search (one long fit) made
-    ``slow_lag`` seconds longer."""
-    import importlib
-    diagnose_module = importlib.import_module("pimodel.diagnosis.diagnose")
-    real = diagnose_module.fit_effect
-    stage, made = ["start"], []
-
-    def fit_effect(name, train, combo, fixed, nominal):
-        fx = fixed or {}
-        made.append(((name, tuple(combo), repr(sorted(fx.items()))), stage[0]))
-        if fx.get("search_all") and slow_lag:
-            time.sleep(slow_lag)
-        return real(name, train, combo, fixed, nominal)
-
-    train, validate = records(("creep", "dynamics"), 0)
-    with monkeypatch.context() as patch:
-        patch.setattr(diagnose_module, "fit_effect", fit_effect)
-        diagnose(train, validate, workers=workers,
-                 progress=lambda message: stage.__setitem__(0, message))
-    return made
-
-
-@pytest.mark.slow  # three diagnoses of about 5-10 s each
-def test_the_revisions_swaps_are_made_ahead_and_none_in_vain(monkeypatch):
-    """Fits a later step will likely need (the revision's swaps) go to a thread that would
-    wait for the longest fit of a batch (the lag searched again): on two threads some of the
-    revision's fits are made before the revision starts, and every fit made is one the serial
-    path makes too (none made in vain here, none twice). Before: no fit of the revision was
-    made before it."""
-    serial = _fits_made(monkeypatch, 1)
-    revision = {key for key, stage in serial if stage == "revising the choice"}
-    assert revision
-    for slow in (0.0, 2.0):  # the lag's re-search as it is, and longer than its neighbours
-        two = _fits_made(monkeypatch, 2, slow)
-        keys = [key for key, _ in two]
-        assert sorted(keys) == sorted(key for key, _ in serial)
-        if slow:
-            ahead = {key for key, stage in two if stage != "revising the choice"} & revision
-            assert ahead, "no swap of the revision was made ahead of it"
-
-
 class _StoresMeet(dict):
     """A fit's memo whose stores of a segment's latest rate filter wait until both threads of
     the test have stored theirs (the order in which two points of one search interleave)."""

@@ -795,30 +795,15 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         _release(m, segs)  # (the bases' memos of this thread: module threads)
         return out
 
-    guesses: list = []  # the queued fits of prefetch(..., ahead=...)
-
-    def prefetch(calls, ahead=()) -> None:
+    def prefetch(calls) -> None:
         """With several threads: make the single fits of ``calls`` (``fit``'s arguments; each
         variant a fit of its own) on the pool, the longest first; the loops after them take
         them from the cache in their own order, so every comparison and tie is decided as on
-        one thread. ``ahead``: fits a later step will likely need, queued behind ``calls``
-        for a thread that would otherwise wait for the longest of them, not waited for; the
-        next prefetch cancels those no thread has started, so they never delay the fits
-        needed then (a step that needs one takes it from the cache, waiting for it if a
-        thread is making it, or makes it)."""
+        one thread."""
         if pool.workers > 1:
-            for f in guesses:
-                f.cancel()
-            guesses.clear()
             fits = {key: fx for c in calls for key, fx in variants(*c)}
-            later = {key: fx for c in ahead for key, fx in variants(*c) if key not in fits}
-            now = [pool.submit(single, *kf) for kf in longest_first(fits)]
-            guesses.extend(pool.submit(single, *kf) for kf in longest_first(later))
-            for f in now:
-                f.result()
-
-    def longest_first(fits: dict) -> list:
-        return sorted(fits.items(), key=lambda kf: -_cost(kf[0][1], kf[0][0], kf[1]))
+            pool.map(lambda kf: single(*kf),
+                     sorted(fits.items(), key=lambda kf: -_cost(kf[0][1], kf[0][0], kf[1])))
 
     prefetch([(name,) for name in EFFECTS])
     candidates = []
@@ -869,12 +854,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if rms_now <= NOISE_STOP * noise:
                 break
             best = None
-            # beside: the revision's swaps, which it makes when this round adds nothing
             prefetch([(name, chosen, dict(fixed) if chosen else None)
                       for name in (EFFECTS if chosen or start is None else (start,))
-                      if name not in chosen],
-                     ahead=[_held_call(e, fixed, fit) for e in _swaps(chosen)]
-                     if len(chosen) > 1 else [])
+                      if name not in chosen])
             for name in EFFECTS if chosen or start is None else (start,):
                 if name in chosen:
                     continue
@@ -907,12 +889,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                             best = (dbic, (first, name), m, o)
             if accepted(best) and pool.workers > 1:  # the fits the acceptance may need next
                 then = chosen + (best[1] if isinstance(best[1], tuple) else (best[1],))
-                fixed_then = {**fixed, **best[2].grid}
-                # beside the lag searched again (one long fit): the revision's swaps of that
-                # lag, which hold none of the parameters the search may change
                 prefetch((_refined_calls(chosen, fixed) if chosen else []) +
-                         _lag_calls(then, fixed_then),
-                         ahead=_lag_swap_calls(then, fixed_then, fit))
+                         _lag_calls(then, {**fixed, **best[2].grid}))
             # accepted(best) is _passes against the current choice (its BIC difference known)
             if not accepted(best) and not (chosen and aside(best[2:], (current, cur_out),
                                                             chosen, fixed, best[1])):
@@ -1086,8 +1064,14 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     model, validate outputs)``. ``prefetch(calls)`` (None: none) makes a step's refits
     (``fit``'s arguments) beforehand, on several threads (``fit`` keeps them; the step then
     takes them in its own order)."""
+    def keys_of(e):  # grid parameters of an effect, as its single fit reports them (a drift's
+        # and a rate's all of their kind: a single fit of another family or variant lacks some,
+        # e.g. rate_growth, which a held SCALED rate needs)
+        return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS}.get(e, ()))
+
     def call(effects):  # fit's arguments for the combination ``effects`` (not empty)
-        return _held_call(effects, fixed, fit)
+        kept = {k: x for k, x in fixed.items() if any(k in keys_of(e) for e in effects)}
+        return effects[-1], effects[:-1], kept or None
 
     def refit(effects):
         return fit(*call(effects)) if effects else nominal
@@ -1099,12 +1083,15 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     for _ in range(len(EFFECTS)):  # swaps, the best first
         best = None
         if prefetch is not None:
-            prefetch([call(effects) for effects in _swaps(chosen)])
-        for effects in _swaps(chosen):
-            new = refit(effects)
-            score = _bic(va, new[1], new[0].k)
-            if passes(new, cur) and (best is None or score < best[0]):
-                best = (score, effects, new)
+            prefetch([call((*(c for c in chosen if c != e), x)) for e in chosen
+                      for x in EFFECTS if x not in chosen])
+        for e in chosen:
+            rest = tuple(c for c in chosen if c != e)
+            for x in (x for x in EFFECTS if x not in chosen):
+                new = refit((*rest, x))
+                score = _bic(va, new[1], new[0].k)
+                if passes(new, cur) and (best is None or score < best[0]):
+                    best = (score, (*rest, x), new)
         if best is None:
             break
         chosen, cur = best[1], best[2]
@@ -1128,37 +1115,6 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
             break
         chosen, cur = worst[1], worst[2]
     return chosen, cur[0], cur[1]
-
-
-def _swaps(chosen: tuple) -> list[tuple]:
-    """The combinations :func:`_revise` tries in a swap, in its order: each chosen effect
-    replaced by each effect not chosen (the others in their order, the new one last)."""
-    return [(*(c for c in chosen if c != e), x) for e in chosen
-            for x in EFFECTS if x not in chosen]
-
-
-def _held_call(effects: tuple, fixed: dict, fit) -> tuple:
-    """``fit``'s arguments for the combination ``effects`` (not empty) with the grid
-    parameters of ``fixed`` that belong to its effects held: those each effect's single fit
-    reports, and a drift's and a rate's all of their kind (a single fit of another family or
-    variant lacks some, e.g. rate_growth, which a held scaled rate needs)."""
-    keys = set().union(*(set(fit(e)[0].grid) |
-                         set({"drift": DRIFT_KEYS, "rate": RATE_KEYS}.get(e, ()))
-                         for e in effects))
-    kept = {k: x for k, x in fixed.items() if k in keys}
-    return effects[-1], effects[:-1], kept or None
-
-
-def _lag_swap_calls(chosen: tuple, fixed: dict, fit) -> list[tuple]:
-    """The revision's swaps of the one lag effect of ``chosen`` (``fit``'s arguments, as
-    :func:`_revise` makes them when ``fixed`` keeps the other effects' parameters) when
-    :func:`_research_lag` will search that lag again: the fits of the revision that hold
-    nothing the search may change (none when there is no such search)."""
-    if not _lag_calls(chosen, fixed):
-        return []
-    lag = next(e for e in chosen if e in LAG_EFFECTS)
-    return [_held_call(effects, fixed, fit) for effects in _swaps(chosen)
-            if lag not in effects]
 
 
 def _passes(va, new, old) -> bool:
