@@ -88,6 +88,8 @@ lib.pim_pi_step.restype = ctypes.c_double
 lib.pim_pi_step.argtypes = [c_size, F64, F64, F64, ctypes.c_double]
 lib.pim_pi_run.restype = None
 lib.pim_pi_run.argtypes = [c_size, c_size, F64, F64, F64, F64, F64, F64_OR_NULL]
+lib.pim_pi_run_rows.restype = None
+lib.pim_pi_run_rows.argtypes = [c_size, c_size, F64, F64, F64, F64, F64, F64, c_size]
 lib.pim_tdpi_run.restype = None
 lib.pim_tdpi_run.argtypes = [c_size, c_size, F64, F64, F64, F64, F64, F64_OR_NULL]
 lib.pim_pi_inverse.restype = ctypes.c_int
@@ -103,6 +105,19 @@ def pi_run(
     zhist = np.empty((N, n)) if with_plays else None
     lib.pim_pi_run(N, n, p, r, z, v, y, zhist)
     return y, zhist
+
+
+def pi_run_rows(p: np.ndarray, r: np.ndarray, z: np.ndarray, v: np.ndarray,
+                rows: np.ndarray) -> np.ndarray:
+    """:func:`pi_run` with the play outputs written as rows, ``rows[i, k] = z_i[k]`` (float64,
+    C-contiguous, shape (n, N), filled in place); ``z`` updated in place; returns ``y``. The
+    same values as :func:`pi_run`'s."""
+    N, n = v.shape[0], p.shape[0]
+    if rows.shape != (n, N):
+        raise ValueError(f"rows: expected shape ({n}, {N}), got {rows.shape}")
+    y = np.empty(N)
+    lib.pim_pi_run_rows(N, n, p, r, z, v, y, rows, N)
+    return y
 
 
 def tdpi_run(

@@ -112,3 +112,26 @@ def test_python_path_sums_in_the_stated_order(seed):
         p, r, z, v = draw(seed + 3, n, positive=True)
         y = PIOperator(p, r, initial_state=z).simulate(np.array(v))
         assert bits(y) == bits(stated_order(p, r, list(z), v)), n
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_play_outputs_as_rows_are_the_runs_own(seed):
+    """pim_pi_run_rows (the diagnosis' play rows, module effects.play_chunks) writes exactly
+    pim_pi_run's play outputs, transposed, with the same outputs and final states, for n up to
+    and beyond the fixed-size limit (its general path), through its buffer in blocks of
+    samples (777 samples: a last block shorter) and stored straight (600 plays); a wrong shape
+    is refused by name."""
+    from pimodel import _native
+    rng = np.random.default_rng(seed)
+    for n in (1, 7, 80, _native.LIMITS["PIM_MAX_PLAYS"] + 3, 600):
+        p, r = rng.uniform(0.1, 1.0, n), np.sort(rng.uniform(0.0, 3.0, n))
+        v = np.cumsum(rng.normal(0.0, 0.3, 777))
+        z0 = rng.uniform(-1.0, 1.0, n)
+        z1, z2 = z0.copy(), z0.copy()
+        y1, plays = _native.pi_run(p, r, z1, v, with_plays=True)
+        rows = np.empty((n, v.size))
+        y2 = _native.pi_run_rows(p, r, z2, v, rows)
+        assert bits(rows.ravel()) == bits(plays.T.ravel()), n
+        assert bits(y1) == bits(y2) and bits(z1) == bits(z2), n
+    with pytest.raises(ValueError, match="rows: expected shape"):
+        _native.pi_run_rows(p, r, z2, v, np.empty((v.size, n)))

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..operators.pi import PIOperator
+from .._native import pi_run_rows
 from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
@@ -262,16 +262,16 @@ def play_chunks(v, radii, *, at_rest: bool = True) -> Iterator[tuple[slice, np.n
     >>> [rows.tolist() for _, rows in play_chunks(np.array([0.0, 1.0, 0.5]), [0.5])]
     [[[0.0, 0.5, 0.5], [1.0, 1.0, 1.0]]]
     """
-    radii = np.asarray(radii, float)
-    v = np.asarray(v, float)
-    op = PIOperator(np.ones(radii.size), radii, initial_state=float(v[0]) if at_rest else 0.0)
+    radii = np.ascontiguousarray(radii, float)
+    v = np.ascontiguousarray(v, float)
+    ones = np.ones(radii.size)
+    z = np.full(radii.size, float(v[0]) if at_rest else 0.0)  # the plays' states, carried
 
     def each():
-        state = None
         for c in chunks(v.size):
-            Zc = op.play_outputs(v[c], state=state)
-            rows = np.empty((radii.size + 1, Zc.shape[0]))
-            rows[:-1], rows[-1], state = Zc.T, 1.0, Zc[-1]
+            rows = np.empty((radii.size + 1, c.stop - c.start))
+            pi_run_rows(ones, radii, z, v[c], rows[:-1])  # written as rows by the C core
+            rows[-1] = 1.0
             yield c, rows
 
     return read_ahead(each())  # the next chunk on an idle thread of a lent pool (module threads)

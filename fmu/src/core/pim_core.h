@@ -173,6 +173,13 @@ PIM_API void pim_pi_run(size_t N, size_t n, const double *p, const double *r, do
                         const double *v, double *y, double *zhist);
 
 /*
+ * pim_pi_run with the play outputs as rows (the layout of the diagnosis' fits):
+ * zrows[i*ld + k] = z_i[k], ld >= N (not nullable). The same values as pim_pi_run's.
+ */
+PIM_API void pim_pi_run_rows(size_t N, size_t n, const double *p, const double *r, double *z,
+                             const double *v, double *y, double *zrows, size_t ld);
+
+/*
  * Time-dependent PI operator: radii given per sample, R[k*n + i] = rhat_i[k].
  * zhist (nullable) as in pim_pi_run.
  */

@@ -8,15 +8,16 @@ double pim_pi_step(size_t n, const double *p, const double *r, double *z, double
     return pim_pi_step_inline(n, p, r, z, v);
 }
 
-void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
-                const double *v, double *y, double *zhist)
+/* pim_pi_run with the play outputs stored at zhist[k*sk + i*si] (sk, si: the strides). */
+static void pi_run_strided(size_t N, size_t n, const double *p, const double *r, double *z,
+                           const double *v, double *y, double *zhist, size_t sk, size_t si)
 {
     double zl[PIM_MAX_PLAYS];
     if (n > PIM_MAX_PLAYS) { /* general path, state in caller memory */
         for (size_t k = 0; k < N; ++k) {
             y[k] = pim_pi_step(n, p, r, z, v[k]);
             if (zhist) {
-                for (size_t i = 0; i < n; ++i) zhist[k * n + i] = z[i];
+                for (size_t i = 0; i < n; ++i) zhist[k * sk + i * si] = z[i];
             }
         }
         return;
@@ -25,10 +26,40 @@ void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
     for (size_t k = 0; k < N; ++k) {
         y[k] = pim_pi_step_inline(n, p, r, zl, v[k]);
         if (zhist) {
-            for (size_t i = 0; i < n; ++i) zhist[k * n + i] = zl[i];
+            for (size_t i = 0; i < n; ++i) zhist[k * sk + i * si] = zl[i];
         }
     }
     for (size_t i = 0; i < n; ++i) z[i] = zl[i];
+}
+
+void pim_pi_run(size_t N, size_t n, const double *p, const double *r, double *z,
+                const double *v, double *y, double *zhist)
+{
+    pi_run_strided(N, n, p, r, z, v, y, zhist, n, 1);
+}
+
+/* Doubles of the buffer through which pim_pi_run_rows writes its rows (32 KB, on the stack):
+ * a block of samples is run into it sample by sample (contiguous stores), then copied out row
+ * by row (contiguous again); storing each sample's plays straight into n rows was slower than
+ * pim_pi_run and a transposed copy together. */
+#define PIM_ROWS_BUFFER 4096
+
+void pim_pi_run_rows(size_t N, size_t n, const double *p, const double *r, double *z,
+                     const double *v, double *y, double *zrows, size_t ld)
+{
+    double buf[PIM_ROWS_BUFFER];
+    if (n == 0 || n > PIM_ROWS_BUFFER / 8) { /* few samples per block: stored straight */
+        pi_run_strided(N, n, p, r, z, v, y, zrows, 1, ld);
+        return;
+    }
+    const size_t block = PIM_ROWS_BUFFER / n;
+    for (size_t k0 = 0; k0 < N; k0 += block) {
+        const size_t b = N - k0 < block ? N - k0 : block;
+        pi_run_strided(b, n, p, r, z, v + k0, y + k0, buf, n, 1);
+        for (size_t i = 0; i < n; ++i) {
+            for (size_t j = 0; j < b; ++j) zrows[i * ld + k0 + j] = buf[j * n + i];
+        }
+    }
 }
 
 void pim_tdpi_run(size_t N, size_t n, const double *p, const double *R, double *z,
