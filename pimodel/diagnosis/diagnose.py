@@ -8,8 +8,10 @@ weights and an output offset by least squares, linear in its parameters). The gr
 hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
 ``v[0]``, or at 0 when the train BIC prefers it; records that travel further than half the range
 from ``v[0]`` also try the grid extended to that travel, kept when validate agrees (issue 33,
-:func:`_nominal`). A plain least-squares PI fit is reported beside it as a check
-(``nominal["baseline"]``), with a warning when the nominal is worse. Each candidate effect is
+:func:`_nominal`); train records of few samples also try grids topped below half the range,
+likewise kept when validate agrees (issue 28, :func:`_topped_grids`). A plain least-squares PI
+fit is reported beside it as a check (``nominal["baseline"]``), with a warning when the nominal
+is worse. Each candidate effect is
 refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are added greedily:
 each round fits every remaining candidate on train (on top of those already chosen) and scores
 it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by
@@ -91,6 +93,9 @@ __all__ = [
 ]
 
 GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is kept
+GRID_TOPS = (0.9, 0.8)  # with few train samples (_topped_grids), grids topped at these
+# fractions of half the train range are tried too, kept when validate agrees
+FEW_SAMPLES_PER_PLAY = 50  # few: fewer train samples than this per play of the finest grid
 BASELINE_PLAYS = 60  # plays of the plain least-squares baseline (0 to max |v| of train)
 PROJECTED = 32  # principal directions of the play outputs kept beside the nominal's weights
 BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor of the baseline's
@@ -465,6 +470,29 @@ def _grids(train) -> tuple[list[np.ndarray], list[np.ndarray]]:
     return half, [np.concatenate((h, extra)) for h in half] if extra.size else []
 
 
+def _topped_grids(train) -> list[np.ndarray]:
+    """The nominal's grids topped below half the train input range ``S / 2`` (issue 28): for
+    each top in ``GRID_TOPS`` (a fraction of ``S / 2``) and each size in ``GRID_SIZES`` the
+    uniform grid from 0 to that top, when the train records hold fewer than
+    ``FEW_SAMPLES_PER_PLAY`` samples per play of the finest grid (counted over the whole
+    records, start-up included); else none.
+
+    A play of radius ``r`` near ``S / 2`` moves only while the input is within ``S - 2 r`` of
+    an extreme it has reached (and in the start-up from rest). On band-limited random input the
+    extremes are visited a few times, so with few samples (a 4 s record at 500 Hz: 2000 samples
+    for 81 coefficients) the top plays' weights are fitted to the noise and to the finer plays'
+    off-grid error, and they mispredict a record that visits its extremes otherwise (on clean
+    stages, validate 2-3.5 times the noise in 3 of 10 seeds). Whether a play that moves so
+    little is part of the stage, train alone cannot tell (on ramps to held levels a stage's
+    largest radius at 0.84-0.99 of ``S / 2`` misfits train little), so :func:`_nominal` keeps a
+    topped grid only when validate agrees, as the extension. With more samples (every record
+    of the ``sim_to_real`` study and the shared real record: at least 8275) none, as before."""
+    if sum(len(r) for r in train) >= FEW_SAMPLES_PER_PLAY * max(GRID_SIZES):
+        return []
+    span = float(np.ptp(np.concatenate([r.v for r in train])))
+    return [np.linspace(0.0, top * span / 2, n) for top in GRID_TOPS for n in GRID_SIZES]
+
+
 def _nominal(train, validate, initial_state):
     """The radius grid with the lowest train BIC (its nominal: :func:`_nominal_segments`).
 
@@ -477,7 +505,11 @@ def _nominal(train, validate, initial_state):
     the radii, whether the grid is extended and whether the plays start at rest at ``v[0]``.
     With ``initial_state="unknown"`` (the start-up is not fitted) the plays start at 0 on the
     half-range grids, as before issue 33
-    (from ``v[0]`` the shared real record's validate gap was 0.154 um against 0.048 um noise)."""
+    (from ``v[0]`` the shared real record's validate gap was 0.154 um against 0.048 um noise).
+    With few train samples, the topped grids (:func:`_topped_grids`, plays started as chosen)
+    give the one with the lowest train BIC, kept in place of a half-range choice only when it
+    has the lower validate BIC (issue 28); the choice stays the grid with which every model
+    then runs, in discrete time as before (plays updated at each sample ``k`` from ``v[k]``)."""
     half, extended = _grids(train)
     if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
         half, extended = [], []
@@ -486,29 +518,54 @@ def _nominal(train, validate, initial_state):
     # the BIC of the whole records' sample count (the screen's mean squared residual)
     n_train = _fitted_samples(train, initial_state)
     for at_rest, grids in ((True, half), (True, extended), (False, _grids(train)[0])):
-        best = None
-        for radii in grids:
-            segs, ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)
-            coef = ne.solve()
-            bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1,
-                       n_train)
-            if best is None or bic < best[0]:
-                best = (bic, radii, coef, at_rest)
-        picks.append(best)
+        picks.append(_train_pick(train, grids, initial_state, at_rest, n_train))
     if picks[0] is None:
-        return picks[2][1], False, False
+        return _topped(train, validate, initial_state, picks[2], n_train)[1], False, False
     if picks[1] is not None:  # the extension: kept only when validate agrees
-        vbic = []
-        for _, radii, coef, at_rest in picks[:2]:
-            va = _bare(validate, initial_state, SCREEN_SAMPLES)
-            vbic.append(_bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1,
-                             _fitted_samples(validate, initial_state)))
+        vbic = [_validate_bic(validate, initial_state, pick) for pick in picks[:2]]
         if vbic[1] >= vbic[0]:
             picks[1] = None
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
-    _, radii, _, at_rest = rest if rest[0] <= picks[2][0] else picks[2]
+    chosen = rest if rest[0] <= picks[2][0] else picks[2]
+    if not (ext and chosen[3]):
+        chosen = _topped(train, validate, initial_state, chosen, n_train)
+    _, radii, _, at_rest = chosen
     return radii, ext and at_rest, at_rest
+
+
+def _train_pick(train, grids, initial_state: str, at_rest: bool, n_train: int):
+    """``(train BIC, radii, coefficients, at_rest)`` of the grid in ``grids`` with the lowest
+    train BIC (None when ``grids`` is empty), each fitted by :func:`_plain_fit` on the records'
+    first ``SCREEN_SAMPLES`` samples and scored with the BIC of ``n_train`` samples."""
+    best = None
+    for radii in grids:
+        segs, ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)
+        coef = ne.solve()
+        bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1, n_train)
+        if best is None or bic < best[0]:
+            best = (bic, radii, coef, at_rest)
+    return best
+
+
+def _validate_bic(validate, initial_state: str, pick) -> float:
+    """The validate BIC of a pick of :func:`_train_pick` (its train fit, on the validate
+    records' first ``SCREEN_SAMPLES`` samples, with the BIC of their fitted samples)."""
+    _, radii, coef, at_rest = pick
+    va = _bare(validate, initial_state, SCREEN_SAMPLES)
+    return _bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1,
+                _fitted_samples(validate, initial_state))
+
+
+def _topped(train, validate, initial_state: str, chosen, n_train: int):
+    """``chosen`` (a pick of :func:`_train_pick`), or the topped grid (:func:`_topped_grids`,
+    the plays started as in ``chosen``) with the lowest train BIC when its validate BIC is
+    lower than ``chosen``'s."""
+    pick = _train_pick(train, _topped_grids(train), initial_state, chosen[3], n_train)
+    if pick is None:
+        return chosen
+    return pick if _validate_bic(validate, initial_state, pick) < \
+        _validate_bic(validate, initial_state, chosen) else chosen
 
 
 def _baseline(train, validate, initial_state) -> dict:
