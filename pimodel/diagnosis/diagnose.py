@@ -63,6 +63,7 @@ from threadpoolctl import threadpool_limits
 
 from ..records import Record
 from .chunked import NormalEquations
+from .coverage import coverage
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
@@ -134,7 +135,8 @@ class DiagnosisReport:
         radii uniform from 0 to the train input's largest magnitude, plays at rest at ``v[0]``,
         one offset; ``kind``, ``plays``, ``max_radius``, ``train`` and ``validate`` errors).
         :func:`diagnose` warns when the nominal's validate RMS exceeds ``BASELINE_WARN`` times
-        the baseline's.
+        the baseline's. ``coverage``: which plays each validate record drives on loops that
+        train moved only in its start-up or never (:func:`.coverage.coverage`).
     where : dict
         Where the nominal's validate residual lies (:mod:`.where`).
     candidates : list of dict
@@ -773,7 +775,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                     "train": _errors(whole[0], out_tr), "validate": before,
                     "initial_state": initial_state,
                     "baseline": baseline.result() if baseline is not None else
-                    _baseline(train, validate, initial_state)}
+                    _baseline(train, validate, initial_state),
+                    "coverage": coverage(train, validate)}
     base_rms = nominal_json["baseline"]["validate"]["rms"]
     if before["rms"] > BASELINE_WARN * base_rms:
         warnings.warn(f"nominal: validate RMS {before['rms']:.4g} is {before['rms'] / base_rms:.2f}"
