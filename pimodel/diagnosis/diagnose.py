@@ -559,8 +559,8 @@ def _one_above(train, validate, initial_state: str, half, extended, n_train: int
     fitted from it with one weight: on ramps to held levels at 500 Hz (4 s and 2 s records) a
     stage with a play at 1.05 ``h`` then validates to 0.0053 / 0.0094 um (0.108 / 0.092 um on
     every grid), and on the other 18 of 20 records (no play above ``h``, or one beyond ``reach``)
-    the train BIC rises with it (docs/diagnosis.md). Plays beyond ``reach`` never move in train: nothing
-    fits them."""
+    the train BIC rises with it (docs/diagnosis.md). Plays beyond ``reach`` never move in
+    train: nothing fits them."""
     if half is None or not half[3] or not _topped_grids(train):
         return None
     h = half[1][-1]
