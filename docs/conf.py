@@ -113,6 +113,7 @@ STRICT_MODULES = [
     "pimodel.diagnosis.filters",
     "pimodel.diagnosis.limits",
     "pimodel.diagnosis.checks",
+    "pimodel.diagnosis.coverage",
     "pimodel.diagnosis.feedforward",
     "pimodel.diagnosis",  # the package docstring
     "pimodel.diagnosis.effects",

@@ -172,3 +172,43 @@ def test_markdown_table_cells_round_trip(seed):
                 assert abs(float(g) - x) <= 5e-4 * abs(x)
             else:
                 assert g == x
+
+
+def test_validate_looping_plays_train_did_not_identify_is_named_unless_none():
+    """The extrapolation rule (issue 28, :mod:`pimodel.diagnosis.coverage`): a validate record
+    whose input spans more than the train input drives plays above half the train range on loops
+    (train moved them only in its start-up, or never); with a verdict other than ``none`` the
+    hint names the record, its share and the train range, it comes first (the next step), and the
+    confidence is ``unsure``; with ``none``, or a validate record within the train range, nothing
+    is said."""
+    from pimodel.diagnosis.coverage import coverage
+    from pimodel.records import Record
+
+    t = np.arange(2000) * 1e-3
+    tri = 2 / np.pi * np.arcsin(np.sin(2 * np.pi * 3 * t))  # +-1, 3 Hz, starts at 0
+    train = [Record(t, 1.0 + tri, np.zeros(t.size), source="tr")]
+    inside = Record(t, 1.0 + 0.9 * tri[::-1], np.zeros(t.size), source="inside")
+    wider = Record(t, 1.0 + np.where(t < 1.0, 0.5, 1.2) * tri, np.zeros(t.size), source="wider")
+    cov = coverage(train, [train[0], inside, wider])
+    assert cov["train_range"] == pytest.approx([0.0, 2.0]) and cov["half_range"] == \
+        pytest.approx(1.0)
+    same, ins, wid = cov["records"]
+    assert same["loops_above"] == ins["loops_above"] == 0.0 and same["first_loop_s"] is None
+    # the 1.2 amplitude from t = 1 s: plays above 1 move on its loops once it has spanned 2
+    assert 0.05 < wid["loops_above"] < 0.5 and 1.0 <= wid["first_loop_s"] < 1.5
+    assert wid["beyond_reach"] >= wid["loops_above"] > 0 and wid["range"][1] == \
+        pytest.approx(2.2)
+    for effects, covered, said in ((("drift",), [same, wid], True),
+                                   (("unexplained",), [wid], True),
+                                   (("none",), [wid], False), (("drift",), [same, ins], False)):
+        rep = _report(effects, ratio=1.5 if effects == ("drift",) else 6.0, share=0.5)
+        rep.nominal["coverage"] = dict(cov, records=covered)
+        named = [h for h in hints(rep) if "half the train input's range" in h]
+        assert bool(named) == said, (effects, named)
+        if said:
+            assert "wider" in named[0] and f"{100 * wid['loops_above']:.1f} %" in named[0]
+            assert "0 to 2" in named[0] and next_step(rep) == named[0]
+            assert confidence(rep)[0] == "unsure"
+        elif effects == ("drift",):
+            assert confidence(rep)[0] == "sure"
+    assert not any("half the train" in h for h in hints(_report(("drift",))))  # no coverage

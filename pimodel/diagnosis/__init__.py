@@ -24,6 +24,7 @@ Modules
     delaylike           whether a fitted dynamics acts as a pure delay
     noise               the measurement-noise floor of the records
     where               regions, bands and correlations of the residual
+    coverage            which plays validate drives on loops that train did not identify
     plots               the figures of a report
     summary             the report in words (verdict, how sure, where, next step) and report.md
     model               DiagnosedModel and DiagnosedInverse: the chosen model, batch forms

@@ -9,7 +9,8 @@ hysteresis whose radii lie off a coarse grid down to the noise. The plays start 
 ``v[0]``, or at 0 when the train BIC prefers it; records that travel further than half the range
 from ``v[0]`` also try the grid extended to that travel, kept when validate agrees (issue 33,
 :func:`_nominal`); train records of few samples also try grids topped below half the range,
-likewise kept when validate agrees (issue 28, :func:`_topped_grids`). A plain least-squares PI
+likewise kept when validate agrees (issue 28, :func:`_topped_grids`), and one play above half
+the range at a radius searched on train (:func:`_one_above`). A plain least-squares PI
 fit is reported beside it as a check (``nominal["baseline"]``), with a warning when the nominal
 is worse. Each candidate effect is
 refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are added greedily:
@@ -63,6 +64,7 @@ from threadpoolctl import threadpool_limits
 
 from ..records import Record
 from .chunked import NormalEquations
+from .coverage import coverage
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
@@ -96,6 +98,8 @@ GRID_SIZES = (20, 40, 80)  # nominal radius grids tried; the lowest train BIC is
 GRID_TOPS = (0.9, 0.8)  # with few train samples (_topped_grids), grids topped at these
 # fractions of half the train range are tried too, kept when validate agrees
 FEW_SAMPLES_PER_PLAY = 50  # few: fewer train samples than this per play of the finest grid
+ABOVE_POINTS = 40  # with few train samples, radii tried for one play above half the range
+ABOVE_MARGIN = 10.0  # ... kept when it lowers the train BIC by this much (and validate agrees)
 BASELINE_PLAYS = 60  # plays of the plain least-squares baseline (0 to max |v| of train)
 PROJECTED = 32  # principal directions of the play outputs kept beside the nominal's weights
 BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor of the baseline's
@@ -134,7 +138,8 @@ class DiagnosisReport:
         radii uniform from 0 to the train input's largest magnitude, plays at rest at ``v[0]``,
         one offset; ``kind``, ``plays``, ``max_radius``, ``train`` and ``validate`` errors).
         :func:`diagnose` warns when the nominal's validate RMS exceeds ``BASELINE_WARN`` times
-        the baseline's.
+        the baseline's. ``coverage``: which plays each validate record drives on loops that
+        train moved only in its start-up or never (:func:`.coverage.coverage`).
     where : dict
         Where the nominal's validate residual lies (:mod:`.where`).
     candidates : list of dict
@@ -508,7 +513,9 @@ def _nominal(train, validate, initial_state):
     (from ``v[0]`` the shared real record's validate gap was 0.154 um against 0.048 um noise).
     With few train samples, the topped grids (:func:`_topped_grids`, plays started as chosen)
     give the one with the lowest train BIC, kept in place of a half-range choice only when it
-    has the lower validate BIC (issue 28); the choice stays the grid with which every model
+    has the lower validate BIC (issue 28), and the half-range pick with one play above half the
+    range (:func:`_one_above`) takes the place of the half-range and extended picks when the
+    train BIC and validate agree; the choice stays the grid with which every model
     then runs, in discrete time as before (plays updated at each sample ``k`` from ``v[k]``)."""
     half, extended = _grids(train)
     if initial_state == "unknown":  # the start-up is not fitted: the plays at 0, as before
@@ -525,6 +532,9 @@ def _nominal(train, validate, initial_state):
         vbic = [_validate_bic(validate, initial_state, pick) for pick in picks[:2]]
         if vbic[1] >= vbic[0]:
             picks[1] = None
+    above = _one_above(train, validate, initial_state, picks[0], picks[1], n_train)
+    if above is not None:  # in place of the half-range grid and of the extension
+        picks[1] = above
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
     chosen = rest if rest[0] <= picks[2][0] else picks[2]
@@ -532,6 +542,40 @@ def _nominal(train, validate, initial_state):
         chosen = _topped(train, validate, initial_state, chosen, n_train)
     _, radii, _, at_rest = chosen
     return radii, ext and at_rest, at_rest
+
+
+def _one_above(train, validate, initial_state: str, half, extended, n_train: int):
+    """The half-range pick ``half`` (of :func:`_train_pick`, plays at rest) with one more play
+    above half the train input range ``h``, at the radius of ``ABOVE_POINTS`` uniform in
+    ``(h, reach]`` (``reach``: the train input's largest travel from its first sample) with the
+    lowest train BIC (issue 28); None unless the train records are few samples (as
+    :func:`_topped_grids`), the train BIC is lower than ``half``'s by ``ABOVE_MARGIN`` and the
+    validate BIC lower than that of ``half`` and of ``extended`` (the extension's pick, None
+    when not kept).
+
+    A play above ``h`` moves in train only in the start-up (once, from rest): a grid of such
+    plays (the extension) fits that one move with several weights, which then mispredict the
+    loops of a validate record that spans more than ``2 h``. One play at a searched radius is
+    fitted from it with one weight: on ramps to held levels at 500 Hz (4 s and 2 s records) a
+    stage with a play at 1.05 ``h`` then validates to 0.0053 / 0.0094 um (0.108 / 0.092 um on
+    every grid), and on the other 18 of 20 records (no play above ``h``, or one beyond ``reach``)
+    the train BIC rises with it (docs/diagnosis.md). Plays beyond ``reach`` never move in
+    train: nothing fits them."""
+    if half is None or not half[3] or not _topped_grids(train):
+        return None
+    h = half[1][-1]
+    reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
+    if reach <= h:
+        return None
+    grids = [np.append(half[1], r) for r in np.linspace(h, reach, ABOVE_POINTS + 1)[1:]]
+    pick = _train_pick(train, grids, initial_state, True, n_train)
+    if pick[0] > half[0] - ABOVE_MARGIN:
+        return None
+    vbic = _validate_bic(validate, initial_state, pick)
+    if any(vbic >= _validate_bic(validate, initial_state, p) for p in (half, extended)
+           if p is not None):
+        return None
+    return pick
 
 
 def _train_pick(train, grids, initial_state: str, at_rest: bool, n_train: int):
@@ -773,7 +817,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                     "train": _errors(whole[0], out_tr), "validate": before,
                     "initial_state": initial_state,
                     "baseline": baseline.result() if baseline is not None else
-                    _baseline(train, validate, initial_state)}
+                    _baseline(train, validate, initial_state),
+                    "coverage": coverage(train, validate)}
     base_rms = nominal_json["baseline"]["validate"]["rms"]
     if before["rms"] > BASELINE_WARN * base_rms:
         warnings.warn(f"nominal: validate RMS {before['rms']:.4g} is {before['rms'] / base_rms:.2f}"

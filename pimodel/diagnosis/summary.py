@@ -38,13 +38,27 @@ def _ratio(v: dict) -> float:
     return float(v.get("gap_after_over_noise", v["gap_after"] / max(v["noise_floor"], 1e-300)))
 
 
+def _extrapolated(rep) -> list[dict]:
+    """The validate records (``nominal["coverage"]["records"]``, :mod:`.coverage`) that drive
+    plays above half the train input's range on loops, when the verdict is not ``none``; a
+    report without ``coverage`` (older JSON) gives none."""
+    if rep.verdict["effects"] == ["none"]:
+        return []
+    cov = (getattr(rep, "nominal", None) or {}).get("coverage") or {}
+    return [dict(r, source=r["source"] or f"validate record {k}")
+            for k, r in enumerate(cov.get("records", [])) if r["loops_above"] > 0]
+
+
 def confidence(rep) -> tuple[str, str]:
     """How sure the verdict is: ``("sure" | "fairly sure" | "unsure", reason)``.
 
     ``sure``: the gap after the chosen model is within ``NEAR_NOISE`` times the noise floor
     and no other effect explains the gap as well (``verdict["alternatives"]`` empty);
     ``fairly sure``: at the noise but with alternatives, or a named effect with a residual
-    above the noise that is not ``unexplained``; ``unsure``: part of the gap is unexplained.
+    above the noise that is not ``unexplained``; ``unsure``: part of the gap is unexplained,
+    or (the verdict not ``none``) a validate record drives plays on loops that train moved
+    only in its start-up or never (``nominal["coverage"]``, :mod:`.coverage`): the gap may be
+    the nominal's extrapolation.
 
     Parameters
     ----------
@@ -68,6 +82,8 @@ def confidence(rep) -> tuple[str, str]:
     ratio = _ratio(v)
     alts = v.get("alternatives") or []
     at = f"the gap left is {ratio:.1f} times the noise floor"
+    if _extrapolated(rep):
+        return "unsure", f"{at}; validate drives plays train did not identify (see the hints)"
     if "unexplained" in v["effects"]:
         share = 100 * v["unexplained"].get("share", 0.0)
         return "unsure", f"{at}; {share:.0f} % of the gap's energy is unexplained"
@@ -90,7 +106,8 @@ def hints(rep) -> list[str]:
     Parameters
     ----------
     rep : DiagnosisReport
-        Uses ``verdict``, ``where`` and ``nominal["initial_state"]``.
+        Uses ``verdict``, ``where``, ``nominal["initial_state"]`` and ``nominal["coverage"]``
+        (when present).
 
     Returns
     -------
@@ -109,6 +126,20 @@ def hints(rep) -> list[str]:
     'the start-up region dominates '
     """
     v, out = rep.verdict, []
+    ext = _extrapolated(rep)
+    if ext:
+        cov = rep.nominal["coverage"]
+        a, b = cov["train_range"]
+        recs = "; ".join(f"{r['source']} (input {r['range'][0]:.4g} to "
+                         f"{r['range'][1]:.4g}) at {100 * r['loops_above']:.1f} % of its samples"
+                         f" from {r['first_loop_s']:.3g} s, plays train never moved at "
+                         f"{100 * r['beyond_reach']:.1f} %" for r in ext[:2])
+        out.append(f"validate drives plays of radius above half the train input's range "
+                   f"({cov['half_range']:.4g}; train input {a:.4g} to {b:.4g}) on loops: "
+                   f"{recs}; train identifies those plays by its start-up alone or not at all, "
+                   "so no model fitted on train is checked there and the gap may be the "
+                   "nominal's extrapolation, not an effect: record train over at least the "
+                   "validate input's range")
     top = _regions(rep.where, 2)
     start = [r for r in top if r["region"].startswith(STARTUP) and
              r["concentration"] >= DOMINANT]

@@ -1,0 +1,86 @@
+"""Which plays validate drives on loops that train moved only in its start-up or never (issue 28):
+where the nominal extrapolates.
+
+The plays are updated at each sample ``k`` from ``v[k]``:
+``z[k] = min(max(z[k-1], v[k] - r), v[k] + r)``, ``z[-1] = v[0]`` (at rest at the record's first
+sample). A play of radius ``r`` moves at ``k`` when ``|v[k] - z[k-1]| > r``, and when it does not,
+no larger play (started likewise) does. Once the input has spanned more than ``2 r``
+(``max(v[:k+1]) - min(v[:k+1]) > 2 r``) the play's state no longer depends on its start: its
+later moves are *loop* moves. With ``h`` half the train input range (the train records
+together), train moves the plays of radius up to ``h`` on loops; those above ``h`` only in a
+record's start-up (once, from the assumed rest) and those beyond the train input's largest
+travel from its first sample (``reach``) never: their output is ``v[0]``, one level with the
+offset. A validate record that spans more than ``2 h`` drives plays above ``h`` on loops; a
+stage with weight there is not identified by train, whatever the model fitted on it (measured
+on ramps to held levels at 500 Hz, clean stages: the records where the nominal misses validate
+by 0.07-0.34 um are those whose stage has plays above ``h``; docs/diagnosis.md).
+:func:`coverage` measures it; :func:`.summary.hints` and :func:`.summary.confidence` name it
+when the verdict is not ``none``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..operators.pi import PIOperator
+from ..records import Record
+
+__all__ = ["LOOP_TOL", "coverage"]
+
+LOOP_TOL = 1e-9  # plays "above h" are those above h (1 + LOOP_TOL): a validate record spanning
+# exactly the train range (to rounding) drives none on loops
+
+
+def _moves(v: np.ndarray, r: float) -> np.ndarray:
+    """Per sample, whether the play of radius ``r`` at rest at ``v[0]`` moves (False at k = 0)."""
+    z = PIOperator([1.0], [r], initial_state=float(v[0])).simulate(v)
+    m = np.zeros(v.size, bool)
+    m[1:] = z[1:] != z[:-1]
+    return m
+
+
+def coverage(train: list[Record], validate: list[Record]) -> dict:
+    """How much each validate record drives plays that train does not identify.
+
+    Parameters
+    ----------
+    train, validate : list of Record
+        The diagnosis' records (their inputs ``v`` and times ``t`` only).
+
+    Returns
+    -------
+    dict
+        ``train_range`` ``[min, max]`` of the train input, ``half_range`` (``h``, half its
+        span), ``reach`` (the train input's largest ``|v[k] - v[0]|`` over its records) and
+        ``records``: per validate record ``source``, ``range`` ``[min, max]``, ``loops_above``
+        (the share of its samples at which plays of radius above ``h`` move on loops: plays
+        train moved only in its start-up or never), ``beyond_reach`` (the share at which
+        plays above ``reach`` move, start-up included, the plays at rest at ``v[0]``: plays
+        train never moved) and ``first_loop_s`` (the time [s] from the record's start of the
+        first loop move above ``h``; None when none).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pimodel.records import Record
+    >>> t = np.arange(400) * 1e-3
+    >>> tr = Record(t, np.sin(2 * np.pi * 4 * t), np.zeros(400))
+    >>> va = Record(t, 1.5 * np.sin(2 * np.pi * 4 * t), np.zeros(400))
+    >>> [r["loops_above"] > 0 for r in coverage([tr], [tr, va])["records"]]
+    [False, True]
+    """
+    v_tr = np.concatenate([r.v for r in train])
+    h = float(np.ptp(v_tr)) / 2 * (1 + LOOP_TOL)
+    reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train) * (1 + LOOP_TOL)
+    out = []
+    for r in validate:
+        spanned = np.maximum.accumulate(r.v) - np.minimum.accumulate(r.v) > 2 * h
+        loops = _moves(r.v, h) & spanned
+        out.append({"source": r.source, "range": [float(r.v.min()), float(r.v.max())],
+                    "loops_above": float(loops.mean()),
+                    "beyond_reach": float(_moves(r.v, reach).mean()),
+                    "first_loop_s": float(r.t[np.argmax(loops)] - r.t[0]) if loops.any()
+                    else None})
+    return {"train_range": [float(v_tr.min()), float(v_tr.max())],
+            "half_range": float(np.ptp(v_tr)) / 2, "reach": reach / (1 + LOOP_TOL),
+            "records": out}
