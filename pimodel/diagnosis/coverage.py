@@ -25,10 +25,18 @@ import numpy as np
 from ..operators.pi import PIOperator
 from ..records import Record
 
-__all__ = ["LOOP_TOL", "coverage"]
+__all__ = ["LOOP_TOL", "coverage", "span_and_reach"]
 
 LOOP_TOL = 1e-9  # plays "above h" are those above h (1 + LOOP_TOL): a validate record spanning
 # exactly the train range (to rounding) drives none on loops
+
+
+def span_and_reach(train: list[Record]) -> tuple[float, float]:
+    """The train input's span ``max v - min v`` over its records together and its ``reach``,
+    the largest travel ``|v[k] - v[0]|`` of a record from its first sample (the nominal's grids,
+    :mod:`.diagnose`, and :func:`coverage` read both)."""
+    span = float(np.ptp(np.concatenate([r.v for r in train])))
+    return span, max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
 
 
 def _moves(v: np.ndarray, r: float) -> np.ndarray:
@@ -70,8 +78,8 @@ def coverage(train: list[Record], validate: list[Record]) -> dict:
     [False, True]
     """
     v_tr = np.concatenate([r.v for r in train])
-    h = float(np.ptp(v_tr)) / 2 * (1 + LOOP_TOL)
-    reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train) * (1 + LOOP_TOL)
+    span, reach = span_and_reach(train)
+    h, reach = span / 2 * (1 + LOOP_TOL), reach * (1 + LOOP_TOL)
     out = []
     for r in validate:
         spanned = np.maximum.accumulate(r.v) - np.minimum.accumulate(r.v) > 2 * h
@@ -82,5 +90,5 @@ def coverage(train: list[Record], validate: list[Record]) -> dict:
                     "first_loop_s": float(r.t[np.argmax(loops)] - r.t[0]) if loops.any()
                     else None})
     return {"train_range": [float(v_tr.min()), float(v_tr.max())],
-            "half_range": float(np.ptp(v_tr)) / 2, "reach": reach / (1 + LOOP_TOL),
+            "half_range": span / 2, "reach": reach / (1 + LOOP_TOL),
             "records": out}

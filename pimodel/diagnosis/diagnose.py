@@ -64,7 +64,7 @@ from threadpoolctl import threadpool_limits
 
 from ..records import Record
 from .chunked import NormalEquations
-from .coverage import coverage
+from .coverage import coverage, span_and_reach
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
@@ -467,12 +467,17 @@ def _grids(train) -> tuple[list[np.ndarray], list[np.ndarray]]:
     never cross to the other envelope), so the extension is informed by the records' start-up
     alone, where the stage's memory is an assumption (rest). Returns (half-range grids,
     extended grids; empty when no record travels that far)."""
-    span = float(np.ptp(np.concatenate([r.v for r in train])))
-    reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
+    span, reach = span_and_reach(train)
     step = span / 2 / (GRID_SIZES[0] - 1)  # the extension's spacing: the coarsest grid's
     extra = step * np.arange(1, int(np.ceil((reach - span / 2) / step)) + 1) + span / 2
     half = [np.linspace(0.0, span / 2, n) for n in GRID_SIZES]
     return half, [np.concatenate((h, extra)) for h in half] if extra.size else []
+
+
+def _few_samples(train: list[Record]) -> bool:
+    """Whether the train records hold fewer than ``FEW_SAMPLES_PER_PLAY`` samples per play of
+    the finest grid (counted over the whole records, start-up included)."""
+    return sum(len(r) for r in train) < FEW_SAMPLES_PER_PLAY * max(GRID_SIZES)
 
 
 def _topped_grids(train) -> list[np.ndarray]:
@@ -492,9 +497,9 @@ def _topped_grids(train) -> list[np.ndarray]:
     largest radius at 0.84-0.99 of ``S / 2`` misfits train little), so :func:`_nominal` keeps a
     topped grid only when validate agrees, as the extension. With more samples (every record
     of the ``sim_to_real`` study and the shared real record: at least 8275) none, as before."""
-    if sum(len(r) for r in train) >= FEW_SAMPLES_PER_PLAY * max(GRID_SIZES):
+    if not _few_samples(train):
         return []
-    span = float(np.ptp(np.concatenate([r.v for r in train])))
+    span, _ = span_and_reach(train)
     return [np.linspace(0.0, top * span / 2, n) for top in GRID_TOPS for n in GRID_SIZES]
 
 
@@ -549,7 +554,7 @@ def _one_above(train, validate, initial_state: str, half, extended, n_train: int
     above half the train input range ``h``, at the radius of ``ABOVE_POINTS`` uniform in
     ``(h, reach]`` (``reach``: the train input's largest travel from its first sample) with the
     lowest train BIC (issue 28); None unless the train records are few samples (as
-    :func:`_topped_grids`), the train BIC is lower than ``half``'s by ``ABOVE_MARGIN`` and the
+    :func:`_few_samples`), the train BIC is lower than ``half``'s by ``ABOVE_MARGIN`` and the
     validate BIC lower than that of ``half`` and of ``extended`` (the extension's pick, None
     when not kept).
 
@@ -561,10 +566,10 @@ def _one_above(train, validate, initial_state: str, half, extended, n_train: int
     every grid), and on the other 18 of 20 records (no play above ``h``, or one beyond ``reach``)
     the train BIC rises with it (docs/diagnosis.md). Plays beyond ``reach`` never move in
     train: nothing fits them."""
-    if half is None or not half[3] or not _topped_grids(train):
+    if half is None or not half[3] or not _few_samples(train):
         return None
     h = half[1][-1]
-    reach = max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
+    _, reach = span_and_reach(train)
     if reach <= h:
         return None
     grids = [np.append(half[1], r) for r in np.linspace(h, reach, ABOVE_POINTS + 1)[1:]]
