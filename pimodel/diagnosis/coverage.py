@@ -34,7 +34,18 @@ LOOP_TOL = 1e-9  # plays "above h" are those above h (1 + LOOP_TOL): a validate 
 def span_and_reach(train: list[Record]) -> tuple[float, float]:
     """The train input's span ``max v - min v`` over its records together and its ``reach``,
     the largest travel ``|v[k] - v[0]|`` of a record from its first sample (the nominal's grids,
-    :mod:`.diagnose`, and :func:`coverage` read both)."""
+    :mod:`.diagnose`, and :func:`coverage` read both).
+
+    Parameters
+    ----------
+    train : list of Record
+        The train records (their inputs ``v`` only).
+
+    Returns
+    -------
+    tuple of float
+        ``(span, reach)`` in input units.
+    """
     span = float(np.ptp(np.concatenate([r.v for r in train])))
     return span, max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
 
