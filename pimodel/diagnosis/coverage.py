@@ -45,6 +45,14 @@ def span_and_reach(train: list[Record]) -> tuple[float, float]:
     -------
     tuple of float
         ``(span, reach)`` in input units.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pimodel.records import Record
+    >>> t = np.arange(3) * 1e-3
+    >>> span_and_reach([Record(t, np.array([1.0, 0.0, 2.0]), np.zeros(3))])
+    (2.0, 1.0)
     """
     span = float(np.ptp(np.concatenate([r.v for r in train])))
     return span, max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
