@@ -20,6 +20,7 @@ __all__ = [
 
 STARTUP = "start-up"  # the start of the start-up region's name (pimodel.diagnosis.where)
 DOMINANT = 1.5  # a region dominates when its concentration is at least this
+STARTUP_MAJORITY = 0.5  # the start-up dominates outside the top two with this energy share
 NOTES = ("the noise floor is estimated", "each validate record sits")  # hints, not next steps
 NEAR_NOISE = 2.0  # the gap after is "at the noise" within this factor of the noise floor
 MEANING = {
@@ -141,8 +142,12 @@ def hints(rep) -> list[str]:
                    "nominal's extrapolation, not an effect: record train over at least the "
                    "validate input's range")
     top = _regions(rep.where, 2)
-    start = [r for r in top if r["region"].startswith(STARTUP) and
-             r["concentration"] >= DOMINANT]
+    # the start-up dominates when it is among the two most concentrated regions, or when it
+    # holds most of the residual (STARTUP_MAJORITY): regions inside it (fast input, ascending
+    # branches of its first sweep) can be more concentrated and rank above it (issue 28)
+    start = [r for r in rep.where.get("regions", []) if r["region"].startswith(STARTUP) and
+             r["concentration"] >= DOMINANT and
+             (r in top or r.get("energy_share", 0.0) >= STARTUP_MAJORITY)]
     if start and rep.nominal.get("initial_state", "rest") == "rest":
         r = start[0]
         out.append(f"the start-up region dominates ({100 * r['energy_share']:.0f} % of the "
