@@ -64,7 +64,7 @@ from threadpoolctl import threadpool_limits
 
 from ..records import Record
 from .chunked import NormalEquations
-from .coverage import coverage, span_and_reach
+from .coverage import coverage, informed_radii, span_and_reach
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
@@ -589,6 +589,7 @@ def _train_pick(train, grids, initial_state: str, at_rest: bool, n_train: int):
     first ``SCREEN_SAMPLES`` samples and scored with the BIC of ``n_train`` samples."""
     best = None
     for radii in grids:
+        radii = informed_radii(train, radii, at_rest)  # no play that moves by a sliver
         segs, ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)
         coef = ne.solve()
         bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1, n_train)
