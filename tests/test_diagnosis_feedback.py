@@ -56,3 +56,18 @@ def test_a_clean_stage_under_feedback_is_none(seed):
     assert nominal < 1.3 * truth.noise_um, nominal  # measured 1.02-1.10 (before: up to 113)
     assert nominal < 1.15 * rep.nominal["baseline"]["validate"]["rms"]
     assert rep.verdict["effects"] == ["none"], rep.verdict["effects"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("effect", ["drift", "asymmetry"])
+def test_an_effect_under_feedback_is_named(effect, seed):
+    """A drift (on the shared clock) or an asymmetric output map, the stage in closed loop:
+    named alone, most of the gap closed (measured on the 8 seeds: shrink 0.91-0.99, the gap
+    after 0.70-0.97 noise floors)."""
+    _, train, validate = records([effect], seed, FS, SCALE)
+    rep = _diagnose(train, validate)
+    v = rep.verdict
+    assert v["effects"] == [effect], v["effects"]
+    assert v["shrink"] > 0.8, v["shrink"]
+    assert v["gap_after"] < 1.5 * v["noise_floor"], (v["gap_after"], v["noise_floor"])
