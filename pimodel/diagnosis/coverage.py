@@ -116,7 +116,9 @@ def informed_radii(train: list[Record], radii: np.ndarray, at_rest: bool = True)
     travels ``d`` or more (the travel does not grow with the radius); plays that never move
     (travel 0: their output is ``v[0]``, one level with the offset, as before) are kept.
     On the ``sim_to_real`` study's records and the real splits the smallest positive travel of
-    a chosen grid's play is 2 spacings: none is left out there.
+    a chosen grid's play is 2 spacings (nothing left out of it; the chosen grids are the same
+    as before), and 183 of the 2811 grids compared there, all reaching above half the range,
+    lose a play that moves 0.03-1.0 spacings in a start-up.
 
     Parameters
     ----------
