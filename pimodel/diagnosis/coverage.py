@@ -115,10 +115,11 @@ def informed_radii(train: list[Record], radii: np.ndarray, at_rest: bool = True)
     move: it is left out. The grid is scanned from its top down to the first play that
     travels ``d`` or more (the travel does not grow with the radius); plays that never move
     (travel 0: their output is ``v[0]``, one level with the offset, as before) are kept.
-    On the ``sim_to_real`` study's records and the real splits the smallest positive travel of
-    a chosen grid's play is 2 spacings (nothing left out of it; the chosen grids are the same
-    as before), and 183 of the 2811 grids compared there, all reaching above half the range,
-    lose a play that moves 0.03-1.0 spacings in a start-up.
+    The nominal applies it to its grids up to ``S / 2`` only: on a grid that reaches above (the
+    extension, the one play above), plays that move only in a start-up are the point, and
+    cutting them there lost a clean band-limited stage at 500 Hz (nominal 0.015 um, the test
+    allows 0.0075; ``tests/test_diagnosis_inputs.py``). On the ``sim_to_real`` study's records
+    and the real splits the nominal's chosen grids are the same as before.
 
     Parameters
     ----------
