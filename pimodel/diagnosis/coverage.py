@@ -25,10 +25,11 @@ import numpy as np
 from ..operators.pi import PIOperator
 from ..records import Record
 
-__all__ = ["LOOP_TOL", "coverage", "span_and_reach"]
+__all__ = ["LOOP_TOL", "coverage", "informed_radii", "play_travel", "span_and_reach"]
 
 LOOP_TOL = 1e-9  # plays "above h" are those above h (1 + LOOP_TOL): a validate record spanning
 # exactly the train range (to rounding) drives none on loops
+TRAVEL_CHUNK = 1 << 20  # samples per pass of play_travel (no record-long play output is held)
 
 
 def span_and_reach(train: list[Record]) -> tuple[float, float]:
@@ -56,6 +57,102 @@ def span_and_reach(train: list[Record]) -> tuple[float, float]:
     """
     span = float(np.ptp(np.concatenate([r.v for r in train])))
     return span, max(float(np.max(np.abs(r.v - r.v[0]))) for r in train)
+
+
+def play_travel(train: list[Record], r: float, at_rest: bool = True) -> float:
+    """The largest travel of the play of radius ``r`` over the train records: ``max z - min z``
+    of its output ``z[-1..N-1]`` (``z[-1]``, the start, counted), the play at rest at ``v[0]``
+    (``at_rest``) or at 0, updated at each sample ``k`` from ``v[k]``.
+
+    Parameters
+    ----------
+    train : list of Record
+        The train records (their inputs ``v`` only).
+    r : float
+        The play's radius (input units), ``>= 0``.
+    at_rest : bool, optional
+        The play starts at rest at each record's ``v[0]`` (default) or at 0.
+
+    Returns
+    -------
+    float
+        The travel (input units), the largest over the records.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pimodel.records import Record
+    >>> t = np.arange(4) * 1e-3
+    >>> rec = Record(t, np.array([0.0, 1.0, -1.0, 1.0 + 1e-6]), np.zeros(4))
+    >>> [round(play_travel([rec], r), 6) for r in (0.5, 1.0)]  # the top play: a sliver
+    [1.000001, 1e-06]
+    """
+    travel = 0.0
+    for rec in train:
+        z = float(rec.v[0]) if at_rest else 0.0
+        lo = hi = z
+        op = PIOperator([1.0], [float(r)])
+        for k in range(0, rec.v.size, TRAVEL_CHUNK):
+            out, state = op.simulate(rec.v[k:k + TRAVEL_CHUNK], state=[z], return_state=True)
+            z = float(state[0])
+            lo, hi = min(lo, float(out.min())), max(hi, float(out.max()))
+        travel = max(travel, hi - lo)
+    return travel
+
+
+def informed_radii(train: list[Record], radii: np.ndarray, at_rest: bool = True) -> np.ndarray:
+    """``radii`` (a grid of spacing ``d = radii[1] - radii[0]``, ascending) without the top
+    plays whose train travel (:func:`play_travel`) is positive but below ``d``.
+
+    Such a play moves only by a sliver, in the start-up of a record whose input ends a little
+    further on one side of its first sample than ``S / 2`` (``S`` the train span): on a record
+    taken in closed loop, the controller's output starting at the centre of its range, the
+    half-range grid's top play (radius ``S / 2``) moves by 2e-6-6e-3 V (a grid spacing of
+    0.01 V), its least-squares weight is the noise (and any unmodelled effect) over that
+    sliver (-5958 um/V, measured) and a validate record that reaches a little further
+    mispredicts by tens of um (docs/diagnosis.md, "Records taken under feedback"). A play
+    within one grid spacing of never moving is, at the grid's resolution, one that does not
+    move: it is left out. The grid is scanned from its top down to the first play that
+    travels ``d`` or more (the travel does not grow with the radius); plays that never move
+    (travel 0: their output is ``v[0]``, one level with the offset, as before) are kept.
+    The nominal applies it to its grids up to ``S / 2`` only: on a grid that reaches above (the
+    extension, the one play above), plays that move only in a start-up are the point, and
+    cutting them there lost a clean band-limited stage at 500 Hz (nominal 0.015 um, the test
+    allows 0.0075; ``tests/test_diagnosis_inputs.py``). On the ``sim_to_real`` study's records
+    and the real splits the nominal's chosen grids are the same as before.
+
+    Parameters
+    ----------
+    train : list of Record
+        The train records.
+    radii : numpy.ndarray
+        The grid, ascending from 0, at least two radii.
+    at_rest : bool, optional
+        The plays start at rest at ``v[0]`` (default) or at 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        The radii kept, in order (``radii`` itself when none is left out).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pimodel.records import Record
+    >>> t = np.arange(4) * 1e-3
+    >>> rec = Record(t, np.array([0.0, 1.0, -1.0, 1.0 + 1e-6]), np.zeros(4))
+    >>> informed_radii([rec], np.linspace(0.0, 1.0, 5)).tolist()
+    [0.0, 0.25, 0.5, 0.75]
+    """
+    d = float(radii[1] - radii[0])
+    drop = []
+    for i in range(radii.size - 1, 0, -1):
+        travel = play_travel(train, float(radii[i]), at_rest)
+        if travel >= d:
+            break
+        if travel > 0:
+            drop.append(i)
+    return np.delete(radii, drop) if drop else radii
 
 
 def _moves(v: np.ndarray, r: float) -> np.ndarray:

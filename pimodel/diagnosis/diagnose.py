@@ -64,7 +64,7 @@ from threadpoolctl import threadpool_limits
 
 from ..records import Record
 from .chunked import NormalEquations
-from .coverage import coverage, span_and_reach
+from .coverage import coverage, informed_radii, span_and_reach
 from .creep import creep_law
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
@@ -585,10 +585,16 @@ def _one_above(train, validate, initial_state: str, half, extended, n_train: int
 
 def _train_pick(train, grids, initial_state: str, at_rest: bool, n_train: int):
     """``(train BIC, radii, coefficients, at_rest)`` of the grid in ``grids`` with the lowest
-    train BIC (None when ``grids`` is empty), each fitted by :func:`_plain_fit` on the records'
-    first ``SCREEN_SAMPLES`` samples and scored with the BIC of ``n_train`` samples."""
+    train BIC (None when ``grids`` is empty), each grid that ends at or below half the train
+    span without its top plays that move in train by a sliver (:func:`.coverage.informed_radii`:
+    less than one grid spacing; records taken under feedback, issue 28), fitted by
+    :func:`_plain_fit` on the records' first ``SCREEN_SAMPLES`` samples and scored with the BIC
+    of ``n_train`` samples."""
     best = None
+    half_top = span_and_reach(train)[0] / 2 * (1 + 1e-12)
     for radii in grids:
+        if radii[-1] <= half_top:  # no play that moves by a sliver, on grids up to S / 2
+            radii = informed_radii(train, radii, at_rest)
         segs, ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)
         coef = ne.solve()
         bic = _bic(segs, _plain_outputs(segs, radii, coef, at_rest), radii.size + 1, n_train)
