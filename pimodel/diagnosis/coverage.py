@@ -24,12 +24,12 @@ import numpy as np
 
 from ..operators.pi import PIOperator
 from ..records import Record
+from .effects import play_chunks
 
 __all__ = ["LOOP_TOL", "coverage", "informed_radii", "play_travel", "span_and_reach"]
 
 LOOP_TOL = 1e-9  # plays "above h" are those above h (1 + LOOP_TOL): a validate record spanning
 # exactly the train range (to rounding) drives none on loops
-TRAVEL_CHUNK = 1 << 20  # samples per pass of play_travel (no record-long play output is held)
 
 
 def span_and_reach(train: list[Record]) -> tuple[float, float]:
@@ -89,13 +89,9 @@ def play_travel(train: list[Record], r: float, at_rest: bool = True) -> float:
     """
     travel = 0.0
     for rec in train:
-        z = float(rec.v[0]) if at_rest else 0.0
-        lo = hi = z
-        op = PIOperator([1.0], [float(r)])
-        for k in range(0, rec.v.size, TRAVEL_CHUNK):
-            out, state = op.simulate(rec.v[k:k + TRAVEL_CHUNK], state=[z], return_state=True)
-            z = float(state[0])
-            lo, hi = min(lo, float(out.min())), max(hi, float(out.max()))
+        lo = hi = float(rec.v[0]) if at_rest else 0.0  # the start, z[-1]
+        for _, rows in play_chunks(rec.v, [float(r)], at_rest=at_rest):
+            lo, hi = min(lo, float(rows[0].min())), max(hi, float(rows[0].max()))
         travel = max(travel, hi - lo)
     return travel
 
