@@ -76,7 +76,10 @@ EXTRA_DAMPING_MAX = 0.25  # a heavily damped fast mode imitates a delay
 MODE_SEPARATION = 1.25  # the modes' frequencies differ by this factor at least
 LOWPASS_MIN_HZ = BASE_MIN_HZ  # slowest low-pass [Hz] (a real pole behind a 120-300 Hz mode)
 LOWPASS_GRID = 10
-ELEMENT_K = {"mode": 3, "lowpass": 2, "direct": 1}  # parameters each element adds
+# parameters each element adds; "lowpass_direct" (the low-pass sampled at the end of the hold,
+# its output at sample k moved by v[k]) is a form of the Wiener filter (module wiener), not
+# selected here
+ELEMENT_K = {"mode": 3, "lowpass": 2, "lowpass_direct": 2, "direct": 1}
 # the kinds the selection tries (the forward form and the inverse accept every kind): a direct
 # term beside the modes imitates a fractional delay; a low-pass is the real pole that a mode
 # alone cannot follow (on density_stage's mode + pole, the one-mode candidate lost to `delay`
@@ -136,7 +139,11 @@ def element_coefficients(element: Sequence, dt: float) -> tuple[np.ndarray, np.n
     Parameters
     ----------
     element : sequence
-        ``("mode", fn [Hz], zeta)``, ``("lowpass", tau [s])`` or ``("direct",)``.
+        ``("mode", fn [Hz], zeta)``, ``("lowpass", tau [s])``, ``("lowpass_direct", tau [s])``
+        or ``("direct",)``. ``"lowpass_direct"`` is the low-pass of ``"lowpass"`` with its
+        output sampled at the end of each hold instead of its start, ``x[k] = a x[k-1] +
+        (1 - a) v[k]``, ``a = exp(-dt / tau)``: the ZOH low-pass advanced one sample (an
+        amplifier whose output the sensor samples just before the next update).
     dt : float
         Sample time [s].
 
@@ -156,6 +163,9 @@ def element_coefficients(element: Sequence, dt: float) -> tuple[np.ndarray, np.n
     >>> b, a = element_coefficients(("lowpass", 1e-3), 1e-3)
     >>> np.round(b, 4).tolist(), np.round(a, 4).tolist()
     ([0.0, 0.6321], [1.0, -0.3679])
+    >>> b, a = element_coefficients(("lowpass_direct", 1e-3), 1e-3)
+    >>> np.round(b, 4).tolist(), np.round(a, 4).tolist()
+    ([0.6321], [1.0, -0.3679])
     >>> b, a = element_coefficients(("mode", 100.0, 0.1), 1e-4)
     >>> round(float(b.sum() / a.sum()), 9)  # unit static gain
     1.0
@@ -166,6 +176,9 @@ def element_coefficients(element: Sequence, dt: float) -> tuple[np.ndarray, np.n
     if kind == "lowpass":
         a1 = np.exp(-dt / float(element[1]))
         return np.array([0.0, 1.0 - a1]), np.array([1.0, -a1])
+    if kind == "lowpass_direct":
+        a1 = np.exp(-dt / float(element[1]))
+        return np.array([1.0 - a1]), np.array([1.0, -a1])
     return mode_coefficients(float(element[1]), float(element[2]), dt)
 
 

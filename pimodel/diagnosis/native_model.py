@@ -104,7 +104,7 @@ def lti_coefficients(model) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 _FORMS = {"mode": "('mode', fn > 0 [Hz], zeta > 0)", "lowpass": "('lowpass', tau > 0 [s])",
-          "direct": "('direct',)"}
+          "lowpass_direct": "('lowpass_direct', tau > 0 [s])", "direct": "('direct',)"}
 
 
 def _section(element, dt: float, name: str, kinds=ELEMENT_K) -> tuple[np.ndarray, np.ndarray]:
@@ -117,7 +117,8 @@ def _section(element, dt: float, name: str, kinds=ELEMENT_K) -> tuple[np.ndarray
         values = [float(x) for x in element[1:]]
     except (TypeError, ValueError, IndexError):
         raise ValueError(f"params: {name} = {element!r}: {expected}") from None
-    if (kind not in kinds or len(values) != {"mode": 2, "lowpass": 1, "direct": 0}[kind]
+    if (kind not in kinds or len(values) != {"mode": 2, "lowpass": 1, "lowpass_direct": 1,
+                                             "direct": 0}[kind]
             or not all(math.isfinite(x) and x > 0 for x in values)):
         raise ValueError(f"params: {name} = {element!r}: {expected}")
     b, a = element_coefficients((kind, *values), dt)

@@ -9,17 +9,23 @@ effects' columns are still built from the nominal hysteresis ``h0`` of ``v``. ``
 element (:func:`pimodel.diagnosis.lti.element_coefficients`):
 
 - ``("lowpass", tau)``: a first-order low-pass ``1 / (tau s + 1)`` [s] (1 parameter);
+- ``("lowpass_direct", tau)``: the same low-pass sampled at the end of each hold,
+  ``x[k] = a x[k-1] + (1 - a) v[k]`` (``a = exp(-dt / tau)``; 1 parameter): the ZOH form
+  advanced one sample, as when the sensor samples the stage just before the next update;
 - ``("mode", fn, zeta)``: ``w^2 / (s^2 + 2 zeta w s + w^2)`` [Hz, -]; a damping of 1 or more
   is a second-order low-pass with real poles (2 parameters).
 
-``x[k]`` depends on ``v[0..k-1]`` (both elements are strictly proper under the hold), so the
-output ``y[k]`` does too. Because the play outputs of ``F[v]`` are no linear function of the
-filter's parameters, every point of the search runs the plays again (:class:`WienerBasis`).
+``x[k]`` depends on ``v[0..k-1]`` for ``"lowpass"`` and ``"mode"`` (strictly proper under the
+hold), on ``v[0..k]`` for ``"lowpass_direct"``; the output ``y[k]`` likewise. Because the play
+outputs of ``F[v]`` are no linear function of the filter's parameters, every point of the
+search runs the plays again (:class:`WienerBasis`).
 
-Selection (:func:`search_filter`): both kinds on a coarse grid (``LOWPASS_HZ``, ``MODE_HZ`` x
-``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual, and the kind
-with the lower train BIC ``N ln(RSS / N) + k ln N`` kept; the candidate then keeps this Wiener
-variant when its train BIC is lower than that of the Hammerstein variant (:mod:`.lti`), with
+Selection (:func:`search_filter`): every kind on a coarse grid (the low-passes' corners
+``LOWPASS_SLOW_HZ`` from ``LOWPASS_MIN_HZ``, then ``LOWPASS_HZ`` points from ``MIN_HZ``;
+``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual,
+and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the candidate then
+keeps this Wiener variant when its train BIC is lower than that of the Hammerstein variant
+(:mod:`.lti`), with
 ``k`` counted the same way (2 for the base mode plus 3 per further mode there; 1 or 2 here).
 The position is decided on the ``dynamics`` candidate alone and held when it is fitted beside
 other effects (:func:`position_hint`).
@@ -45,16 +51,21 @@ from .threads import drop_threads, per_thread
 __all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "inverse_sections",
            "polish_filter", "position_hint", "prefilter", "search_filter", "wiener_k"]
 
-MIN_HZ = 50.0  # slowest corner or mode [Hz] (a slower filter moves every loop of the record)
+MIN_HZ = 50.0  # slowest mode [Hz] (a slower filter moves every loop of the record)
+LOWPASS_MIN_HZ = 15.0  # slowest low-pass corner [Hz]: an amplifier's bandwidth of 20-50 Hz
 LOWPASS_HZ = 8  # points of the low-pass grid, geometric from MIN_HZ to the highest frequency
+LOWPASS_SLOW_HZ = (15.0, 22.0, 33.0)  # and these below MIN_HZ
+LOWPASS_KINDS = ("lowpass", "lowpass_direct")  # the two samplings of the first-order low-pass
 MODE_HZ = 6  # points of the mode grid, likewise
 MODE_DAMPING = (0.1, 0.4, 1.0)
 GATE = 8.0  # refine a kind only when its grid comes within this factor of the RSS to beat
 DAMPING_RANGE = (0.02, 2.0)  # bounds of the refined damping
-REFINE_EVALUATIONS = {"lowpass": 12, "mode": 60}  # Nelder-Mead budget per kind (leading columns)
-POLISH_EVALUATIONS = {"lowpass": 10, "mode": 20}  # then with every column, when it is kept
+REFINE_EVALUATIONS = {"lowpass": 12, "lowpass_direct": 12, "mode": 60}  # Nelder-Mead budget per
+# kind (leading columns)
+POLISH_EVALUATIONS = {"lowpass": 10, "lowpass_direct": 10, "mode": 20}  # then with every
+# column, when it is kept
 KEPT_COLUMNS = 4  # play-output matrices a WienerBasis keeps (the latest)
-ELEMENT_K = {"lowpass": 1, "mode": 2}
+ELEMENT_K = {"lowpass": 1, "lowpass_direct": 1, "mode": 2}
 KEYS = ("wiener",)  # the grid key of the Wiener variant (its filter elements)
 
 
@@ -74,14 +85,16 @@ def prefilter(v: np.ndarray, elements: Sequence, dt: float) -> np.ndarray:
     v : numpy.ndarray
         Input ``v[k]``.
     elements : sequence
-        ``("lowpass", tau [s])`` or ``("mode", fn [Hz], zeta)`` (module docstring).
+        ``("lowpass", tau [s])``, ``("lowpass_direct", tau [s])`` or ``("mode", fn [Hz],
+        zeta)`` (module docstring).
     dt : float
         Sample time [s].
 
     Returns
     -------
     numpy.ndarray
-        ``x[k]``, units of ``v``; ``x[k]`` depends on ``v[0..k-1]``.
+        ``x[k]``, units of ``v``; ``x[k]`` depends on ``v[0..k-1]`` (on ``v[0..k]`` with a
+        ``"lowpass_direct"``).
 
     Raises
     ------
@@ -93,6 +106,8 @@ def prefilter(v: np.ndarray, elements: Sequence, dt: float) -> np.ndarray:
     >>> x = prefilter(np.r_[0.0, np.ones(4)], [("lowpass", 1e-3)], 1e-3)
     >>> np.round(x, 4).tolist()
     [0.0, 0.0, 0.6321, 0.8647, 0.9502]
+    >>> np.round(prefilter(np.r_[0.0, np.ones(4)], [("lowpass_direct", 1e-3)], 1e-3), 4).tolist()
+    [0.0, 0.6321, 0.8647, 0.9502, 0.9817]
     """
     x = np.asarray(v, float)
     for el in elements:
@@ -134,8 +149,9 @@ def describe_wiener(elements: Sequence) -> dict:
     -------
     dict
         ``dynamics_position`` (``"before"``), ``wiener_elements`` (JSON lists),
-        ``dynamics_order`` (the filter's order), and ``lowpass_hz`` (a low-pass's corner) or
-        ``dynamics_modes`` (a mode's ``hz`` and ``damping``).
+        ``dynamics_order`` (the filter's order), and ``lowpass_hz`` (a low-pass's corner) with
+        ``lowpass_sampling`` (``"start"`` or ``"end of hold"``) or ``dynamics_modes`` (a
+        mode's ``hz`` and ``damping``).
 
     Examples
     --------
@@ -145,10 +161,11 @@ def describe_wiener(elements: Sequence) -> dict:
     """
     out: dict = {"dynamics_position": "before",
                  "wiener_elements": [[e[0], *(float(x) for x in e[1:])] for e in elements],
-                 "dynamics_order": sum(1 if _check(e) == "lowpass" else 2 for e in elements)}
+                 "dynamics_order": sum(1 if _check(e) in LOWPASS_KINDS else 2 for e in elements)}
     for e in elements:
-        if e[0] == "lowpass":
+        if e[0] in LOWPASS_KINDS:
             out["lowpass_hz"] = 1.0 / (2 * np.pi * float(e[1]))
+            out["lowpass_sampling"] = "end of hold" if e[0] == "lowpass_direct" else "start"
         else:
             out.setdefault("dynamics_modes", []).append({"hz": float(e[1]),
                                                          "damping": float(e[2])})
@@ -238,17 +255,19 @@ class WienerBasis:
 
 
 def _admissible(element, fmax: float) -> bool:
-    if element[0] == "lowpass":
-        return MIN_HZ <= 1.0 / (2 * np.pi * element[1]) <= fmax
+    if element[0] in LOWPASS_KINDS:
+        return LOWPASS_MIN_HZ <= 1.0 / (2 * np.pi * element[1]) <= fmax
     return MIN_HZ <= element[1] <= fmax and DAMPING_RANGE[0] <= element[2] <= DAMPING_RANGE[1]
 
 
 def _grid(fmax: float) -> dict:
-    lp = [("lowpass", float(1 / (2 * np.pi * f))) for f in np.geomspace(MIN_HZ, fmax,
+    corners = [*(f for f in LOWPASS_SLOW_HZ if f < MIN_HZ), *np.geomspace(MIN_HZ, fmax,
                                                                           LOWPASS_HZ)]
-    modes = [("mode", float(f), z) for f in np.geomspace(2 * MIN_HZ, fmax, MODE_HZ)
-             for z in MODE_DAMPING]
-    return {"lowpass": lp, "mode": modes}
+    out = {kind: [(kind, float(1 / (2 * np.pi * f))) for f in corners]
+           for kind in LOWPASS_KINDS}
+    out["mode"] = [("mode", float(f), z) for f in np.geomspace(2 * MIN_HZ, fmax, MODE_HZ)
+                   for z in MODE_DAMPING]
+    return out
 
 
 def search_filter(rss_of: Callable, fmax: float, n: int,
@@ -320,7 +339,7 @@ def _refine(rss_of: Callable, el0: tuple, rss0: float, fmax: float, maxfev: int,
         el = (kind, *(float(u) for u in np.exp(x)))
         return rss_of((el,)) if _admissible(el, fmax) else np.inf
 
-    step = [steps[0]] if kind == "lowpass" else [0.5 * steps[0], steps[1]]
+    step = [steps[0]] if kind in LOWPASS_KINDS else [0.5 * steps[0], steps[1]]
     simplex = [x0] + [x0 + np.eye(x0.size)[i] * s for i, s in enumerate(step)]
     r = nelder_mead(cost, x0, initial_simplex=simplex, xatol=1e-4, fatol=1e-7 * rss0,
                     maxfev=maxfev)
@@ -332,7 +351,9 @@ def _refine(rss_of: Callable, el0: tuple, rss0: float, fmax: float, maxfev: int,
 def polish_filter(rss_of: Callable, elements: tuple, rss: float,
                   fmax: float) -> tuple[tuple, float]:
     """A short Nelder-Mead polish of a filter found by :func:`search_filter` (which scores
-    with the leading play columns only) on the fit with every column.
+    with the leading play columns only) on the fit with every column; a low-pass is also
+    polished in its other sampling (``"lowpass"``, ``"lowpass_direct"``) from the same corner,
+    the lower RSS kept.
 
     Parameters
     ----------
@@ -362,6 +383,16 @@ def polish_filter(rss_of: Callable, elements: tuple, rss: float,
     """
     el, rss = _refine(rss_of, tuple(elements[0]), rss, fmax,
                       POLISH_EVALUATIONS[elements[0][0]], (0.03, 0.1))
+    if el[0] in LOWPASS_KINDS:
+        # the other sampling of the low-pass from the same corner: on the leading columns of
+        # the search the two differ little (a sample of lag against a slightly faster
+        # corner), with every column the right one fits to the noise (bw49: a 108 Hz
+        # amplifier sampled at the end of the hold kept as a 124 Hz ZOH low-pass)
+        other = (LOWPASS_KINDS[el[0] == "lowpass"], el[1])
+        el2, rss2 = _refine(rss_of, other, rss_of((other,)), fmax,
+                            POLISH_EVALUATIONS[other[0]], (0.03, 0.1))
+        if rss2 < rss:
+            el, rss = el2, rss2
     return (el,), rss
 
 
@@ -417,10 +448,11 @@ def inverse_sections(elements: Sequence, dt: float) -> np.ndarray | None:
     >>> sos.shape, round(float(np.sum(sos[0, :3]) / np.sum(sos[0, 3:])), 12)
     ((1, 6), 1.0)
     """
-    poles = []
+    poles, advanced = [], 0
     for e in elements:
-        if _check(e) == "lowpass":
+        if _check(e) in LOWPASS_KINDS:
             poles.append(np.array([-1.0 / float(e[1])]))
+            advanced += e[0] == "lowpass_direct"
         else:
             w, z = 2 * np.pi * float(e[1]), float(e[2])
             poles.append(np.roots([1.0, 2 * z * w, w * w]))
@@ -430,7 +462,10 @@ def inverse_sections(elements: Sequence, dt: float) -> np.ndarray | None:
     wf = INVERSE_FILTER * float(np.max(np.abs(p)))
     p_inv = np.full(p.size, -wf)
     k = float(np.real(np.prod(-p_inv) / np.prod(-p)))  # static gain 1
-    return zpk2sos(*bilinear_zpk(p, p_inv, k, fs=1.0 / dt))
+    sos = zpk2sos(*bilinear_zpk(p, p_inv, k, fs=1.0 / dt))
+    # a "lowpass_direct" is the ZOH form advanced one sample: a sample of delay in its inverse
+    # (a section z^-1), which the inverse's one-sample advance then cancels
+    return np.vstack([sos] + [[0.0, 1.0, 0.0, 1.0, 0.0, 0.0]] * advanced)
 
 
 def inverse_prefilter(x: np.ndarray, elements: Sequence, dt: float) -> np.ndarray:
