@@ -141,7 +141,8 @@ def test_block_errors():
 
 WIENER = {"lowpass": [["lowpass", 1 / (2 * np.pi * 60.0)]],
           "mode": [["mode", 90.0, 0.4]],
-          "lowpass+mode": [["lowpass", 1 / (2 * np.pi * 150.0)], ["mode", 90.0, 1.2]]}
+          "lowpass+mode": [["lowpass", 1 / (2 * np.pi * 150.0)], ["mode", 90.0, 1.2]],
+          "lowpass_direct": [["lowpass_direct", 1 / (2 * np.pi * 60.0)]]}
 
 
 def wiener_model(elements, effects=()) -> DiagnosedModel:
@@ -156,9 +157,9 @@ def wiener_model(elements, effects=()) -> DiagnosedModel:
 
 
 @pytest.mark.parametrize(("kind", "effects", "latency"), [
-    ("lowpass", (), 1), ("mode", ("creep",), 1), ("lowpass+mode", ("delay",), 4),
-    ("mode", ("delay", "asymmetry"), 4)], ids=lambda x: "+".join(x) if isinstance(x, tuple)
-    else str(x))
+    ("lowpass", (), 1), ("lowpass_direct", ("creep",), 1), ("mode", ("creep",), 1),
+    ("lowpass+mode", ("delay",), 4), ("mode", ("delay", "asymmetry"), 4)],
+    ids=lambda x: "+".join(x) if isinstance(x, tuple) else str(x))
 def test_wiener_block_equals_simulate_delayed_by_its_latency(kind, effects, latency):
     """The solver gives the filter's output, the inverse filter's sections the input; the
     batch's one-sample advance of that filter is one more sample of latency."""

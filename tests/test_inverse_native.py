@@ -76,6 +76,9 @@ CASES = {
     # a filter before the hysteresis (a Wiener model): its inverse's post sections
     "wiener_lowpass": (("dynamics",), {"dynamics_position": "before",
                                        "wiener_elements": [["lowpass", 1 / (2 * np.pi * 60)]]}),
+    "wiener_lowpass_direct": (("dynamics", "creep"),
+                              {"dynamics_position": "before",
+                               "wiener_elements": [["lowpass_direct", 1 / (2 * np.pi * 40)]]}),
     "wiener_two_delay_creep": (("dynamics", "delay", "creep"),
                                {"dynamics_position": "before",
                                 "wiener_elements": [["lowpass", 1 / (2 * np.pi * 150)],

@@ -46,6 +46,9 @@ FILTERS = {  # elements of the filter before the plays
     "mode_critical": [["mode", 30.0, 1.0]],
     "mode_overdamped": [["mode", 30.0, 1.6]],
     "lowpass_then_mode": [["lowpass", 3e-3], ["mode", 40.0, 0.4]],
+    # sampled at the end of the hold: x[k] moves with v[k] (direct feedthrough)
+    "lowpass_direct": [["lowpass_direct", 4e-3]],
+    "lowpass_direct_then_mode": [["lowpass_direct", 3e-3], ["mode", 40.0, 0.4]],
 }
 OTHER_EFFECTS = {
     "creep_lag_gains": [0.04, -0.01], "creep_time_constants_s": [0.003, 0.03],
@@ -170,7 +173,8 @@ def test_bad_filters_are_named(filt, message):
 @pytest.mark.parametrize(("case", "effects", "family"),
                          [("mode_underdamped", ("dynamics",), "weight"),
                           ("lowpass_then_mode", ALL, "weight"),
-                          ("mode_overdamped", ALL, "radius")])
+                          ("mode_overdamped", ALL, "radius"),
+                          ("lowpass_direct_then_mode", ALL, "weight")])
 def test_unit_equals_simulate(built_fmus, fmi, case, effects, family):
     m = model(case, effects, family)
     name, params = fmu_parameters(m)
