@@ -46,6 +46,17 @@ def test_the_top_play_that_moves_by_a_sliver_is_left_out():
     assert np.array_equal(informed_radii([train], far), np.delete(far, radii.size - 1))
 
 
+@pytest.mark.parametrize("radii", [[0.5], [], [[0.0, 0.5]], [0.0, 0.5, 0.5], [0.5, 0.0],
+                                   [0.0, np.nan], [-0.5, 0.0, 0.5]],
+                         ids=["one", "none", "2-D", "repeated", "descending", "nan", "negative"])
+def test_a_grid_that_is_not_one_is_named(radii):
+    from pimodel.diagnosis.coverage import informed_radii
+
+    _, train, _ = records([], SEEDS[0], FS, SCALE)
+    with pytest.raises(ValueError, match=r"radii: expected a 1-D grid of at least two"):
+        informed_radii([train], radii)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", SEEDS)
 def test_a_clean_stage_under_feedback_is_none(seed):

@@ -131,6 +131,11 @@ def informed_radii(train: list[Record], radii: np.ndarray, at_rest: bool = True)
     numpy.ndarray
         The radii kept, in order (``radii`` itself when none is left out).
 
+    Raises
+    ------
+    ValueError
+        ``radii`` is not a 1-D grid of at least two finite radii, ascending from 0 or above.
+
     Examples
     --------
     >>> import numpy as np
@@ -140,6 +145,11 @@ def informed_radii(train: list[Record], radii: np.ndarray, at_rest: bool = True)
     >>> informed_radii([rec], np.linspace(0.0, 1.0, 5)).tolist()
     [0.0, 0.25, 0.5, 0.75]
     """
+    radii = np.asarray(radii, dtype=float)
+    if (radii.ndim != 1 or radii.size < 2 or not np.all(np.isfinite(radii)) or radii[0] < 0
+            or np.any(np.diff(radii) <= 0)):
+        raise ValueError(f"radii: expected a 1-D grid of at least two finite radii, ascending "
+                         f"from 0 or above, got {np.array2string(radii, threshold=8)}")
     d = float(radii[1] - radii[0])
     drop = []
     for i in range(radii.size - 1, 0, -1):
