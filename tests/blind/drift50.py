@@ -1,4 +1,4 @@
-"""The blind generator's creep-bearing cases (drift50; docs/drift50-notes.md): one JSON line per
+"""The blind generator's creep-bearing cases (drift50; docs/notes/drift50.md): one JSON line per
 case and variant appended to ``OUT``.
 
 Generator variants (how ``stage48``'s creep starts; ``h[k]`` the plays' output before the
