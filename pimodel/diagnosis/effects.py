@@ -408,6 +408,10 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     as the slices of its whole blocks, so the same sums. With a pool lent to the caller
     (module threads), idle threads make some chunks' terms of whole blocks; every sum is
     still taken in the chunks' order (:func:`_per_chunk`)."""
+    memo = _fit_memo(features, train)
+    if memo is not None and memo[1] is not None:  # this fit made before: its coefficients
+        coef, rss = memo[1]
+        return Model(name, k, features, coef.copy(), params or {}), rss
     blocks = [None if is_streamed(s) else _row_parts(features, s) for s in train]
     ne = None
     for P, s in zip(blocks, train, strict=True):
@@ -422,7 +426,56 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     for P, s in zip(blocks, train, strict=True):
         for r in _per_chunk(features, P, s, lambda j, c, Pc, s=s: _chunk_rss(Pc, s, c, coef)):
             rss += r  # summed in the chunks' order, whichever thread made each
+    if memo is not None:
+        memo[0][memo[2]] = (memo[3], (coef.copy(), rss))
     return Model(name, k, features, coef, params or {}), rss
+
+
+_FIT_MEMO_LOCK = threading.Lock()  # guards the memos of _fit_memo (module threads)
+
+
+def _fit_memo(features, train) -> tuple | None:
+    """The memo of :func:`_fit` for a candidate's regressors (:func:`_combo_features`: the
+    effects, the grid point and the play columns name them) on the train segments ``train``:
+    ``(memo, (coef, rss) or None, key, weak references to train)``; None for other builders,
+    grid points it cannot name exactly, or streamed segments. A search revisits points (a
+    polish's optimum fitted again as the search's result, the confirmation of the screen's
+    best, the same combination asked for by the rounds, the revision and the lag's re-search):
+    the same regressors on the same segments give the same sums in the same order, so the
+    coefficients and RSS kept are those a second pass makes, to the bit. Kept on the
+    ``nominal`` the regressors are built from (one per diagnosis, a new one for each refined
+    or asymmetry reference), by the segments' identity (weak references checked, so a segment
+    freed and another at its address is not taken for it)."""
+    recipe = getattr(features, "recipe", None)
+    if recipe is None or any(is_streamed(s) for s in train):
+        return None
+    nominal, exact = recipe
+    if exact is None:
+        return None
+    key = (exact, tuple(id(s) for s in train))
+    with _FIT_MEMO_LOCK:
+        memo = nominal.__dict__.setdefault("_fit_memo", {})
+        kept = memo.get(key)
+    if kept is not None and all(r() is s for r, s in zip(kept[0], train, strict=True)):
+        return memo, kept[1], key, kept[0]
+    return memo, None, key, [weakref.ref(s) for s in train]
+
+
+def _exact(x):
+    """``x`` (a grid point's value) as a hashable key that tells apart every value and type
+    (floats by ``repr``, which round-trips their bits; arrays by their bytes); None when ``x``
+    holds anything else."""
+    if isinstance(x, dict):
+        items = tuple((k, _exact(v)) for k, v in sorted(x.items()))
+        return None if any(v is None for _, v in items) else ("dict", items)
+    if isinstance(x, (tuple, list)):
+        items = tuple(_exact(v) for v in x)
+        return None if any(v is None for v in items) else (type(x).__name__, items)
+    if x is None or isinstance(x, (bool, int, float, str, np.generic)):
+        return (type(x).__name__, repr(x))
+    if isinstance(x, np.ndarray):
+        return ("ndarray", x.dtype.str, x.shape, x.tobytes())
+    return None
 
 
 def _per_chunk(features, P: tuple | None, s: Segment, fn: Callable) -> Iterable:
@@ -1200,6 +1253,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                             len(static["train"]))
 
     feats.parts = rows
+    feats.recipe = (nominal, _exact((tuple(effects), p, ncols)))  # names the regressors (_fit_memo)
     feats.parts_chunks = parts_chunks
     feats.stacked_times = lambda s, coef: stacked_times(parts_chunks, feats, s, coef)
     feats.release = release

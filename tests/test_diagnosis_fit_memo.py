@@ -1,0 +1,71 @@
+"""The candidates' least-squares fits are made once per grid point
+(:func:`pimodel.diagnosis.effects._fit_memo`): a point fitted again gives the same coefficients
+and RSS to the bit without a pass over the records, and any other point, column count, nominal
+or record is fitted anew."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pimodel.diagnosis.effects import (
+    TrainRecords,
+    _combo_features,
+    _fit,
+    fit_nominal,
+    make_segment,
+)
+from pimodel.stages.pi_stage import excitation, random_truth
+
+
+def _segments(seed: int = 1):
+    truth = random_truth(["dynamics"], 0)
+    t, v = excitation("train", seed=seed)
+    rec = truth.record(t, v, seed)
+    return [make_segment(rec.t, rec.v, rec.y, np.linspace(0.0, np.ptp(v) / 2, 20))]
+
+
+def _counted(effects, p, nominal, static, ncols=None):
+    """The regressors of :func:`_combo_features` and a count of the passes that build them."""
+    feats = _combo_features(effects, p, nominal, static, ncols)
+    calls = [0]
+    rows = feats.parts
+
+    def parts(s):
+        calls[0] += 1
+        return rows(s)
+
+    feats.parts = parts
+    return feats, calls
+
+
+def test_a_point_fitted_again_is_taken_from_the_memo_to_the_bit():
+    train = _segments()
+    nominal = fit_nominal(train)
+    p = {"fn": 800.0, "zeta": 0.1}
+    first, calls1 = _counted(("dynamics",), dict(p), nominal, {"train": TrainRecords(train)})
+    m1, rss1 = _fit("dynamics", 2, first, train, dict(p))
+    again, calls2 = _counted(("dynamics",), dict(p), nominal, {"train": TrainRecords(train)})
+    m2, rss2 = _fit("dynamics", 2, again, train, dict(p))
+    assert calls1[0] >= 1 and calls2[0] == 0  # the second fit made no pass
+    assert rss2 == rss1 and np.array_equal(m2.coef, m1.coef)
+    assert m2.coef is not m1.coef and m2.params == p and m2.features is again
+
+
+def test_other_points_columns_nominals_and_records_are_fitted_anew():
+    train = _segments()
+    nominal = fit_nominal(train)
+    static = {"train": TrainRecords(train)}
+    p = {"fn": 800.0, "zeta": 0.1}
+    _fit("dynamics", 2, _counted(("dynamics",), p, nominal, static)[0], train, p)
+    q_next = {"fn": float(np.nextafter(800.0, 1e9)), "zeta": 0.1}  # one bit off
+    for q, ncols, nom, segs in ((q_next, None, nominal, train),
+                                (p, 12, nominal, train),
+                                (p, None, fit_nominal(train), train),
+                                (p, None, nominal, _segments())):
+        feats, calls = _counted(("dynamics",), dict(q), nom,
+                                {"train": TrainRecords(segs)}, ncols)
+        m, rss = _fit("dynamics", 2, feats, segs, dict(q))
+        plain = _fit("dynamics", 2, _combo_features(("dynamics",), dict(q), nom,
+                                                    {"train": TrainRecords(segs)}, ncols),
+                     segs, dict(q))[1]
+        assert calls[0] >= 1 and rss == plain
