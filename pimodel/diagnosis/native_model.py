@@ -117,8 +117,8 @@ def _section(element, dt: float, name: str, kinds=ELEMENT_K) -> tuple[np.ndarray
         values = [float(x) for x in element[1:]]
     except (TypeError, ValueError, IndexError):
         raise ValueError(f"params: {name} = {element!r}: {expected}") from None
-    if (kind not in kinds or len(values) != {"mode": 2, "lowpass": 1, "lowpass_direct": 1,
-                                             "direct": 0}[kind]
+    # the values an element holds: the parameters it adds in the linear part, its gain aside
+    if (kind not in kinds or len(values) != ELEMENT_K[kind] - 1
             or not all(math.isfinite(x) and x > 0 for x in values)):
         raise ValueError(f"params: {name} = {element!r}: {expected}")
     b, a = element_coefficients((kind, *values), dt)
