@@ -21,10 +21,12 @@ where ``D`` is the identity, the unit-gain base mode ``M_1`` (ZOH, ``(D Z)[k]`` 
 delay alone. ``E_j`` are the further modes, low-pass and direct term of the linear part
 (:mod:`.lti`). ``L_i`` is the exact
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
-``a = exp(-dt / tau)``. This class evaluates exactly that form, so :meth:`simulate` equals the
-diagnosis' own prediction. The same form, streamed sample by sample on the C core
-(:mod:`.native_model`), is the python-control block (:meth:`DiagnosedModel.block`) and the
-DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
+``a = exp(-dt / tau)``; with ``creep_start == "common"`` (a stage parked between records,
+:mod:`.creep`) each lag rests instead at its level ``s_i`` of ``creep_start_levels``,
+``L_i[-1] = s_i``, shared by every record. This class evaluates exactly that form, so
+:meth:`simulate` equals the diagnosis' own prediction. The same form, streamed sample by sample on
+the C core (:mod:`.native_model`), is the python-control block (:meth:`DiagnosedModel.block`) and
+the DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
 :meth:`simulate` to 1e-12.
 
 The inverse solves, sample by sample, ``F_k(v[k]) = y_d[k]``: with the play states, the lags
@@ -98,6 +100,7 @@ from .._native import LIMITS
 from ..operators.base import check_finite
 from ..operators.pi import PIOperator
 from .checks import checked_signal
+from .creep import creep_start_levels
 from .drift import drift_term
 from .filters import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
@@ -143,7 +146,9 @@ class DiagnosedModel:
     reference_weights, reference_offset
         ``w0``, ``c0`` of ``h0`` (the diagnosis' nominal fit the effect columns use).
     params : dict
-        Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s``;
+        Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s`` (and
+        ``creep_start = "common"`` with ``creep_start_levels``, the lags' rest levels [output
+        unit], when they start at a common rest, :mod:`.creep`);
         ``asymmetry_quadratic``, ``asymmetry_cubic``, ``center``, ``half_range``;
         ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
         (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,
@@ -198,6 +203,8 @@ class DiagnosedModel:
         bad = set(self.effects) - {"creep", "asymmetry", "rate", "drift", "dynamics", "delay"}
         if bad:
             raise ValueError(f"effects: unknown {sorted(bad)}")
+        if "creep" in self.effects:
+            creep_start_levels(self.params)  # a common rest's levels checked
         w0 = w if self.reference_weights is None else np.asarray(self.reference_weights, float)
         if w0.shape != r.shape:
             raise ValueError(f"reference_weights: expected {r.size} values, got {w0.shape}")
@@ -316,8 +323,10 @@ class DiagnosedModel:
             # memory unknown at the start: the lags start at the measured first output
             y0 = float(y_meas[0]) if y_meas is not None and self.initial_state == "unknown" \
                 else None
-            for g, tau in zip(p["creep_lag_gains"], p["creep_time_constants_s"], strict=True):
-                y = y + g * (lag(h0, tau, self.dt, y0) - h0)
+            starts = creep_start_levels(p)  # a common rest: where each lag starts
+            for i, (g, tau) in enumerate(zip(p["creep_lag_gains"], p["creep_time_constants_s"],
+                                             strict=True)):
+                y = y + g * (lag(h0, tau, self.dt, y0 if starts is None else starts[i]) - h0)
         if "asymmetry" in e:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
