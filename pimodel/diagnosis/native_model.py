@@ -626,6 +626,8 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
     if d.m:
         out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
                     **arr("creep_tau", model.params["creep_time_constants_s"])})
+        if "lag_start" in k:  # the lags' common rest (module creep)
+            out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
     if d.asym:
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})

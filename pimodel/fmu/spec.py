@@ -334,6 +334,12 @@ MODELS: dict[str, dict] = {
                  Var("plays_start", 72, "Integer", "parameter", "0",
                      "plays before the first sample: 0 at z0, 1 at rest at the first input "
                      "v[0] (the diagnosis' nominal, DiagnosedModel.plays_start)"),
+                 Var("creep_start", 78, "Integer", "parameter", "0",
+                     "creep lags before the first sample: 0 at rest at h0[0], 1 at rest at "
+                     "creep_start_level (a common rest, params creep_start 'common')"),
+                 *_arrays("creep_start_level", 2100, "parameter", "0",
+                          "rest level s of the creep lag before the first sample when "
+                          "creep_start = 1 (output unit), lag"),
                  *_arrays("wiener_element_b", 1700, "parameter", "0",
                           "filter before the plays: second-order sections, 3 numerator "
                           "coefficients each (z^0, z^-1, z^-2): F_j in 3j-2..3j, element"),
