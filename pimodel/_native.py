@@ -464,7 +464,7 @@ class InverseParams(ctypes.Structure):
                 ("rate_tau", c_double), ("rate_saturation", c_double),
                 ("rate_growth", c_double), ("reference_range", c_double), ("ns", c_size),
                 ("sos", _DP), ("latency", c_size), ("frac", c_double), ("npost", c_size),
-                ("post", _DP)]
+                ("post", _DP), ("lag_start", _DP)]
 
 
 _check_layout(InverseParams, "pim_dinv")

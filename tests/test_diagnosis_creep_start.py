@@ -151,3 +151,28 @@ def test_creep_at_rest_keeps_the_rest_start(seed):
     v = diagnose(tr, va, workers=1).verdict
     assert v["effects"] == ["creep"], v["effects"]
     assert "creep_start" not in v["model"]
+
+
+@pytest.mark.parametrize("plays_start", ["zero", "v0"])
+@pytest.mark.parametrize("asymmetry", [False, True])
+def test_inverse_is_exact_with_the_common_start(plays_start, asymmetry):
+    """The feedforward of a model whose lags start at a common rest is exact (the creep acts
+    on the first sample already: ``sum_j g_j a_j (s_j - h0[0])``), in NumPy and in C."""
+    from pimodel.diagnosis.native_inverse import NativeInverse
+
+    p = {"creep_lag_gains": [0.05, -0.02, 0.03], "creep_time_constants_s": [0.01, 0.1, 1.0],
+         "creep_start": "common", "creep_start_levels": [0.9, -0.4, 1.5]}
+    if asymmetry:
+        p.update({"asymmetry_quadratic": 0.03, "asymmetry_cubic": -0.01, "center": 0.5,
+                  "half_range": 1.5})
+    m = DiagnosedModel([0.0, 0.3, 0.7], [1.0, 0.5, 0.3], 0.1, dt=DT,
+                       effects=("creep", "asymmetry") if asymmetry else ("creep",), params=p,
+                       reference_weights=[0.9, 0.45, 0.25], reference_offset=0.05,
+                       plays_start=plays_start)
+    v = np.sin(np.linspace(0, 7, 600)) + 0.4
+    if plays_start == "zero":
+        v[:5] = 0.0
+    y = m.simulate(v)
+    assert np.max(np.abs(m.inverse().simulate(y) - v)) < 1e-9
+    if plays_start == "zero":
+        assert np.max(np.abs(NativeInverse(m.inverse()).run(y) - v)) < 1e-9

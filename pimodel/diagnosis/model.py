@@ -716,7 +716,8 @@ class DiagnosedInverse:
         """The first input ``v[0]`` of a model whose plays start at rest at ``v[0]``
         (:attr:`DiagnosedModel.plays_start` ``"v0"``): every play then outputs ``v[0]`` on the
         first sample, so the static part's output there, ``(sum w) v[0] + c`` plus the
-        asymmetry of ``h0``, is solved for ``y_0`` (creep and rate act from the next sample).
+        asymmetry of ``h0`` (and a creep whose lags start at a common rest), is solved for
+        ``y_0`` (rate, and a creep at rest at ``h0[0]``, act from the next sample).
 
         Parameters
         ----------
@@ -743,7 +744,8 @@ class DiagnosedInverse:
 
         total = float(np.sum(m.weights))
         u0 = (float(y_0) - m.offset) / total if total != 0 else 0.0
-        if f(u0) == 0.0 or "asymmetry" not in m.effects:
+        if f(u0) == 0.0 or ("asymmetry" not in m.effects and (
+                "creep" not in m.effects or creep_start_levels(m.params) is None)):
             return u0
         step = 1e-3 * (1.0 + abs(u0) + float(m.radii[-1]))
         while step < 1e6:
@@ -877,12 +879,19 @@ class DiagnosedInverse:
 
 def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
     """The static part's output on a first sample whose play outputs are ``z`` (hysteresis,
-    offset and the asymmetry of ``h0``; creep and rate are 0 there)."""
+    offset and the asymmetry of ``h0``; rate is 0 there, and creep too unless its lags start
+    at a common rest ``s_j``: then ``sum_j g_j a_j (s_j - h0)``)."""
+    p = m.params
     y = float(z @ m.weights) + m.offset
+    h0 = float(z @ m.reference_weights) + m.reference_offset
     if "asymmetry" in m.effects:
-        p = m.params
-        x = (float(z @ m.reference_weights) + m.reference_offset - p["center"]) / p["half_range"]
+        x = (h0 - p["center"]) / p["half_range"]
         y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
+    starts = creep_start_levels(p) if "creep" in m.effects else None
+    if starts is not None:
+        ga = np.asarray(p["creep_lag_gains"], float) * np.exp(
+            -m.dt / np.asarray(p["creep_time_constants_s"], float))
+        y += float(ga @ (starts - h0))
     return y
 
 

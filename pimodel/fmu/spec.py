@@ -365,7 +365,8 @@ MODELS: dict[str, dict] = {
 # (pimodel.diagnosis.native_inverse, fmu/src/core/pim_diag_inverse.h). The static part's variables
 # are the DiagnosedModel unit's (same names and references, the weights projected monotone).
 _INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset", "n_lags",
-                   "creep_gain", "creep_tau", "asymmetry_quadratic", "asymmetry_cubic",
+                   "creep_gain", "creep_tau", "creep_start", "creep_start_level",
+                   "asymmetry_quadratic", "asymmetry_cubic",
                    "center", "half_range", "rate_band_gain", "rate_scale", "rate_family",
                    "rate_tau", "rate_saturation", "rate_growth", "input_range", "p_hi", "r_hi",
                    "w0_hi", "rate_band_gain_hi"}

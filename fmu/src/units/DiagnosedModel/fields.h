@@ -7,8 +7,7 @@
 #include "diag_fields.h"
 double lti_b[PIM_NMAX], lti_a[PIM_NMAX];
 double drift_per_s, delay_samples, drift_settling, drift_settling_tau, drift_settling_start;
-int lti_order, drift_clock, n_lti_elements, n_wiener_elements, plays_start, creep_start;
-double creep_start_level[PIM_NMAX]; /* the creep lags' common rest (creep_start = 1) */
+int lti_order, drift_clock, n_lti_elements, n_wiener_elements, plays_start;
 double lti_gain[PIM_NMAX], lti_element_b[PIM_NMAX], lti_element_a[PIM_NMAX];
 double wiener_element_b[PIM_NMAX], wiener_element_a[PIM_NMAX];
 double dstate[PIM_DIAG_STATE_MAX]; /* pim_diag's state */

@@ -39,7 +39,6 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->settle = u->drift_settling;
     d->settle_tau = u->drift_settling_tau;
     d->settle_t0 = u->drift_settling_start;
-    d->lag_start = u->creep_start ? u->creep_start_level : NULL;
 }
 
 /* The DiagnosedModel parameter rules, with the variable, index and value in the message. */
@@ -60,13 +59,6 @@ static int model_check_parameters(pim_unit *u)
     if (u->plays_start < 0 || u->plays_start > 1)
         return unit_error(u, "parameter plays_start = %d out of range: 0 at z0, 1 at rest at "
                              "the first input v[0]", u->plays_start);
-    if (u->creep_start < 0 || u->creep_start > 1)
-        return unit_error(u, "parameter creep_start = %d out of range: 0 at rest at h0[0], 1 at "
-                             "rest at creep_start_level", u->creep_start);
-    for (int j = 0; u->creep_start && j < u->n_lags && j < PIM_NMAX; ++j)
-        if (!isfinite(u->creep_start_level[j]))
-            return unit_error(u, "creep start level creep_start_level[%d] = %g is not finite",
-                              j + 1, u->creep_start_level[j]);
     if (u->lti_order < 0 || u->lti_order > PIM_DIAG_MAX_ORDER)
         return unit_error(u, "parameter lti_order = %d out of range: 0 <= lti_order <= %d",
                           u->lti_order, PIM_DIAG_MAX_ORDER);
