@@ -176,3 +176,26 @@ def test_inverse_is_exact_with_the_common_start(plays_start, asymmetry):
     assert np.max(np.abs(m.inverse().simulate(y) - v)) < 1e-9
     if plays_start == "zero":
         assert np.max(np.abs(NativeInverse(m.inverse()).run(y) - v)) < 1e-9
+
+
+def test_report_reads_the_asymmetry_beside_a_common_start():
+    """Beside a creep at a common rest the asymmetry's coefficients are read from their own
+    columns (after the lags' start columns): the model built from the report predicts as the
+    fit, on train and on another record."""
+    from pimodel.diagnosis.effects import fit_effect, fit_nominal, make_segment
+
+    tr, va = records(0)
+    radii = np.linspace(0.0, 2.2, 21)
+    segs = [make_segment(r.t, r.v, r.y, radii) for r in (tr[0], va[0])]
+    nominal = fit_nominal(segs[:1])
+    m = fit_effect("asymmetry", segs[:1], ("creep",), {"creep_start": "common"}, nominal)
+    assert m.grid == {"creep_start": "common"}
+    ref, n = m.reference, radii.size
+    model = DiagnosedModel(radii, m.coef[:n], float(m.coef[n]), dt=DT,
+                           effects=("creep", "asymmetry"), reference_weights=ref.coef[:n],
+                           reference_offset=float(ref.coef[n]), plays_start="v0",
+                           params={**m.params, "center": ref.params["center"],
+                                   "half_range": ref.params["half_range"]})
+    assert len(m.params["creep_start_levels"]) == len(TAUS)
+    for r, s in zip((tr[0], va[0]), segs, strict=True):
+        assert np.max(np.abs(model.simulate(r.v) - m.predict(s))) < 1e-9
