@@ -399,7 +399,7 @@ class DiagParams(ctypes.Structure):
                 ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
                 ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP),
                 ("plays_start", c_int), ("settle", c_double), ("settle_tau", c_double),
-                ("settle_t0", c_double)]
+                ("settle_t0", c_double), ("lag_start", _DP)]
 
 
 _check_layout(DiagParams, "pim_diag")
@@ -464,7 +464,7 @@ class InverseParams(ctypes.Structure):
                 ("rate_tau", c_double), ("rate_saturation", c_double),
                 ("rate_growth", c_double), ("reference_range", c_double), ("ns", c_size),
                 ("sos", _DP), ("latency", c_size), ("frac", c_double), ("npost", c_size),
-                ("post", _DP)]
+                ("post", _DP), ("lag_start", _DP)]
 
 
 _check_layout(InverseParams, "pim_dinv")

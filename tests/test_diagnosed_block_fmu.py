@@ -60,6 +60,7 @@ CASES = {
     "delay_whole": ("delay",),
     "rate_saturated": ("rate",),
     "rate_scaled": ("rate",),
+    "creep_common": ("creep",),
     "all": tuple(EFFECT_PARAMS),
 }
 
@@ -85,6 +86,8 @@ def model(case: str) -> DiagnosedModel:
                        "rate_time_constant_s": 3e-3, "rate_saturation": 0.4})
     if case in RATE_VARIANTS:
         params["rate_family"], params["rate_time_constant_s"] = RATE_VARIANTS[case]
+    if case == "creep_common":  # the lags at a common rest, away from h0[0] (module creep)
+        params.update({"creep_start": "common", "creep_start_levels": [0.8, -0.5, 1.3]})
     return DiagnosedModel(RADII, [1.2, -0.4, 0.8, -0.3, 0.25], 0.3, dt=DT, effects=effects,
                           reference_weights=[1.0, -0.2, 0.7, -0.2, 0.2], reference_offset=0.1,
                           params=params)
@@ -153,7 +156,7 @@ def test_general_lti_coefficients():
 
 
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
-                                  "delay_whole"])
+                                  "delay_whole", "creep_common"])
 def test_block_equals_simulate(case):
     m = model(case)
     t, v = signal(1200)
@@ -229,7 +232,7 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
                                   "delay_whole", "rate", "rate_saturated", "rate_scaled",
-                                  *RATE_VARIANTS])
+                                  "creep_common", *RATE_VARIANTS])
 def test_unit_equals_simulate(fmus, fmi, case):
     """The generic unit with the model's values (FMU time k Ts from 0: the drift clocks read
     t = k Ts)."""

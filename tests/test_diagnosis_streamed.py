@@ -93,6 +93,9 @@ CASES = [
     ("dynamics", (), {"fn": 900.0, "zeta": 0.08, "lti": LTI}),
     ("delay", ("dynamics",), {"fn": 900.0, "zeta": 0.08, "lti": LTI[:2], "d": 2.5}),
     ("asymmetry", ("creep",), {}),
+    ("creep", (), {"creep_start": "common"}),  # the lags at a common rest (module creep)
+    ("asymmetry", ("creep",), {"creep_start": "common"}),
+    ("delay", ("creep",), {"creep_start": "common", "d": 1.5}),
 ]
 
 

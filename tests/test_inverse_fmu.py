@@ -59,7 +59,7 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "dynamics_delay_creep", "rate_weight",
                                   "rate_weight_filtered", "rate_saturated", "rate_scaled_creep",
-                                  "delay_whole",
+                                  "delay_whole", "creep_common", "dynamics_delay_creep_common",
                                   "wiener_two_delay_creep"])
 def test_unit_equals_the_python_stream(fmus, fmi, case):
     effects, extra = CASES[case]

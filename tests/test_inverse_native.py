@@ -54,6 +54,10 @@ CASES = {
     "creep": (("creep",), {}),
     "asymmetry": (("asymmetry",), {}),
     "creep_asymmetry": (("creep", "asymmetry"), {}),
+    # the creep's lags at a common rest away from h0[0] (module creep): on the first sample too
+    "creep_common": (("creep",), {"creep_start": "common", "creep_start_levels": [0.4, -0.3]}),
+    "creep_asymmetry_common": (("creep", "asymmetry"), {"creep_start": "common",
+                                                       "creep_start_levels": [0.4, -0.3]}),
     "rate_radius": (("rate",), {}),
     # (with the gains of PARAMS and a filter the radius family's inverse diverged on these
     # references, v up to 180 for |v| <= 1.2, before the rate feedback cap; bounded now:
@@ -72,6 +76,8 @@ CASES = {
     "delay_whole": (("delay",), {"delay_samples": 3}),
     "delay_fraction": (("delay",), {}),
     "dynamics_delay_creep": (("dynamics", "delay", "creep"), {}),
+    "dynamics_delay_creep_common": (("dynamics", "delay", "creep"),
+                                    {"creep_start": "common", "creep_start_levels": [0.4, -0.3]}),
     "all": (("dynamics", "delay", "creep", "asymmetry", "rate"), {}),
     # a filter before the hysteresis (a Wiener model): its inverse's post sections
     "wiener_lowpass": (("dynamics",), {"dynamics_position": "before",

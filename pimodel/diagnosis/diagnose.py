@@ -40,7 +40,9 @@ other effect), and the path with the lowest validate BIC is kept: a first effect
 in for two others that pass only together (a broad lag for creep and rate-dependent
 hysteresis). The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or,
 where the train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock,
-or a level per record, :mod:`.drift`) is chosen on validate for every combination.
+or a level per record, :mod:`.drift`) is chosen on validate for every combination, and so is
+the creep's start (its lags at rest at each record's first output, or at levels shared by the
+records: a stage parked between records, :mod:`.creep`).
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
@@ -65,7 +67,7 @@ from threadpoolctl import threadpool_limits
 from ..records import Record
 from .chunked import NormalEquations
 from .coverage import coverage, informed_radii, span_and_reach
-from .creep import creep_law
+from .creep import creep_law, creep_starts
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
 from .effects import (
@@ -870,7 +872,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
-        shapes = rate_shapes((*combo, name), fixed_ or {})
+        shapes = [{**r, **c} for r in rate_shapes((*combo, name), fixed_ or {})
+                  for c in creep_starts((*combo, name))]  # a creep's start: chosen anew
         out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):

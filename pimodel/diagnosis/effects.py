@@ -22,7 +22,7 @@ from .._native import pi_run_rows
 from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
-from .creep import creep_time_constants
+from .creep import creep_time_constants, start_columns
 from .drift import (
     DRIFT_VARIANTS,
     SETTLE_POINTS,
@@ -858,6 +858,10 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                                            "creep_taus": (*taus, REFINED_CREEP_LAG * taus[-1])})
     scaled = fixed.pop("rate_shape", None) == SCALED  # the rate's exact shape (module rate)
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
+    # the creep's lags at rest at a level shared by the records (module creep): one further
+    # coefficient per lag, g_i s_i
+    common = "creep" in effects and fixed.get("creep_start") == "common"
+    k += len(nominal.params["creep_taus"]) if common else 0
     if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
         k -= RATE_BANDS - 1
     static: dict = {"train": TrainRecords(train)}
@@ -899,6 +903,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                            "lti": fixed.get("lti", ())}] if "fn" in fixed else
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING] +
                          [{"fn": f, "zeta": MODE_HEAVY[1]} for f in MODE_HEAVY[0] if f <= fmax])
+        elif e == "creep":  # the start: a variant chosen on validate (module creep)
+            grids.append([{"creep_start": "common"}] if common else [{}])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
@@ -1193,16 +1199,22 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     of rows (``feats.parts(s)``: the play rows, then the others; :func:`_row_parts`);
     ``feats(s)`` is the transpose of their stack."""
 
+    common = "creep" in effects and p.get("creep_start") == "common"
+
     def static_rows(s: Segment) -> np.ndarray:
-        key = id(s)
+        key = ("common", id(s)) if common else id(s)
         if key not in static:
             out = [np.ones(s.t.size)]
             h0 = nominal.predict(s)
-            if "creep" in effects:
+            taus = nominal.params["creep_taus"] if "creep" in effects else ()
+            if common:  # lags at rest at levels shared by the records (module creep)
+                out += [lag(h0, tau, s.dt, 0.0) - h0 for tau in taus]
+                out += list(start_columns(np.arange(h0.size), s.dt, taus))
+            elif taus:
                 # the stage's memory at the start unknown (a start-up mask): the creep's
                 # too; its lags start at the measured first output, not at h0[0]
                 y0 = None if s.mask is None else float(s.y[0])
-                out += [lag(h0, tau, s.dt, y0) - h0 for tau in nominal.params["creep_taus"]]
+                out += [lag(h0, tau, s.dt, y0) - h0 for tau in taus]
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 out += [u**2, u**3]
@@ -1294,6 +1306,13 @@ def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
     return shift(cols, p["d"]) if "d" in p else cols
 
 
+def _start_levels(gains: np.ndarray, terms: np.ndarray) -> list:
+    """The common start's levels ``s_i`` from the fitted ``g_i`` and ``g_i s_i`` (module
+    creep); a lag of gain 0 has no start (its level 0: the term is then lost, never met on a
+    least-squares fit)."""
+    return [float(b / g) if g != 0 else 0.0 for g, b in zip(gains, terms, strict=True)]
+
+
 def _describe(effects, model: Model, nominal: Model) -> dict:
     out: dict = {}
     n = nominal.coef.size - 1
@@ -1302,9 +1321,14 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
     for e in (e for e in ("creep", "asymmetry", "rate") if e in effects):  # column order
         if e == "creep":
             taus = nominal.params["creep_taus"]
-            out["creep_lag_gains"] = extra[i:i + len(taus)].tolist()
+            gains = extra[i:i + len(taus)]
+            out["creep_lag_gains"] = gains.tolist()
             out["creep_time_constants_s"] = list(taus)
             i += len(taus)
+            if model.params.get("creep_start") == "common":  # g_i s_i, then the levels s_i
+                out["creep_start"] = "common"
+                out["creep_start_levels"] = _start_levels(gains, extra[i:i + len(taus)])
+                i += len(taus)
         elif e == "asymmetry":
             out["asymmetry_quadratic"], out["asymmetry_cubic"] = extra[i:i + 2].tolist()
             i += 2

@@ -21,10 +21,12 @@ where ``D`` is the identity, the unit-gain base mode ``M_1`` (ZOH, ``(D Z)[k]`` 
 delay alone. ``E_j`` are the further modes, low-pass and direct term of the linear part
 (:mod:`.lti`). ``L_i`` is the exact
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
-``a = exp(-dt / tau)``. This class evaluates exactly that form, so :meth:`simulate` equals the
-diagnosis' own prediction. The same form, streamed sample by sample on the C core
-(:mod:`.native_model`), is the python-control block (:meth:`DiagnosedModel.block`) and the
-DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
+``a = exp(-dt / tau)``; with ``creep_start == "common"`` (a stage parked between records,
+:mod:`.creep`) each lag rests instead at its level ``s_i`` of ``creep_start_levels``,
+``L_i[-1] = s_i``, shared by every record. This class evaluates exactly that form, so
+:meth:`simulate` equals the diagnosis' own prediction. The same form, streamed sample by sample on
+the C core (:mod:`.native_model`), is the python-control block (:meth:`DiagnosedModel.block`) and
+the DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
 :meth:`simulate` to 1e-12.
 
 The inverse solves, sample by sample, ``F_k(v[k]) = y_d[k]``: with the play states, the lags
@@ -98,6 +100,7 @@ from .._native import LIMITS
 from ..operators.base import check_finite
 from ..operators.pi import PIOperator
 from .checks import checked_signal
+from .creep import creep_start_levels
 from .drift import drift_term
 from .filters import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
@@ -143,7 +146,9 @@ class DiagnosedModel:
     reference_weights, reference_offset
         ``w0``, ``c0`` of ``h0`` (the diagnosis' nominal fit the effect columns use).
     params : dict
-        Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s``;
+        Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s`` (and
+        ``creep_start = "common"`` with ``creep_start_levels``, the lags' rest levels [output
+        unit], when they start at a common rest, :mod:`.creep`);
         ``asymmetry_quadratic``, ``asymmetry_cubic``, ``center``, ``half_range``;
         ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
         (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,
@@ -198,6 +203,8 @@ class DiagnosedModel:
         bad = set(self.effects) - {"creep", "asymmetry", "rate", "drift", "dynamics", "delay"}
         if bad:
             raise ValueError(f"effects: unknown {sorted(bad)}")
+        if "creep" in self.effects:
+            creep_start_levels(self.params)  # a common rest's levels checked
         w0 = w if self.reference_weights is None else np.asarray(self.reference_weights, float)
         if w0.shape != r.shape:
             raise ValueError(f"reference_weights: expected {r.size} values, got {w0.shape}")
@@ -316,8 +323,10 @@ class DiagnosedModel:
             # memory unknown at the start: the lags start at the measured first output
             y0 = float(y_meas[0]) if y_meas is not None and self.initial_state == "unknown" \
                 else None
-            for g, tau in zip(p["creep_lag_gains"], p["creep_time_constants_s"], strict=True):
-                y = y + g * (lag(h0, tau, self.dt, y0) - h0)
+            starts = creep_start_levels(p)  # a common rest: where each lag starts
+            for i, (g, tau) in enumerate(zip(p["creep_lag_gains"], p["creep_time_constants_s"],
+                                             strict=True)):
+                y = y + g * (lag(h0, tau, self.dt, y0 if starts is None else starts[i]) - h0)
         if "asymmetry" in e:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
@@ -707,7 +716,8 @@ class DiagnosedInverse:
         """The first input ``v[0]`` of a model whose plays start at rest at ``v[0]``
         (:attr:`DiagnosedModel.plays_start` ``"v0"``): every play then outputs ``v[0]`` on the
         first sample, so the static part's output there, ``(sum w) v[0] + c`` plus the
-        asymmetry of ``h0``, is solved for ``y_0`` (creep and rate act from the next sample).
+        asymmetry of ``h0`` (and a creep whose lags start at a common rest), is solved for
+        ``y_0`` (rate, and a creep at rest at ``h0[0]``, act from the next sample).
 
         Parameters
         ----------
@@ -734,7 +744,8 @@ class DiagnosedInverse:
 
         total = float(np.sum(m.weights))
         u0 = (float(y_0) - m.offset) / total if total != 0 else 0.0
-        if f(u0) == 0.0 or "asymmetry" not in m.effects:
+        if f(u0) == 0.0 or ("asymmetry" not in m.effects and (
+                "creep" not in m.effects or creep_start_levels(m.params) is None)):
             return u0
         step = 1e-3 * (1.0 + abs(u0) + float(m.radii[-1]))
         while step < 1e6:
@@ -868,12 +879,19 @@ class DiagnosedInverse:
 
 def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
     """The static part's output on a first sample whose play outputs are ``z`` (hysteresis,
-    offset and the asymmetry of ``h0``; creep and rate are 0 there)."""
+    offset and the asymmetry of ``h0``; rate is 0 there, and creep too unless its lags start
+    at a common rest ``s_j``: then ``sum_j g_j a_j (s_j - h0)``)."""
+    p = m.params
     y = float(z @ m.weights) + m.offset
+    h0 = float(z @ m.reference_weights) + m.reference_offset
     if "asymmetry" in m.effects:
-        p = m.params
-        x = (float(z @ m.reference_weights) + m.reference_offset - p["center"]) / p["half_range"]
+        x = (h0 - p["center"]) / p["half_range"]
         y += p["asymmetry_quadratic"] * x**2 + p["asymmetry_cubic"] * x**3
+    starts = creep_start_levels(p) if "creep" in m.effects else None
+    if starts is not None:
+        ga = np.asarray(p["creep_lag_gains"], float) * np.exp(
+            -m.dt / np.asarray(p["creep_time_constants_s"], float))
+        y += float(ga @ (starts - h0))
     return y
 
 

@@ -92,6 +92,8 @@ class NativeInverse:
                 raise ValueError("params: creep_lag_gains and creep_time_constants_s: expected "
                                  f"as many gains as time constants, at most {NMAX}")
             d.m = solver.m
+            if solver.starts is not None:  # the lags at a common rest (module creep)
+                keep["lag_start"] = solver.starts
         if solver.asym:
             d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
             d.center, d.half = p["center"], p["half_range"]
@@ -361,6 +363,8 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
     if d.m:
         out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
                     **arr("creep_tau", inverse.model.params["creep_time_constants_s"])})
+        if "lag_start" in k:  # the lags at a common rest (module creep)
+            out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
     if d.asym:
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})

@@ -10,10 +10,11 @@ Discrete-time semantics (those of ``simulate``, written per sample): with the pl
 ``plays_start`` is ``"v0"``, set by the C step on the first sample) and the input ``v[k]``,
 ``y[k]`` depends on ``v[0..k]`` and ``t[k]`` only; the LTI part (the dynamics) and the delay act
 on the hysteresis term ``sum_i w_i z_i[k]`` and start at rest around its first value; the creep
-lags start at rest around ``h0[0]``; the rate effect (:mod:`.rate`) low-passes the normalised
-input rate from rest at 0 (without a filter, a one-sample jump above ``STEP_SHARE *
-input_range`` counts as a step, no rate); the radius family holds each play's term from its
-last contact, the weight family scales the band's ``sum_i w0_i z_i[k]`` by the current rate.
+lags start at rest around ``h0[0]`` (or at the model's ``creep_start_levels`` when its
+``creep_start`` is ``"common"``: :mod:`.creep`); the rate effect (:mod:`.rate`) low-passes the
+normalised input rate from rest at 0 (without a filter, a one-sample jump above ``STEP_SHARE *
+input_range`` counts as a step, no rate); the radius family holds each play's term from its last
+contact, the weight family scales the band's ``sum_i w0_i z_i[k]`` by the current rate.
 
 Two things ``simulate`` takes from the whole record are parameters here:
 
@@ -56,6 +57,7 @@ import numpy as np
 from .. import _native
 from ..blocks.framework import BlockSettings, labelled_values, signal_labels, stepped_block
 from .checks import block_dt, checked_signal
+from .creep import creep_start_levels
 from .filters import mode_coefficients
 from .limits import MAX_DELAY, MAX_ELEMENTS, MAX_ORDER, NMAX, SECTION
 from .lti import ELEMENT_K, element_coefficients
@@ -278,6 +280,9 @@ class NativeModel:
                 raise ValueError("params: creep_lag_gains and creep_time_constants_s: expected "
                                  "as many gains as time constants")
             d.m = taus.size
+            starts = creep_start_levels(p)  # the lags at a common rest (module creep)
+            if starts is not None:
+                keep["lag_start"] = starts
         if "asymmetry" in e:
             d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
             d.center, d.half = p["center"], p["half_range"]
@@ -621,6 +626,8 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
     if d.m:
         out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
                     **arr("creep_tau", model.params["creep_time_constants_s"])})
+        if "lag_start" in k:  # the lags' common rest (module creep)
+            out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
     if d.asym:
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})

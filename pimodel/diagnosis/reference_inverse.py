@@ -47,6 +47,7 @@ from scipy.signal import sosfilt_zi
 from .._native import LIMITS
 from ..blocks.framework import BlockSettings, signal_labels, stepped_block
 from .checks import block_dt
+from .creep import creep_start_levels
 from .lti import inverse_sos
 from .monotone import monotone_model
 from .rate import (
@@ -229,11 +230,13 @@ class StaticInverse:
         self.span = max(2 * float(r[-1]), rr / max(abs(self.w.sum()), 1e-12), 1.0)
         self.creep = "creep" in e
         self.m = 0
+        self.starts = None  # the lags' common rest levels (module creep), or at rest at h0[0]
         if self.creep:
             taus = np.asarray(p["creep_time_constants_s"], float)
             self.a_lag = np.exp(-m.dt / taus)
             self.ga = np.asarray(p["creep_lag_gains"], float) * self.a_lag
             self.m = taus.size
+            self.starts = creep_start_levels(p)
         self.asym = "asymmetry" in e
         self.rate = "rate" in e
         self.scaled = False
@@ -360,6 +363,9 @@ class StaticInverse:
         v_prev, guess = float(x[1]), float(x[2])
         z = x[self._z].copy()
         lags = x[self._lags].copy()
+        if first and self.starts is not None:  # at their common rest before the first sample
+            lags = self.starts.copy()
+        creep_now = self.creep and (not first or self.starts is not None)
         rho_f = float(x[self._rho_f]) if self.rate else 0.0
         memory = x[self._memory].copy() if self.rate else None
         span = self.span
@@ -379,7 +385,7 @@ class StaticInverse:
             Zc = np.clip(z[None, :], vs[:, None] - r, vs[:, None] + r)
             y = Zc @ w + m.offset
             h0 = Zc @ w0 + m.reference_offset
-            if self.creep and not first:
+            if creep_now:
                 y = y + (self.ga * lags).sum() - self.ga.sum() * h0
             if self.asym:
                 u = (h0 - p["center"]) / p["half_range"]
@@ -407,7 +413,8 @@ class StaticInverse:
         z_new = np.clip(z, vk - r, vk + r)
         h = float(z_new @ w0 + m.reference_offset)
         if self.creep:
-            lags = h + 0 * lags if first else self.a_lag * lags + (1 - self.a_lag) * h
+            lags = h + 0 * lags if first and self.starts is None else \
+                self.a_lag * lags + (1 - self.a_lag) * h
         if self.scaled:
             memory = np.clip(memory, vk - rs, vk + rs)
             rho_f = self.a_rate * rho_f + (1 - self.a_rate) * (0.0 if first else

@@ -14,7 +14,9 @@ is carried from one chunk to the next, or a per-sample map:
 - ``h0[c] = coef @ rows[c]``, the reference hysteresis (the nominal, or an asymmetry's
   reference), a per-sample product;
 - the creep lags ``out[k] = a out[k-1] + (1 - a) h0[k]`` (``scipy.signal.lfilter`` with the
-  previous chunk's final state ``zf`` as ``zi``: the same sample recursion);
+  previous chunk's final state ``zf`` as ``zi``: the same sample recursion); with the lags at
+  a common rest (``creep_start`` ``"common"``, :mod:`.creep`) the lags from 0 and the columns
+  ``a^(k+1)`` of the chunk's own sample indices ``k`` (:func:`.creep.start_columns`);
 - the mode after the hysteresis and the linear part's elements (the C core's biquad,
   ``pim_biquad_rows_carry``: ``s0[k-1], s1[k-1]`` carried);
 - a delay of ``d`` samples (whole or fractional): the chunk's rows with the last
@@ -40,6 +42,7 @@ from scipy.signal import lfilter
 
 from .._native import biquad_rows_carry
 from .chunked import combine, stack_rows
+from .creep import start_columns
 from .drift import drift_columns
 from .filters import mode_coefficients, shift
 from .lti import element_coefficients
@@ -133,8 +136,9 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
         raise ValueError(f"{'+'.join(effects)}: its columns are not streamed (module streamed)")
     dt = s.dt
     y0 = None if s.mask is None else float(s.y[0])
-    lags = [_Lag(tau, dt, y0) for tau in nominal.params["creep_taus"]] \
-        if "creep" in effects else []
+    taus = nominal.params["creep_taus"] if "creep" in effects else ()
+    common = bool(taus) and p.get("creep_start") == "common"  # lags at a common rest
+    lags = [_Lag(tau, dt, 0.0 if common else y0) for tau in taus]
     mode_f = _Biquad(*mode_coefficients(p["fn"], p["zeta"], dt)) if "dynamics" in effects \
         else None
     delayed = _Shift(p["d"]) if "delay" in effects else None
@@ -156,6 +160,8 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
         h0 = combine((rows,), nominal.coef)
         out = [np.ones(h0.size)]
         out += [lag(h0) - h0 for lag in lags]
+        if common:
+            out += list(start_columns(np.arange(c.start, c.stop), dt, taus))
         if "asymmetry" in effects:
             u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
             out += [u**2, u**3]

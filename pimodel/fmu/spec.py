@@ -334,6 +334,12 @@ MODELS: dict[str, dict] = {
                  Var("plays_start", 72, "Integer", "parameter", "0",
                      "plays before the first sample: 0 at z0, 1 at rest at the first input "
                      "v[0] (the diagnosis' nominal, DiagnosedModel.plays_start)"),
+                 Var("creep_start", 78, "Integer", "parameter", "0",
+                     "creep lags before the first sample: 0 at rest at h0[0], 1 at rest at "
+                     "creep_start_level (a common rest, params creep_start 'common')"),
+                 *_arrays("creep_start_level", 2100, "parameter", "0",
+                          "rest level s of the creep lag before the first sample when "
+                          "creep_start = 1 (output unit), lag"),
                  *_arrays("wiener_element_b", 1700, "parameter", "0",
                           "filter before the plays: second-order sections, 3 numerator "
                           "coefficients each (z^0, z^-1, z^-2): F_j in 3j-2..3j, element"),
@@ -359,7 +365,8 @@ MODELS: dict[str, dict] = {
 # (pimodel.diagnosis.native_inverse, fmu/src/core/pim_diag_inverse.h). The static part's variables
 # are the DiagnosedModel unit's (same names and references, the weights projected monotone).
 _INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset", "n_lags",
-                   "creep_gain", "creep_tau", "asymmetry_quadratic", "asymmetry_cubic",
+                   "creep_gain", "creep_tau", "creep_start", "creep_start_level",
+                   "asymmetry_quadratic", "asymmetry_cubic",
                    "center", "half_range", "rate_band_gain", "rate_scale", "rate_family",
                    "rate_tau", "rate_saturation", "rate_growth", "input_range", "p_hi", "r_hi",
                    "w0_hi", "rate_band_gain_hi"}

@@ -100,6 +100,8 @@ const char *pim_dinv_check(const pim_dinv *d)
         if (!isfinite(d->lag_g[j])) return "a creep gain is not finite";
         if (!(d->lag_a[j] > 0.0 && d->lag_a[j] < 1.0))
             return "a creep time constant is not finite and > 0";
+        if (d->lag_start && !isfinite(d->lag_start[j]))
+            return "a creep start level is not finite";
     }
     if (d->asym) {
         if (!isfinite(d->q) || !isfinite(d->c3) || !isfinite(d->center))
@@ -192,7 +194,7 @@ static double dinv_F(const dinv_ctx *c, double v)
     }
     y += d->c;
     h0 += d->c0;
-    if (d->m && !c->first) y += c->lag_acc - c->lag_sum * h0;
+    if (d->m && (!c->first || d->lag_start)) y += c->lag_acc - c->lag_sum * h0;
     if (d->asym) {
         const double u = (h0 - d->center) / d->half;
         y += d->q * (u * u) + d->c3 * (u * u * u);
@@ -326,6 +328,7 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
         *v0_prev = v0;
         c.rho_k = dinv_saturate(d, a_rate * *rho_f + (1.0 - a_rate) * fresh);
     }
+    for (size_t j = 0; first && d->lag_start && j < m; ++j) lags[j] = d->lag_start[j];
     for (size_t j = 0; j < m; ++j) {
         const double ga = d->lag_g[j] * d->lag_a[j];
         c.lag_acc += ga * lags[j];
@@ -426,7 +429,7 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
     }
     h += d->c0;
     for (size_t j = 0; j < m; ++j)
-        lags[j] = first ? h : d->lag_a[j] * lags[j] + (1.0 - d->lag_a[j]) * h;
+        lags[j] = first && !d->lag_start ? h : d->lag_a[j] * lags[j] + (1.0 - d->lag_a[j]) * h;
     if (scaled) {
         for (size_t i = 0; i < n; ++i) mem[i] = dinv_clamp(mem[i], vk - rs[i], vk + rs[i]);
         *rho_f = a_rate * *rho_f + (1.0 - a_rate) * (first ? 0.0 : fabs(vk - v_prev) / d->dt);

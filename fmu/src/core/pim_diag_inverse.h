@@ -25,7 +25,8 @@
  *
  *     Z_i(v) = clip(z_i[k-1], v - r_i, v + r_i),  h(v) = sum w_i Z_i + c,
  *     h0(v) = sum w0_i Z_i + c0
- *     F_k(v) = h(v) + sum_j g_j a_j (L_j[k-1] - h0(v))          creep (not on the first sample)
+ *     F_k(v) = h(v) + sum_j g_j a_j (L_j[k-1] - h0(v))          creep (not on the first sample;
+ *                                                      with lag_start, L_j[-1] = lag_start[j])
  *            + q u^2 + c3 u^3,  u = (h0(v) - center) / half       asymmetry
  *            + sum_i g_i r_i (contact_i(v) ? -sign(v - Z_i) rho_k : m_i)   rate, radius family
  *            + rho_k sum_i g_i w0_i Z_i                                     rate, weight family
@@ -48,7 +49,7 @@
  * of every segment does); out of reach, the breakpoint closest to the target.  Guess: v[k] after a jump of more
  * than 1 % of span, else 2 v[k] - v[k-1].  span = max(2 r_n, reference_range / max(|sum w|,
  * 1e-12), 1).  After the solve: plays, creep lags L_j = a_j L_j + (1 - a_j) h0 (L = h0 on the
- * first solve), rate rho_f (from the solved input's rate, at most PIM_DINV_RATE_FEEDBACK_CAP
+ * first solve without lag_start), rate rho_f (from the solved input's rate, at most PIM_DINV_RATE_FEEDBACK_CAP
  * times fresh[k]) and the radius family's memory m_i of the plays in contact.
  *
  * State (pim_dinv_state_size doubles): [started, seen, v_rest, f_prev, s[2 ns], g[2 npost],
@@ -97,6 +98,8 @@ typedef struct {
     double frac;           /* the delay's fractional part, 0 <= frac < 1 */
     size_t npost;          /* sections after the solve (a Wiener model's filter inverse; 0: none) */
     const double *post;    /* npost rows of 6, as sos */
+    const double *lag_start; /* NULL: the creep lags at rest at h0[0]; else L_j[-1] =
+                                lag_start[j], a common rest (pim_diagnosed.h) */
 } pim_dinv;
 
 /* Length of the flat state (layout above). */

@@ -106,6 +106,8 @@ const char *pim_diag_check(const pim_diag *d)
         if (!isfinite(d->lag_g[j])) return "a creep gain is not finite";
         if (!(d->lag_a[j] > 0.0 && d->lag_a[j] < 1.0))
             return "a creep time constant is not finite and > 0";
+        if (d->lag_start && !isfinite(d->lag_start[j]))
+            return "a creep start level is not finite";
     }
     if (d->asym) {
         if (!isfinite(d->q) || !isfinite(d->c3) || !isfinite(d->center))
@@ -275,7 +277,8 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     /* the effect terms, in the order of DiagnosedModel.simulate */
     for (size_t j = 0; j < d->m; ++j) {
         const double a = d->lag_a[j];
-        lag[j] = (1.0 - a) * h0 + a * (first ? h0 : lag[j]);
+        const double before = !first ? lag[j] : d->lag_start ? d->lag_start[j] : h0;
+        lag[j] = (1.0 - a) * h0 + a * before;
         y += d->lag_g[j] * (lag[j] - h0);
     }
     if (d->asym) {

@@ -27,7 +27,9 @@
  *     y[k]   = (1 - f) x[k - d0] + f x[k - d0 - 1] + c               delay d = d0 + f samples,
  *                                                                    x[j < 0] = x[0]
  *            + sum_j g_j (L_j[k] - h0[k])     creep: L_j[k] = a_j L_j[k-1] + (1 - a_j) h0[k],
- *                                                    L_j[-1] = h0[0]
+ *                                                    L_j[-1] = h0[0] (lag_start NULL) or
+ *                                                    L_j[-1] = lag_start[j] (a common rest:
+ *                                                    pimodel.diagnosis.creep)
  *            + q u^2 + c3 u^3,  u = (h0[k] - center) / half            asymmetry
  *            + sum_i g_i m_i[k]                 rate, radius family       (g_i: the gain
  *            + rho_f[k] sum_i g_i w0_i z_i[k]   or weight family           of play i's band)
@@ -115,6 +117,9 @@ typedef struct {
     double settle;         /* D: the settling's total change from t_s on [output unit] */
     double settle_tau;     /* T [s] (0: no settling term; else > 0) */
     double settle_t0;      /* t_s [s], on the clock t[k] */
+    const double *lag_start; /* NULL: each creep lag at rest at h0[0]; else L_j[-1] =
+                                lag_start[j], the lags' common rest levels (creep_start
+                                "common" of pimodel.diagnosis.creep) [output unit] */
 } pim_diag;
 
 /* Length of the flat state of d (the layout above). */
@@ -138,7 +143,8 @@ PIM_API size_t pim_diag_delay_length(double delay);
  * input_range > 0 when rate_tau = 0; lags
  * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists, for the LTI and for each
  * section of the further elements and of the prefilter; ne, nw <= PIM_DIAG_MAX_ELEMENTS;
- * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2; settle_tau >= 0), else a static message naming the first bad one
+ * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2; settle_tau >= 0; lag_start finite),
+ * else a static message naming the first bad one
  * (the FMU adds the value).
  */
 PIM_API const char *pim_diag_check(const pim_diag *d);

@@ -6,7 +6,8 @@
 double w0[PIM_NMAX], creep_gain[PIM_NMAX], creep_tau[PIM_NMAX], rate_band_gain[PIM_NMAX];
 double p_hi[PIM_NMAX], r_hi[PIM_NMAX], w0_hi[PIM_NMAX], rate_band_gain_hi[PIM_NMAX];
 double offset, reference_offset, asym_q, asym_c3, center, half_range, rate_scale, input_range;
-int n_lags, rate_family;
+int n_lags, rate_family, creep_start;
+double creep_start_level[PIM_NMAX]; /* the creep lags' common rest (creep_start = 1) */
 double rate_tau, rate_saturation, rate_growth;
 /* derived */
 double dw[PIM_DIAG_MAX_PLAYS], dr[PIM_DIAG_MAX_PLAYS], dw0[PIM_DIAG_MAX_PLAYS],

@@ -105,6 +105,13 @@ static int unit_check_diag_static(pim_unit *u)
                                  "finite and > 0 s)", j + 1, u->creep_tau[j]);
         u->a[j] = exp(-u->Ts / u->creep_tau[j]); /* derived; checked below */
     }
+    if (u->creep_start < 0 || u->creep_start > 1)
+        return unit_error(u, "parameter creep_start = %d out of range: 0 at rest at h0[0], 1 at "
+                             "rest at creep_start_level", u->creep_start);
+    for (int j = 0; u->creep_start && j < u->n_lags; ++j)
+        if (!isfinite(u->creep_start_level[j]))
+            return unit_error(u, "creep start level creep_start_level[%d] = %g is not finite",
+                              j + 1, u->creep_start_level[j]);
     if (!isfinite(u->asym_q) || !isfinite(u->asym_c3) || !isfinite(u->center))
         return unit_error(u, "parameters asymmetry_quadratic, asymmetry_cubic, center = (%g, %g, "
                              "%g): must be finite", u->asym_q, u->asym_c3, u->center);
@@ -148,6 +155,7 @@ static int unit_check_diag_static(pim_unit *u)
         (d)->m = (u)->n_lags > 0 ? (size_t)(u)->n_lags : 0;                                     \
         (d)->lag_a = (u)->a;                                                                    \
         (d)->lag_g = (u)->creep_gain;                                                           \
+        (d)->lag_start = (u)->creep_start ? (u)->creep_start_level : NULL;                      \
         (d)->asym = (u)->asym_q != 0.0 || (u)->asym_c3 != 0.0;                                  \
         (d)->q = (u)->asym_q;                                                                   \
         (d)->c3 = (u)->asym_c3;                                                                 \
