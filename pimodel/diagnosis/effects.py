@@ -400,8 +400,10 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     """Least squares over all train records through normal equations accumulated chunk by
     chunk (:class:`~pimodel.diagnosis.chunked.NormalEquations`: columns scaled to unit norm, the
     Gram matrix is small), so a grid search costs one pass over the data per point and no
-    temporary larger than a chunk; the residual sum of squares is computed from the residuals
-    themselves, chunk by chunk. The regressors are taken as blocks of rows when the builder has
+    temporary larger than a chunk; the residual sum of squares is taken from the same sums
+    when that is safe from cancellation (:meth:`~pimodel.diagnosis.chunked.NormalEquations.rss`,
+    within ``RSS_RTOL``), else computed from the residuals themselves, chunk by chunk (a second
+    pass). The regressors are taken as blocks of rows when the builder has
     them (:func:`_row_parts`): no copy of the play columns at each point of a search. A
     streamed segment (a long record in the whole-record refit, module streamed) gives its
     blocks chunk by chunk (``features.parts_chunks``), built once per pass: the same values
@@ -416,16 +418,18 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     ne = None
     for P, s in zip(blocks, train, strict=True):
         first = None if P is None else _first_grams(P[0], s)
-        for G, Xy, m in _per_chunk(features, P, s, lambda j, c, Pc, s=s, first=first:
-                                   _normal_terms(Pc, s, c, None if first is None else first[j])):
+        for terms in _per_chunk(features, P, s, lambda j, c, Pc, s=s, first=first:
+                                _normal_terms(Pc, s, c, None if first is None else first[j])):
             if ne is None:
-                ne = NormalEquations(G.shape[0])
-            ne.add_gram(G, Xy, m)
+                ne = NormalEquations(terms[0].shape[0])
+            ne.add_gram(*terms)
     coef = ne.solve()
-    rss = 0.0
-    for P, s in zip(blocks, train, strict=True):
-        for r in _per_chunk(features, P, s, lambda j, c, Pc, s=s: _chunk_rss(Pc, s, c, coef)):
-            rss += r  # summed in the chunks' order, whichever thread made each
+    rss = ne.rss(coef)  # from the sums when that is safe from cancellation (RSS_RTOL)
+    if rss is None:  # else a second pass, over the residuals
+        rss = 0.0
+        for P, s in zip(blocks, train, strict=True):
+            for r in _per_chunk(features, P, s, lambda j, c, Pc, s=s: _chunk_rss(Pc, s, c, coef)):
+                rss += r  # summed in the chunks' order, whichever thread made each
     if memo is not None:
         memo[0][memo[2]] = (memo[3], (coef.copy(), rss))
     return Model(name, k, features, coef, params or {}), rss
@@ -492,9 +496,10 @@ def _per_chunk(features, P: tuple | None, s: Segment, fn: Callable) -> Iterable:
 
 
 def _normal_terms(Pc: tuple, s: Segment, c: slice, first: np.ndarray | None):
-    """The Gram matrix, ``X y`` and the sample count of the fitted samples of chunk ``c``."""
+    """The Gram matrix, ``X y``, the sample count and ``y^T y`` of the fitted samples of
+    chunk ``c``."""
     Pc, y = _used_chunk(Pc, s, c)
-    return _gram(Pc, first), np.concatenate([X @ y for X in Pc]), y.size
+    return _gram(Pc, first), np.concatenate([X @ y for X in Pc]), y.size, float(y @ y)
 
 
 def _chunk_rss(Pc: tuple, s: Segment, c: slice, coef: np.ndarray) -> float:
