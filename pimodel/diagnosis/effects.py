@@ -499,7 +499,11 @@ def _normal_terms(Pc: tuple, s: Segment, c: slice, first: np.ndarray | None):
     """The Gram matrix, ``X y``, the sample count and ``y^T y`` of the fitted samples of
     chunk ``c``."""
     Pc, y = _used_chunk(Pc, s, c)
-    return _gram(Pc, first), np.concatenate([X @ y for X in Pc]), y.size, float(y @ y)
+    if first is None:
+        return _gram(Pc), np.concatenate([X @ y for X in Pc]), y.size, float(y @ y)
+    gram, zy = first  # the first block's, kept (_first_grams)
+    return (_gram(Pc, gram), np.concatenate([zy] + [X @ y for X in Pc[1:]]), y.size,
+            float(y @ y))
 
 
 def _chunk_rss(Pc: tuple, s: Segment, c: slice, coef: np.ndarray) -> float:
@@ -529,8 +533,8 @@ def _row_parts(features, s: Segment) -> tuple:
 
 
 def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
-    """``Z_c Z_c^T`` of the first block of rows ``Z`` (the play rows) on each chunk ``c`` of
-    ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
+    """``(Z_c Z_c^T, Z_c y_c)`` of the first block of rows ``Z`` (the play rows) on each chunk
+    ``c`` of ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
     screen's (at most ``SCREEN_SAMPLES`` samples): the fits of a search that holds the play
     rows (creep, asymmetry, drift, the rate's filters, the linear part's elements around one
     mode) then form only the blocks that change. None for a whole long record."""
@@ -541,9 +545,13 @@ def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
     kept = s.__dict__.setdefault("_first_grams", {})  # per thread (module threads)
     memo = kept.get(threading.get_ident())
     if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
-        grams = helped_map(lambda c: _square(_used_chunk((Z[:, c],), s, c)[0][0]), cuts)
+        grams = helped_map(lambda c: _first_terms(*_used_chunk((Z[:, c],), s, c)), cuts)
         memo = kept[threading.get_ident()] = (key, Z, grams)
     return memo[2]
+
+
+def _first_terms(Pc: tuple, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return _square(Pc[0]), Pc[0] @ y  # the products _normal_terms would make
 
 
 def _square(X: np.ndarray) -> np.ndarray:
