@@ -909,7 +909,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
     if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
         k -= RATE_BANDS - 1
-    static: dict = {"train": TrainRecords(train)}
+    # held: one point, no search; its play rows' Gram formed as a streamed refit forms it
+    # (no delayed Gram from the undelayed rows', _first_grams), so the two equal to the bit
+    static: dict = {"train": TrainRecords(train), "held": held}
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
     # then left a spurious second effect)
@@ -1117,8 +1119,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
         # exponential map, the validate RMS drops 3 to 10 times in two steps)
         for _ in range(ASYMMETRY_ITERATIONS):
             ref = _hysteresis_reference(model, train, nominal)
-            model = _fit(name, k_all, _combo_features(effects, p, ref, {"train": static["train"]}),
-                         train, p)[0]
+            model = _fit(name, k_all, _combo_features(
+                effects, p, ref, {"train": static["train"], "held": held}), train, p)[0]
             model.reference = ref
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
@@ -1280,7 +1282,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             Z = last[1]
         delayed = None
         if "delay" in effects:
-            delayed, Z = (Z, p["d"]), shift(Z, p["d"], axis=-1)
+            delayed, Z = (None if static.get("held") else (Z, p["d"])), shift(Z, p["d"], axis=-1)
         parts = [Z, static_rows(s)]
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
@@ -1304,7 +1306,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         return _stack_rows(rows(s)).T
 
     def release() -> None:  # drop the memoised columns (rebuilt on the next use)
-        for key in [key for key in static if key != "train"]:
+        for key in [key for key in static if key not in ("train", "held")]:
             del static[key]
 
     def parts_chunks(s: Segment):  # a streamed segment's blocks, chunk by chunk (held p)
