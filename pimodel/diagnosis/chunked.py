@@ -8,6 +8,9 @@ layout the diagnosis builds them in) and the outputs of the same samples:
   the columns to unit norm first (the normal equations square the condition number; scaling
   removes the part due to columns of different size) and solves by least squares with a
   relative cut-off ``rcond``. One pass, ``p^2 m`` flops per chunk: the diagnosis' searches use it.
+  With ``y^T y`` summed too, :meth:`~NormalEquations.rss` gives the residual sum of squares from
+  the sums where cancellation cannot move it by ``RSS_RTOL`` (else None: a pass over the
+  residuals is needed).
 - :class:`ChunkedQR` keeps a running triangular factor: each chunk is stacked under the ``R``
   so far (with the output as a last column) and factored again by ``numpy.linalg.qr``, so
   the condition number is never squared; the last diagonal element of the factor gives the
