@@ -285,6 +285,9 @@ lib.pim_rdpi_sat_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c
 lib.pim_rdpi_sat_plays.restype = None
 lib.pim_rdpi_sat_plays.argtypes = [c_size, c_size, F64, c_double, c_double, c_double, c_double,
                                    F64, F64, F64, F64]
+lib.pim_rdpi_sat_plays_strided.restype = None
+lib.pim_rdpi_sat_plays_strided.argtypes = [c_size, c_size, F64, c_double, c_double, c_double,
+                                           c_double, F64, F64, F64, F64, c_size, c_size]
 lib.pim_rdpi_inverse_run.restype = c_int
 lib.pim_rdpi_inverse_run.argtypes = [c_size, c_size, F64, F64, c_double, c_double, c_double, F64,
                                      F64, F64, F64]
@@ -327,12 +330,15 @@ def rdpi_sat_run(p: np.ndarray, alpha: np.ndarray, beta: float, sat: float, lam:
 
 
 def rdpi_sat_plays(alpha: np.ndarray, beta: float, sat: float, lam: float, Ts: float,
-                   z: np.ndarray, hist: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The play outputs ``z_i[k]`` of :func:`rdpi_sat_run` (shape (N, n)), every play on the
-    one rate; ``z`` (n) and ``hist`` (v[k-1], rate[k]) updated in place."""
-    out = np.empty((v.shape[0], alpha.shape[0]))
-    lib.pim_rdpi_sat_plays(v.shape[0], alpha.shape[0], alpha, beta, sat, lam, Ts, z, hist, v,
-                           out)
+                   z: np.ndarray, hist: np.ndarray, v: np.ndarray, *,
+                   rows: bool = False) -> np.ndarray:
+    """The play outputs ``z_i[k]`` of :func:`rdpi_sat_run` (shape (N, n); ``rows``: (n, N),
+    written so, the same values), every play on the one rate; ``z`` (n) and ``hist`` (v[k-1],
+    rate[k]) updated in place."""
+    N, n = v.shape[0], alpha.shape[0]
+    out = np.empty((n, N) if rows else (N, n))
+    lib.pim_rdpi_sat_plays_strided(N, n, alpha, beta, sat, lam, Ts, z, hist, v, out,
+                                   *((1, N) if rows else (n, 1)))
     return out
 
 

@@ -14,6 +14,8 @@ from numpy.polynomial.legendre import legvander
 from scipy.signal import lfilter
 
 from pimodel.diagnosis.chunked import (
+    CHUNK,
+    RSS_RTOL,
     TRANSPOSE_BLOCK,
     ChunkedQR,
     NormalEquations,
@@ -47,6 +49,44 @@ def test_chunked_fits_equal_full_least_squares(seed):
     assert np.max(np.abs(coef_qr - ref)) < 1e-10 * scale
     assert abs(rss_qr - res[0]) < 1e-8 * res[0]
     assert ne.samples == qr.samples == y.size
+
+
+def _play_problem(noise: float, n: int = 2 * CHUNK + 3000, plays: int = 40):
+    # play outputs of a multisine (nearly collinear columns, as the diagnosis' regressors), an
+    # offset, and an output they fit up to white noise of relative size `noise`
+    rng = np.random.default_rng(7)
+    t = np.arange(n) * 1e-4
+    freqs = np.array([3.0, 7.0, 17.0, 41.0])
+    v = np.sin(2 * np.pi * freqs[:, None] * t + rng.uniform(0, 6, 4)[:, None]).T @ (1 / freqs)
+    seg = make_segment(t, v, np.zeros(n), np.linspace(0.0, 0.9 * np.ptp(v) / 2, plays))
+    X = seg.play_rows(offset=True)
+    y = rng.uniform(0.5, 1.5, X.shape[0]) @ X
+    return X, y + noise * np.std(y) * rng.normal(size=n)
+
+
+@pytest.mark.parametrize("noise", [1e-1, 1e-3, 1e-5, 1e-7, 1e-9])
+def test_rss_from_sums_within_tolerance_or_refused(noise):
+    # NormalEquations.rss takes y^T y - 2 c^T g + c^T G c only where the rounding of the sums
+    # cannot move it by RSS_RTOL: then it equals the residuals' RSS (in extended precision) to
+    # RSS_RTOL; a good fit of collinear columns (small noise) is refused (a pass is made)
+    X, y = _play_problem(noise)
+    ne = NormalEquations(X.shape[0])
+    for c in chunks(y.size):
+        ne.add(X[:, c], y[c])
+    coef = ne.solve()
+    r = y.astype(np.longdouble) - coef.astype(np.longdouble) @ X.astype(np.longdouble)
+    exact = float(np.sum(r * r))
+    naive = ne.yy - 2.0 * coef @ ne.g + coef @ ne.G @ coef
+    got = ne.rss(coef)
+    if got is not None:
+        assert abs(got - exact) <= RSS_RTOL * exact
+    if noise >= 1e-3:  # a fit that leaves 1e-6 of the output's variance: taken from the sums
+        assert got is not None
+    if noise <= 1e-7:  # the sums' cancellation: the formula alone would be off by far more
+        assert got is None
+        assert abs(naive - exact) > 10 * RSS_RTOL * exact
+    ne.add_gram(np.zeros_like(ne.G), np.zeros_like(ne.g), 0)  # y^T y not given: not known
+    assert ne.rss(coef) is None
 
 
 def test_chunked_qr_keeps_digits_where_normal_equations_lose_them():

@@ -69,3 +69,35 @@ def test_other_points_columns_nominals_and_records_are_fitted_anew():
                                                     {"train": TrainRecords(segs)}, ncols),
                      segs, dict(q))[1]
         assert calls[0] >= 1 and rss == plain
+
+
+def test_a_delay_search_forms_the_play_rows_gram_once(monkeypatch):
+    # the Gram of play rows delayed by a whole d is that of the undelayed rows on the window d
+    # samples earlier (effects._delayed_grams): one Gram of the play rows for the search, and
+    # the fits equal those that form each delayed Gram anew, to rounding
+    from pimodel.diagnosis import effects
+
+    train = _segments()
+    nominal, other = fit_nominal(train), fit_nominal(train)
+    big = []
+    square = effects._square
+    monkeypatch.setattr(effects, "_square",
+                        lambda X: (big.append(X.shape) if X.shape[1] > 1024 else None,
+                                   square(X))[1])
+
+    def search(nominal):  # a nominal of its own: no fit taken from the other's memo
+        static = {"train": TrainRecords(train)}
+        return [_fit("delay", 1, _combo_features(("delay",), {"d": d}, nominal, static),
+                     train, {"d": d}) for d in (1, 2, 5, 40, 2.5)]
+
+    fast = search(nominal)
+    n_fast = len(big)
+    monkeypatch.setattr(effects, "DELAYED_GRAM_MAX", 0)  # every delayed Gram formed anew
+    plain = search(other)
+    cuts = len(list(effects.chunks(train[0].y.size)))
+    # the undelayed rows' Gram once, the fractional delay's anew; without: one per delay
+    assert n_fast == 2 * cuts and len(big) - n_fast == 5 * cuts
+    for (m1, rss1), (m2, rss2) in zip(fast, plain, strict=True):
+        assert abs(rss1 - rss2) <= 1e-9 * rss2
+        out1, out2 = m1.predict(train[0]), m2.predict(train[0])
+        assert np.max(np.abs(out1 - out2)) <= 1e-7 * np.ptp(train[0].y)

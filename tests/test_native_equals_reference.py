@@ -125,6 +125,12 @@ def test_rdpi_sat_plays_equals_sat_run_per_play(seed):
         z0, hist0 = rng.uniform(-0.5, 0.5, n), np.array([v[0], rng.uniform(0, 5)])
         z, hist = z0.copy(), hist0.copy()
         plays = _native.rdpi_sat_plays(alpha, beta, sat, lam, dt, z, hist, v)
+        # the same plays written as rows (the diagnosis' layout), state updated alike
+        zr, hr = z0.copy(), hist0.copy()
+        rows = _native.rdpi_sat_plays(alpha, beta, sat, lam, dt, zr, hr, v, rows=True)
+        assert rows.shape == (n, N) and rows.flags.c_contiguous
+        np.testing.assert_array_equal(rows, plays.T)
+        assert np.array_equal(zr, z) and np.array_equal(hr, hist)
         for i in range(n):
             zi, hi = z0[i:i + 1].copy(), hist0.copy()
             ref = _native.rdpi_sat_run(np.ones(1), alpha[i:i + 1].copy(), beta, sat, lam, dt,

@@ -87,6 +87,7 @@ SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the fi
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
 LTI_MEMO = 16  # columns of the linear part's elements memoised per record (the last base mode)
 _ORDER_LOCK = threading.Lock()  # guards the memos of _order_memo (module threads)
+DELAYED_GRAM_MAX = 1024  # samples: a longer whole delay's Gram formed anew (_delayed_grams)
 SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
 EFFECTS = ("creep", "dynamics", "delay", "asymmetry", "drift", "rate")
@@ -190,6 +191,7 @@ class Segment:
         >>> seg.forget_grams()  # nothing kept yet: nothing to drop
         """
         self.__dict__.pop("_first_grams", None)  # every thread's
+        self.__dict__.pop("_base_grams", None)
 
 
 def make_segment(t, v, y, radii, mask=None, *, at_rest: bool = True) -> Segment:
@@ -400,8 +402,10 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     """Least squares over all train records through normal equations accumulated chunk by
     chunk (:class:`~pimodel.diagnosis.chunked.NormalEquations`: columns scaled to unit norm, the
     Gram matrix is small), so a grid search costs one pass over the data per point and no
-    temporary larger than a chunk; the residual sum of squares is computed from the residuals
-    themselves, chunk by chunk. The regressors are taken as blocks of rows when the builder has
+    temporary larger than a chunk; the residual sum of squares is taken from the same sums
+    when that is safe from cancellation (:meth:`~pimodel.diagnosis.chunked.NormalEquations.rss`,
+    within ``RSS_RTOL``), else computed from the residuals themselves, chunk by chunk (a second
+    pass). The regressors are taken as blocks of rows when the builder has
     them (:func:`_row_parts`): no copy of the play columns at each point of a search. A
     streamed segment (a long record in the whole-record refit, module streamed) gives its
     blocks chunk by chunk (``features.parts_chunks``), built once per pass: the same values
@@ -415,17 +419,19 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     blocks = [None if is_streamed(s) else _row_parts(features, s) for s in train]
     ne = None
     for P, s in zip(blocks, train, strict=True):
-        first = None if P is None else _first_grams(P[0], s)
-        for G, Xy, m in _per_chunk(features, P, s, lambda j, c, Pc, s=s, first=first:
-                                   _normal_terms(Pc, s, c, None if first is None else first[j])):
+        first = None if P is None else _first_grams(P[0], s, getattr(P, "delayed", None))
+        for terms in _per_chunk(features, P, s, lambda j, c, Pc, s=s, first=first:
+                                _normal_terms(Pc, s, c, None if first is None else first[j])):
             if ne is None:
-                ne = NormalEquations(G.shape[0])
-            ne.add_gram(G, Xy, m)
+                ne = NormalEquations(terms[0].shape[0])
+            ne.add_gram(*terms)
     coef = ne.solve()
-    rss = 0.0
-    for P, s in zip(blocks, train, strict=True):
-        for r in _per_chunk(features, P, s, lambda j, c, Pc, s=s: _chunk_rss(Pc, s, c, coef)):
-            rss += r  # summed in the chunks' order, whichever thread made each
+    rss = ne.rss(coef)  # from the sums when that is safe from cancellation (RSS_RTOL)
+    if rss is None:  # else a second pass, over the residuals
+        rss = 0.0
+        for P, s in zip(blocks, train, strict=True):
+            for r in _per_chunk(features, P, s, lambda j, c, Pc, s=s: _chunk_rss(Pc, s, c, coef)):
+                rss += r  # summed in the chunks' order, whichever thread made each
     if memo is not None:
         memo[0][memo[2]] = (memo[3], (coef.copy(), rss))
     return Model(name, k, features, coef, params or {}), rss
@@ -492,9 +498,14 @@ def _per_chunk(features, P: tuple | None, s: Segment, fn: Callable) -> Iterable:
 
 
 def _normal_terms(Pc: tuple, s: Segment, c: slice, first: np.ndarray | None):
-    """The Gram matrix, ``X y`` and the sample count of the fitted samples of chunk ``c``."""
+    """The Gram matrix, ``X y``, the sample count and ``y^T y`` of the fitted samples of
+    chunk ``c``."""
     Pc, y = _used_chunk(Pc, s, c)
-    return _gram(Pc, first), np.concatenate([X @ y for X in Pc]), y.size
+    if first is None:
+        return _gram(Pc), np.concatenate([X @ y for X in Pc]), y.size, float(y @ y)
+    gram, zy = first  # the first block's, kept (_first_grams)
+    return (_gram(Pc, gram), np.concatenate([zy] + [X @ y for X in Pc[1:]]), y.size,
+            float(y @ y))
 
 
 def _chunk_rss(Pc: tuple, s: Segment, c: slice, coef: np.ndarray) -> float:
@@ -523,12 +534,19 @@ def _row_parts(features, s: Segment) -> tuple:
     return (features(s).T,)
 
 
-def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
-    """``Z_c Z_c^T`` of the first block of rows ``Z`` (the play rows) on each chunk ``c`` of
-    ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
+def _first_grams(Z: np.ndarray, s: Segment, delayed: tuple | None = None) -> list | None:
+    """``(Z_c Z_c^T, Z_c y_c)`` of the first block of rows ``Z`` (the play rows) on each chunk
+    ``c`` of ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
     screen's (at most ``SCREEN_SAMPLES`` samples): the fits of a search that holds the play
     rows (creep, asymmetry, drift, the rate's filters, the linear part's elements around one
-    mode) then form only the blocks that change. None for a whole long record."""
+    mode) then form only the blocks that change. None for a whole long record.
+
+    ``delayed = (Z0, d)``: ``Z`` is ``Z0`` delayed by ``d`` samples (held at ``Z0[:, 0]``
+    before the start). For a whole ``d`` and no mask, the Gram on a chunk ``[a, b)`` is that
+    of ``Z0`` on ``[a - d, b - d)``: ``Z0``'s on ``[a, b)`` (kept for the latest ``Z0``,
+    :func:`_delayed_grams`) less its ``d`` last samples' outer products plus those of the ``d``
+    samples before ``a``, so a delay search forms one Gram of the play rows per ``Z0``, not
+    one per delay (the same sums in another order: equal to rounding)."""
     if Z.shape[1] > SCREEN_SAMPLES:
         return None
     cuts = list(chunks(s.y.size))
@@ -536,9 +554,40 @@ def _first_grams(Z: np.ndarray, s: Segment) -> list | None:
     kept = s.__dict__.setdefault("_first_grams", {})  # per thread (module threads)
     memo = kept.get(threading.get_ident())
     if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
-        grams = helped_map(lambda c: _square(_used_chunk((Z[:, c],), s, c)[0][0]), cuts)
+        grams = None
+        if delayed is not None and s.mask is None and Z.shape == delayed[0].shape:
+            grams = _delayed_grams(Z, s, cuts, *delayed)
+        if grams is None:
+            grams = helped_map(lambda c: _first_terms(*_used_chunk((Z[:, c],), s, c)), cuts)
         memo = kept[threading.get_ident()] = (key, Z, grams)
     return memo[2]
+
+
+def _delayed_grams(Z: np.ndarray, s: Segment, cuts: list, Z0: np.ndarray, d) -> list | None:
+    """:func:`_first_grams` of ``Z``, ``Z0`` delayed by a whole ``d`` samples, from those of
+    ``Z0`` (kept on the segment for the latest ``Z0``, per thread); None for a fractional or
+    zero ``d`` or one beyond ``DELAYED_GRAM_MAX`` samples (``Z`` then fitted as it is)."""
+    n = int(d) if float(d).is_integer() else 0
+    if not 0 < n <= DELAYED_GRAM_MAX:
+        return None
+    key = (Z0.__array_interface__["data"][0], Z0.shape, Z0.strides, len(cuts))
+    kept = s.__dict__.setdefault("_base_grams", {})  # per thread (module threads)
+    memo = kept.get(threading.get_ident())
+    if memo is None or memo[0] != key:  # memo[1] keeps Z0 alive: its address stays its own
+        memo = kept[threading.get_ident()] = (key, Z0, helped_map(lambda c: _square(Z0[:, c]),
+                                                                  cuts))
+    z0 = Z0[:, :1]
+
+    def window(x: int, y: int) -> np.ndarray:  # sum of z_max(j,0) z_max(j,0)^T, j in [x, y)
+        G = _square(Z0[:, max(x, 0):y]) if y > 0 else 0.0
+        return G + (min(y, 0) - x) * _square(z0) if x < 0 else G
+
+    return [((G0 - window(c.stop - n, c.stop)) + window(c.start - n, c.start), Z[:, c] @ s.y[c])
+            for c, G0 in zip(cuts, memo[2], strict=True)]
+
+
+def _first_terms(Pc: tuple, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return _square(Pc[0]), Pc[0] @ y  # the products _normal_terms would make
 
 
 def _square(X: np.ndarray) -> np.ndarray:
@@ -864,7 +913,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     k += len(nominal.params["creep_taus"]) if common else 0
     if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
         k -= RATE_BANDS - 1
-    static: dict = {"train": TrainRecords(train)}
+    # held: one point, no search; its play rows' Gram formed as a streamed refit forms it
+    # (no delayed Gram from the undelayed rows', _first_grams), so the two equal to the bit
+    static: dict = {"train": TrainRecords(train), "held": held}
     # a mode search filters every column at every point: there, the leading columns only (not
     # for the rate filter: with 12 columns it chose 17 ms for a 20 ms truth_alt rate, which
     # then left a spurious second effect)
@@ -1074,8 +1125,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
         # exponential map, the validate RMS drops 3 to 10 times in two steps)
         for _ in range(ASYMMETRY_ITERATIONS):
             ref = _hysteresis_reference(model, train, nominal)
-            model = _fit(name, k_all, _combo_features(effects, p, ref, {"train": static["train"]}),
-                         train, p)[0]
+            model = _fit(name, k_all, _combo_features(
+                effects, p, ref, {"train": static["train"], "held": held}), train, p)[0]
             model.reference = ref
     model.grid = dict(model.params)
     model.params = _describe(effects, model, nominal)
@@ -1192,6 +1243,13 @@ def _combo_k(effects, nominal: Model) -> int:
                 "asymmetry": 2, "drift": 1, "rate": RATE_BANDS + 2}[e] for e in effects)
 
 
+class _Parts(tuple):
+    """Blocks of rows (:func:`_row_parts`); ``delayed``: ``(Z0, d)`` when the first block is
+    ``Z0`` delayed by ``d`` samples (:func:`_first_grams`), else None."""
+
+    delayed = None
+
+
 def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
     """Feature builder for the effects with grid parameters ``p``; the columns that do not
     depend on ``p`` (offset, creep, asymmetry) are memoised per segment in ``static`` (the rate
@@ -1234,8 +1292,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                 last = ((p["fn"], p["zeta"]), mode_rows(Z, p["fn"], p["zeta"], s.dt), s)
                 static[("mode", id(s), ncols)] = last
             Z = last[1]
+        delayed = None
         if "delay" in effects:
-            Z = shift(Z, p["d"], axis=-1)
+            delayed, Z = (None if static.get("held") else (Z, p["d"])), shift(Z, p["d"], axis=-1)
         parts = [Z, static_rows(s)]
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
@@ -1251,13 +1310,15 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                                        len(static["train"])).T)
         # the other rows as they are when there is one block (the static rows, C-contiguous:
         # a mode or delay search then copies nothing of them per point)
-        return Z, parts[1] if len(parts) == 2 else _stack_rows(parts[1:])
+        out = _Parts((Z, parts[1] if len(parts) == 2 else _stack_rows(parts[1:])))
+        out.delayed = delayed  # the play rows before the delay (their Gram: _first_grams)
+        return out
 
     def feats(s: Segment) -> np.ndarray:
         return _stack_rows(rows(s)).T
 
     def release() -> None:  # drop the memoised columns (rebuilt on the next use)
-        for key in [key for key in static if key != "train"]:
+        for key in [key for key in static if key not in ("train", "held")]:
             del static[key]
 
     def parts_chunks(s: Segment):  # a streamed segment's blocks, chunk by chunk (held p)

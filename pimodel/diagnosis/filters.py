@@ -186,7 +186,13 @@ def shift(x: np.ndarray, d: float, axis: int = 0) -> np.ndarray:
     n = int(np.floor(d))
     f = float(d) - n
     if f > 1e-12:
-        return (1.0 - f) * shift(x, n, axis) + f * shift(x, n + 1, axis)
+        lo, hi = shift(x, n, axis), shift(x, n + 1, axis)  # hi is new, lo too unless n == 0
+        if hi.dtype.kind != "f":
+            return (1.0 - f) * lo + f * hi
+        # (1 - f) lo + f hi in place: the same products and sum as the expression (no three
+        # more temporaries of x's size; a delay search shifts the play rows at every point)
+        lo = (1.0 - f) * lo if lo is x else np.multiply(lo, 1.0 - f, out=lo)
+        return np.add(lo, np.multiply(hi, f, out=hi), out=lo)
     if n == 0:
         return x
     out = np.empty_like(x)  # the layout of x (signals as rows stay rows)

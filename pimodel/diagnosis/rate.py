@@ -473,9 +473,10 @@ class RateBasis:
         key = ("scaled", float(tau), saturation, float(growth))
         if key not in self._cache:
             z0 = float(self.v[0]) if self.at_rest else 0.0
+            # the plays written as rows when they are the rows (no transpose of N x n)
             Zs = scaled_plays(self.v, self.radii, self.dt, self.rate_scale, tau, saturation,
-                              growth, z0)
-            rows = transposed(Zs if self.projection is None else Zs @ self.projection)
+                              growth, z0, rows=self.projection is None)
+            rows = Zs if self.projection is None else transposed(Zs @ self.projection)
             self._cache.clear()
             self._cache[key] = rows
         return self._cache[key]
@@ -537,7 +538,8 @@ class RateBasis:
 
 
 def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
-                 saturation: float | None, growth: float, z0: float = 0.0) -> np.ndarray:
+                 saturation: float | None, growth: float, z0: float = 0.0, *,
+                 rows: bool = False) -> np.ndarray:
     """Outputs ``zs_i[k]`` of plays whose radii scale with the rate (the exact shape).
 
     ``zs_i[k] = min(max(zs_i[k-1], v[k] - rho_i[k]), v[k] + rho_i[k])``, ``zs_i[-1] = z0``,
@@ -564,11 +566,14 @@ def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
         ``G`` [-].
     z0 : float
         Play states before ``v[0]``.
+    rows : bool
+        Return the plays as rows, shape (n, N), written so by the C core (the same values as
+        the transpose of the default, without the copy).
 
     Returns
     -------
     numpy.ndarray
-        Shape (N, n); row ``k`` depends on ``v[0..k]``.
+        Shape (N, n) (``rows``: (n, N)); sample ``k`` depends on ``v[0..k]``.
 
     Raises
     ------
@@ -596,7 +601,7 @@ def scaled_plays(v: np.ndarray, radii, dt: float, rate_scale: float, tau: float,
     lam = float(np.exp(-dt / tau))
     sat = 0.0 if saturation is None else saturation * rate_scale
     return _native.rdpi_sat_plays(np.ascontiguousarray(r), growth / rate_scale, sat, lam, dt,
-                                  np.full(r.size, z0), np.array([v[0], 0.0]), v)
+                                  np.full(r.size, z0), np.array([v[0], 0.0]), v, rows=rows)
 
 
 def rate_columns(Z: np.ndarray, radii, v: np.ndarray, dt: float, rate_scale: float, weights,

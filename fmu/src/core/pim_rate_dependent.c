@@ -60,15 +60,23 @@ void pim_rdpi_sat_run(size_t N, size_t n, const double *p, const double *alpha, 
     }
 }
 
+void pim_rdpi_sat_plays_strided(size_t N, size_t n, const double *alpha, double beta,
+                                double sat, double lam, double Ts, double *z, double *hist,
+                                const double *v, double *zs, size_t ks, size_t is)
+{
+    for (size_t k = 0; k < N; ++k) {
+        const double g = rate_growth(hist, beta, sat);
+        for (size_t i = 0; i < n; ++i)
+            zs[k * ks + i * is] = z[i] = rate_play(z[i], alpha[i], g, v[k]);
+        rate_update(hist, v[k], lam, Ts);
+    }
+}
+
 void pim_rdpi_sat_plays(size_t N, size_t n, const double *alpha, double beta, double sat,
                         double lam, double Ts, double *z, double *hist, const double *v,
                         double *zs)
 {
-    for (size_t k = 0; k < N; ++k) {
-        const double g = rate_growth(hist, beta, sat);
-        for (size_t i = 0; i < n; ++i) zs[k * n + i] = z[i] = rate_play(z[i], alpha[i], g, v[k]);
-        rate_update(hist, v[k], lam, Ts);
-    }
+    pim_rdpi_sat_plays_strided(N, n, alpha, beta, sat, lam, Ts, z, hist, v, zs, n, 1);
 }
 
 int pim_rdpi_inverse_run(size_t N, size_t n, const double *p, const double *alpha, double beta,

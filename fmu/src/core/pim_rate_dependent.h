@@ -61,6 +61,15 @@ PIM_API void pim_rdpi_sat_plays(size_t N, size_t n, const double *alpha, double 
                                 const double *v, double *zs);
 
 /*
+ * pim_rdpi_sat_plays writing z_i[k] to zs[k ks + i is]: (ks, is) = (n, 1) is its row-major
+ * N x n, (1, N) the plays as rows (n x N, the layout the diagnosis' fits take; no transpose).
+ */
+PIM_API void pim_rdpi_sat_plays_strided(size_t N, size_t n, const double *alpha, double beta,
+                                        double sat, double lam, double Ts, double *z,
+                                        double *hist, const double *v, double *zs, size_t ks,
+                                        size_t is);
+
+/*
  * Exact inverse run: v[k] such that the forward operator with state (z, hist) outputs yd[k];
  * z and hist are the *forward* operator's state and are advanced with v[k].  Returns 0, or
  * -1 when n > PIM_MAX_PLAYS.
