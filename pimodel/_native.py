@@ -268,6 +268,9 @@ lib.pim_joint_select.restype = c_size
 lib.pim_joint_select.argtypes = [c_size, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double,
                                  ctypes.c_double, ctypes.c_double, ctypes.c_void_p,
                                  ctypes.c_void_p, ctypes.POINTER(ctypes.c_longlong)]
+lib.pim_joint_hinges.restype = None
+lib.pim_joint_hinges.argtypes = [c_size, ctypes.c_void_p, c_size, ctypes.c_void_p,
+                                 ctypes.c_void_p]
 lib.pim_joint_add.restype = ctypes.c_double
 lib.pim_joint_add.argtypes = [c_size, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
                               ctypes.c_double, c_size, ctypes.c_double, ctypes.c_double,
@@ -296,6 +299,15 @@ def joint_select(v: np.ndarray, y: np.ndarray, s: float, keep_limit: float,
                              travel_range, _f64_address(x, "x"), _f64_address(Y, "Y"),
                              ctypes.byref(outside))
     return x[:m], Y[:m], outside.value
+
+
+def joint_hinges(x: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """``max(0, x[k] - 2 r[j])`` as an (m, n) array (``pim_joint_hinges``): the values of
+    ``np.maximum(0.0, x[:, None] - 2.0 * r[None, :])`` in one pass."""
+    m, n = x.shape[0], r.shape[0]
+    H = np.empty((m, n))
+    lib.pim_joint_hinges(m, _f64_address(x, "x"), n, _f64_address(r, "r"), _f64_address(H, "H"))
+    return H
 
 
 def joint_add(x: np.ndarray, Y: np.ndarray, e: np.ndarray, c: float, stats: np.ndarray,

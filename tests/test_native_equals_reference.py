@@ -137,10 +137,17 @@ def test_rdpi_sat_plays_equals_sat_run_per_play(seed):
 
 @pytest.mark.parametrize("seed", range(4))
 def test_joint_branch_statistics_equal_reference(seed):
-    """``pim_joint_select`` picks exactly the reference's samples; ``pim_joint_add`` bins them
-    exactly as the reference does, with and without forgetting (its sum of squares to 1e-12)."""
+    """``pim_joint_select`` picks exactly the reference's samples, ``branch_shape`` on the hinge
+    matrix of ``pim_joint_hinges`` equals the reference's to the bit, ``pim_joint_add`` bins
+    them exactly as the reference does, with and without forgetting (its sum of squares to
+    1e-12)."""
     from pimodel import _native
-    from pimodel.reference.joint import joint_add_reference, joint_select_reference
+    from pimodel.identification.adaptive.joint import branch_shape
+    from pimodel.reference.joint import (
+        branch_shape_reference,
+        joint_add_reference,
+        joint_select_reference,
+    )
 
     rng = np.random.default_rng(seed)
     N, n, bins = int(rng.integers(2, 6000)), int(rng.integers(1, 9)), int(rng.integers(40, 3000))
@@ -155,7 +162,9 @@ def test_joint_branch_statistics_equal_reference(seed):
         if x.size < 1:
             continue
         w, r = rng.uniform(0, 2, n), np.sort(rng.uniform(0, 0.6 * travel, n))
-        e = Y - np.maximum(0.0, x[:, None] - 2.0 * r[None, :]) @ w
+        g = branch_shape(x, w, r)
+        assert np.array_equal(g, branch_shape_reference(x, w, r))
+        e = Y - g
         c = float(np.mean(e))
         for forgetting in (1.0, float(rng.uniform(0.5, 1.0))):
             stats = np.abs(rng.normal(0, 3, (3, bins)))
@@ -188,6 +197,7 @@ def test_joint_estimator_on_the_core_equals_it_on_the_reference(monkeypatch):
     update's weights and radii to the bit, the same updates and counts, the fit RMS (a sum of
     squares in another order) to 1e-12."""
     from pimodel import _native, estimate_jointly
+    from pimodel.identification.adaptive import joint
     from pimodel.reference import joint as reference
 
     for v, y, n, options in _joint_records():
@@ -197,6 +207,7 @@ def test_joint_estimator_on_the_core_equals_it_on_the_reference(monkeypatch):
             with monkeypatch.context() as m:
                 m.setattr(_native, "joint_select", reference.joint_select_reference)
                 m.setattr(_native, "joint_add", reference.joint_add_reference)
+                m.setattr(joint, "branch_shape", reference.branch_shape_reference)
                 ref = estimate_jointly(v, y, n, **options)
         assert core.update_index.size >= 3
         assert np.array_equal(core.update_index, ref.update_index)

@@ -22,7 +22,7 @@ from .extended_operators import (
     rdpi_inverse_reference,
     rdpi_reference,
 )
-from .joint import joint_add_reference, joint_select_reference
+from .joint import branch_shape_reference, joint_add_reference, joint_select_reference
 from .operators import (
     pi_inverse_reference,
     pi_reference,
@@ -50,6 +50,7 @@ __all__ = [
     "BranchProfile",
     "estimate_radii_reference",
     "project_ordered_reference",
+    "branch_shape_reference",
     "joint_add_reference",
     "joint_select_reference",
 ]

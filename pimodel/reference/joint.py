@@ -13,9 +13,38 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "branch_shape_reference",
     "joint_add_reference",
     "joint_select_reference",
 ]
+
+
+def branch_shape_reference(x: np.ndarray, weights: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """``g(x) = sum_j p_j max(0, x - 2 r_j)``, the specification of
+    :func:`pimodel.identification.adaptive.joint.branch_shape` (whose hinge matrix the C core
+    builds: ``pim_joint_hinges``).
+
+    Parameters
+    ----------
+    x : numpy.ndarray of float, shape (N,)
+        Travels from the reversal (input unit, >= 0).
+    weights : numpy.ndarray of float, shape (n,)
+        Play weights ``p_j``.
+    radii : numpy.ndarray of float, shape (n,)
+        Play radii ``r_j`` (input unit).
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (N,)
+        ``g(x)`` (output unit).
+
+    Examples
+    --------
+    >>> branch_shape_reference(np.array([0.0, 0.5, 1.0]), np.array([1.0, 0.5]),
+    ...                        np.array([0.0, 0.4]))
+    array([0. , 0.5, 1.1])
+    """
+    return np.maximum(0.0, x[:, None] - 2.0 * radii[None, :]) @ weights
 
 
 def joint_select_reference(v: np.ndarray, y: np.ndarray, s: float, keep_limit: float,

@@ -24,6 +24,15 @@ size_t pim_joint_select(size_t N, const double *v, const double *y, double s,
     return m;
 }
 
+void pim_joint_hinges(size_t m, const double *x, size_t n, const double *r, double *H)
+{
+    for (size_t k = 0; k < m; ++k)
+        for (size_t j = 0; j < n; ++j) {
+            const double d = x[k] - 2.0 * r[j];
+            H[k * n + j] = d > 0.0 ? d : 0.0;
+        }
+}
+
 double pim_joint_add(size_t m, const double *x, const double *Y, const double *e, double c,
                      size_t bins, double scale, double forgetting, double *stats,
                      double *branch)
