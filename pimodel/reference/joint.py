@@ -27,16 +27,14 @@ def branch_shape_reference(x: np.ndarray, weights: np.ndarray, radii: np.ndarray
     Parameters
     ----------
     x : numpy.ndarray of float, shape (N,)
-        Travels from the reversal (input unit, >= 0).
-    weights : numpy.ndarray of float, shape (n,)
-        Play weights ``p_j``.
-    radii : numpy.ndarray of float, shape (n,)
-        Play radii ``r_j`` (input unit).
+        Travel of each sample since the branch's reversal (input unit).
+    weights, radii : numpy.ndarray of float, shape (n,)
+        The estimate in force: ``p_j`` and ``r_j`` (input unit).
 
     Returns
     -------
     numpy.ndarray of float, shape (N,)
-        ``g(x)`` (output unit).
+        The shape at each travel (output unit).
 
     Examples
     --------
