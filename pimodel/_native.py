@@ -292,8 +292,8 @@ def joint_select(v: np.ndarray, y: np.ndarray, s: float, keep_limit: float,
     C-contiguous, equal lengths). Returns the travels ``x``, the signed outputs ``Y`` and the
     count of samples beyond ``travel_range``."""
     N = v.shape[0]
-    if y.shape != (N,):
-        raise ValueError(f"y: expected shape ({N},), got {y.shape}")
+    if y.shape != (N,) or N < 1:
+        raise ValueError(f"v and y: expected one length >= 1, got {v.shape} and {y.shape}")
     x, Y, outside = np.empty(N), np.empty(N), ctypes.c_longlong(0)
     m = lib.pim_joint_select(N, _f64_address(v, "v"), _f64_address(y, "y"), s, keep_limit,
                              travel_range, _f64_address(x, "x"), _f64_address(Y, "Y"),

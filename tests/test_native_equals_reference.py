@@ -164,6 +164,9 @@ def test_joint_branch_statistics_equal_reference(seed):
         w, r = rng.uniform(0, 2, n), np.sort(rng.uniform(0, 0.6 * travel, n))
         g = branch_shape(x, w, r)
         assert np.array_equal(g, branch_shape_reference(x, w, r))
+        nan = x.copy()
+        nan[::7] = np.nan  # a NaN travel gives a NaN shape, as numpy's maximum does
+        np.testing.assert_array_equal(branch_shape(nan, w, r), branch_shape_reference(nan, w, r))
         e = Y - g
         c = float(np.mean(e))
         for forgetting in (1.0, float(rng.uniform(0.5, 1.0))):

@@ -29,7 +29,7 @@ void pim_joint_hinges(size_t m, const double *x, size_t n, const double *r, doub
     for (size_t k = 0; k < m; ++k)
         for (size_t j = 0; j < n; ++j) {
             const double d = x[k] - 2.0 * r[j];
-            H[k * n + j] = d > 0.0 ? d : 0.0;
+            H[k * n + j] = (d > 0.0 || d != d) ? d : 0.0; /* NaN stays NaN, as in numpy */
         }
 }
 

@@ -27,8 +27,8 @@ PIM_API size_t pim_joint_select(size_t N, const double *v, const double *y, doub
 /*
  * The hinge matrix of the branch shape: H[k][j] = max(0, x[k] - 2 r[j]) for the m travels x
  * and the n radii r (row-major, m x n), the values numpy gives for
- * np.maximum(0.0, x[:, None] - 2.0 * r[None, :]); the branch shape g = H w is then one BLAS
- * product, as in the NumPy reference.
+ * np.maximum(0.0, x[:, None] - 2.0 * r[None, :]) (a NaN stays NaN); the branch shape
+ * g = H w is then one BLAS product, as in the NumPy reference.
  */
 PIM_API void pim_joint_hinges(size_t m, const double *x, size_t n, const double *r, double *H);
 
