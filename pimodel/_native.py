@@ -262,6 +262,69 @@ def reversal_scanner() -> ctypes.Array:
     return buf
 
 
+# -- joint estimator's branch statistics (fmu/src/core/pim_joint.h) -------------------------
+
+lib.pim_joint_select.restype = c_size
+lib.pim_joint_select.argtypes = [c_size, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double,
+                                 ctypes.c_double, ctypes.c_double, ctypes.c_void_p,
+                                 ctypes.c_void_p, ctypes.POINTER(ctypes.c_longlong)]
+lib.pim_joint_hinges.restype = None
+lib.pim_joint_hinges.argtypes = [c_size, ctypes.c_void_p, c_size, ctypes.c_void_p,
+                                 ctypes.c_void_p]
+lib.pim_joint_add.restype = ctypes.c_double
+lib.pim_joint_add.argtypes = [c_size, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+                              ctypes.c_double, c_size, ctypes.c_double, ctypes.c_double,
+                              ctypes.c_void_p, ctypes.c_void_p]
+
+
+def _f64_address(a: np.ndarray, name: str) -> int:
+    """The data address of a float64 C-contiguous array (the joint estimator calls these
+    functions once per branch, where numpy's ``ndpointer`` checks cost as much as the work)."""
+    if a.dtype != np.float64 or not a.flags.c_contiguous:
+        raise TypeError(f"{name}: expected a C-contiguous float64 array")
+    return a.__array_interface__["data"][0]
+
+
+def joint_select(v: np.ndarray, y: np.ndarray, s: float, keep_limit: float,
+                 travel_range: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """The samples of a finished branch the joint estimator uses (``pim_joint_select``):
+    ``v`` the branch's inputs from its reversal extreme, ``y`` their outputs (float64,
+    C-contiguous, equal lengths). Returns the travels ``x``, the signed outputs ``Y`` and the
+    count of samples beyond ``travel_range``."""
+    N = v.shape[0]
+    if y.shape != (N,) or N < 1:
+        raise ValueError(f"v and y: expected one length >= 1, got {v.shape} and {y.shape}")
+    x, Y, outside = np.empty(N), np.empty(N), ctypes.c_longlong(0)
+    m = lib.pim_joint_select(N, _f64_address(v, "v"), _f64_address(y, "y"), s, keep_limit,
+                             travel_range, _f64_address(x, "x"), _f64_address(Y, "Y"),
+                             ctypes.byref(outside))
+    return x[:m], Y[:m], outside.value
+
+
+def joint_hinges(x: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """``max(0, x[k] - 2 r[j])`` as an (m, n) array (``pim_joint_hinges``): the values of
+    ``np.maximum(0.0, x[:, None] - 2.0 * r[None, :])`` in one pass."""
+    m, n = x.shape[0], r.shape[0]
+    H = np.empty((m, n))
+    lib.pim_joint_hinges(m, _f64_address(x, "x"), n, _f64_address(r, "r"), _f64_address(H, "H"))
+    return H
+
+
+def joint_add(x: np.ndarray, Y: np.ndarray, e: np.ndarray, c: float, stats: np.ndarray,
+              travel_range: float, forgetting: float) -> float:
+    """Selected branch samples ``(x, Y)`` centred by ``c`` (the mean of their errors ``e``
+    about the estimate in force) and added to ``stats`` (float64, shape (3, bins), updated in
+    place) (``pim_joint_add``); returns ``sum (e - c)^2``."""
+    m, bins = x.shape[0], stats.shape[1]
+    if Y.shape != (m,) or e.shape != (m,) or stats.shape != (3, bins) or m < 1:
+        raise ValueError("joint_add: expected x, Y, e of one length >= 1 and stats of shape "
+                         "(3, bins)")
+    scratch = np.empty(3 * bins)
+    return lib.pim_joint_add(m, _f64_address(x, "x"), _f64_address(Y, "Y"),
+                             _f64_address(e, "e"), c, bins, bins / travel_range, forgetting,
+                             _f64_address(stats, "stats"), _f64_address(scratch, "scratch"))
+
+
 # -- generalized, rate-dependent and creep operators (fmu/src/pim_generalized.h,
 #    pim_rate_dependent.h, pim_creep.h) --------------------------------------------------------
 

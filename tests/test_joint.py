@@ -28,7 +28,12 @@ def max_rel_error(est, truth):
 
 
 def sine(t):
-    return 30 * np.sin(2 * np.pi * t)
+    """``30 sin(2 pi t)``, computed in place (the same values as ``30 * np.sin(2 * np.pi * t)``
+    without two temporary arrays: the long records below call it on 2.6 G samples)."""
+    out = t * (2 * np.pi)
+    np.sin(out, out=out)
+    out *= 30
+    return out
 
 
 def staircase_at(step: float, fs: float):

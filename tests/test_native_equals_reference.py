@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -137,3 +139,89 @@ def test_rdpi_sat_plays_equals_sat_run_per_play(seed):
                                        zi, hi, v)
             np.testing.assert_array_equal(plays[:, i], ref)
             assert zi[0] == z[i] and np.array_equal(hi, hist)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_joint_branch_statistics_equal_reference(seed):
+    """``pim_joint_select`` picks exactly the reference's samples, ``branch_shape`` on the hinge
+    matrix of ``pim_joint_hinges`` equals the reference's to the bit, ``pim_joint_add`` bins
+    them exactly as the reference does, with and without forgetting (its sum of squares to
+    1e-12)."""
+    from pimodel import _native
+    from pimodel.identification.adaptive.joint import branch_shape
+    from pimodel.reference.joint import (
+        branch_shape_reference,
+        joint_add_reference,
+        joint_select_reference,
+    )
+
+    rng = np.random.default_rng(seed)
+    N, n, bins = int(rng.integers(2, 6000)), int(rng.integers(1, 9)), int(rng.integers(40, 3000))
+    v = np.cumsum(rng.normal(0, 0.1, N))
+    y = rng.normal(0, 5, N)
+    span = float(np.ptp(np.abs(v - v[0])))
+    for s, keep, travel in ((1.0, span, span), (-1.0, 0.7 * span, 0.4 * span),
+                            (1.0, 0.3 * span, 2 * span)):
+        x, Y, outside = _native.joint_select(v, y, s, keep, travel)
+        xr, Yr, outside_r = joint_select_reference(v, y, s, keep, travel)
+        assert np.array_equal(x, xr) and np.array_equal(Y, Yr) and outside == outside_r
+        if x.size < 1:
+            continue
+        w, r = rng.uniform(0, 2, n), np.sort(rng.uniform(0, 0.6 * travel, n))
+        g = branch_shape(x, w, r)
+        assert np.array_equal(g, branch_shape_reference(x, w, r))
+        nan = x.copy()
+        nan[::7] = np.nan  # a NaN travel gives a NaN shape, as numpy's maximum does
+        np.testing.assert_array_equal(branch_shape(nan, w, r), branch_shape_reference(nan, w, r))
+        e = Y - g
+        c = float(np.mean(e))
+        for forgetting in (1.0, float(rng.uniform(0.5, 1.0))):
+            stats = np.abs(rng.normal(0, 3, (3, bins)))
+            ref = stats.copy()
+            sse = _native.joint_add(x, Y, e, c, stats, travel, forgetting)
+            sse_r = joint_add_reference(x, Y, e, c, ref, travel, forgetting)
+            assert np.array_equal(stats, ref)
+            assert sse == pytest.approx(sse_r, rel=1e-12, abs=1e-12)
+
+
+def _joint_records():
+    from pimodel.signals import biased_staircase, sinusoid
+
+    p, r = np.array([0.3, 0.5, 0.8, 0.3, 0.2]), np.array([0.4, 1.0, 1.5, 2.0, 3.6])
+    _, s = biased_staircase(20, 5, step=0.25, hold=0.005, fs=1000, duration=24)
+    ys = PIOperator(p, r).simulate(s) + np.random.default_rng(5).normal(0, 0.2, s.size)
+    yield s, ys, 5, {"refit_every": 5, "threshold": 0.1}
+    yield s, ys, 5, {"refit_every": 4, "threshold": 0.1, "forgetting": 0.97,
+                     "initial_weights": np.ones(5), "initial_radii": [1.0, 2.0, 3.0, 4.0, 5.0]}
+    p2, r2 = np.array([1.0, 0.6, 0.4]), np.array([0.0, 0.5, 1.2])
+    _, v2 = sinusoid(5, 1, fs=1000, duration=6)
+    y2 = PIOperator(p2, r2).simulate(v2) + np.random.default_rng(6).normal(0, 0.01, v2.size)
+    yield v2, y2, 3, {"linear_play": True, "bins": 500, "refit_every": 3}
+
+
+@pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
+def test_joint_estimator_on_the_core_equals_it_on_the_reference(monkeypatch):
+    """The joint estimator with its per-branch statistics in C (``pim_joint.h``) gives the
+    estimate it gives with the NumPy reference (the implementation before the C core): every
+    update's weights and radii to the bit, the same updates and counts, the fit RMS (a sum of
+    squares in another order) to 1e-12."""
+    from pimodel import _native, estimate_jointly
+    from pimodel.identification.adaptive import joint
+    from pimodel.reference import joint as reference
+
+    for v, y, n, options in _joint_records():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            core = estimate_jointly(v, y, n, **options)
+            with monkeypatch.context() as m:
+                m.setattr(_native, "joint_select", reference.joint_select_reference)
+                m.setattr(_native, "joint_add", reference.joint_add_reference)
+                m.setattr(joint, "branch_shape", reference.branch_shape_reference)
+                ref = estimate_jointly(v, y, n, **options)
+        assert core.update_index.size >= 3
+        assert np.array_equal(core.update_index, ref.update_index)
+        assert (core.branches_used, core.samples_used, core.samples_outside) == \
+            (ref.branches_used, ref.samples_used, ref.samples_outside)
+        assert np.array_equal(core.weight_history, ref.weight_history)
+        assert np.array_equal(core.radius_history, ref.radius_history)
+        assert core.fit_rms == pytest.approx(ref.fit_rms, rel=1e-12)

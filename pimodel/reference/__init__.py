@@ -10,6 +10,7 @@ Modules
     operators           play, PI, time-dependent PI and the PI inverse
     extended_operators  generalized, rate-dependent, asymmetric and creep operators
     radius_estimator    the radius estimator, one Python step per sample
+    joint               the joint estimator's per-branch statistics
 """
 
 from .extended_operators import (
@@ -21,6 +22,7 @@ from .extended_operators import (
     rdpi_inverse_reference,
     rdpi_reference,
 )
+from .joint import branch_shape_reference, joint_add_reference, joint_select_reference
 from .operators import (
     pi_inverse_reference,
     pi_reference,
@@ -48,4 +50,7 @@ __all__ = [
     "BranchProfile",
     "estimate_radii_reference",
     "project_ordered_reference",
+    "branch_shape_reference",
+    "joint_add_reference",
+    "joint_select_reference",
 ]

@@ -59,7 +59,8 @@ def _clean_chunks(op: PIOperator, input_at: Callable[[np.ndarray], np.ndarray], 
                   n: int, chunk: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     state = None
     for a in range(0, n, chunk):
-        t = np.arange(a, min(n, a + chunk)) / fs
+        t = np.arange(a, min(n, a + chunk), dtype=float)  # exact integers, then in place:
+        t /= fs  # the values of np.arange(a, b) / fs without a temporary integer array
         v = np.asarray(input_at(t), dtype=float)
         if v.shape != t.shape:
             raise ValueError(f"input_at: expected an array shaped like its argument {t.shape}, "

@@ -44,6 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ... import _native
 from ...checks import as_signal, as_vector, integer_in, positive_scalar
 from ..branches import ReversalScanner
 from ..piecewise_linear import fit_hinges, fit_segmented
@@ -136,7 +137,10 @@ def branch_shape(x: np.ndarray, weights: np.ndarray, radii: np.ndarray) -> np.nd
     >>> branch_shape(np.array([0.0, 0.5, 1.0]), np.array([1.0, 0.5]), np.array([0.0, 0.4]))
     array([0. , 0.5, 1.1])
     """
-    return np.maximum(0.0, x[:, None] - 2.0 * radii[None, :]) @ weights
+    x, weights, radii = (np.ascontiguousarray(a, dtype=float) for a in (x, weights, radii))
+    # the hinge matrix max(0, x - 2 r) built in one pass in C (pim_joint_hinges, the values of
+    # np.maximum(0.0, x[:, None] - 2.0 * radii[None, :])), then the same BLAS product
+    return _native.joint_hinges(x, radii) @ weights
 
 
 class JointEstimator:
@@ -353,17 +357,16 @@ class JointEstimator:
         travel = abs(float(v[-1] - v[0]))
         s = 1.0 if v[-1] > v[0] else -1.0
         if self._from_reversal and travel > 0:
-            xs = np.abs(v[:-1] - v[0])
             if self.travel_range is None:
                 self.travel_range = travel
-            keep = xs <= self._prev_travel * (1 + 1e-12)
-            inside = keep & (xs <= self.travel_range)
-            self.samples_outside += int(np.count_nonzero(keep & ~inside))
-            if np.count_nonzero(inside) >= 2:
+            x, Y, outside = _native.joint_select(v[:-1], y, s, self._prev_travel * (1 + 1e-12),
+                                                 self.travel_range)
+            self.samples_outside += outside
+            if x.size >= 2:
                 if self._updates:  # an estimate exists
-                    self._add_branch(xs[inside], s * y[inside])
+                    self._add_branch(x, Y)
                 else:
-                    self._pending.append((xs[inside], s * y[inside]))
+                    self._pending.append((x, Y))
         self._from_reversal = True
         self._prev_travel = travel
 
@@ -394,17 +397,13 @@ class JointEstimator:
         return self.n if self.linear_play else self.n + 1
 
     def _add_branch(self, x: np.ndarray, Y: np.ndarray) -> None:
-        """Centre a finished branch on the estimate in force and add it to the bins."""
+        """Centre a finished branch on the estimate in force and add it to the bins: the errors
+        and their mean in numpy, the binning in the C core (``pim_joint_add``; NumPy reference
+        :func:`pimodel.reference.joint.joint_add_reference`), the same statistics to the bit."""
         e = Y - branch_shape(x, self.weights, self.radii)
-        c = float(np.mean(e))
-        e -= c
-        self._sse += float(e @ e)
-        self._sse_count += e.size
-        Yc = Y - c
-        idx = np.minimum((x * (self.bins / self.travel_range)).astype(np.int64), self.bins - 1)
-        self._stats *= self.forgetting
-        for row, w in enumerate((None, x, Yc)):
-            self._stats[row] += np.bincount(idx, weights=w, minlength=self.bins)
+        self._sse += _native.joint_add(x, Y, e, float(np.mean(e)), self._stats,
+                                       self.travel_range, self.forgetting)
+        self._sse_count += x.size
         self.branches_used += 1
         self.samples_used += x.size
         self._since_update += 1
