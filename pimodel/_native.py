@@ -159,8 +159,9 @@ lib.pim_adaptive_inverse_step.argtypes = [c_size, F64, F64, F64, ctypes.c_double
 
 
 def address(a: np.ndarray) -> int:
-    """The data address of a C-contiguous float64 array, for :data:`raw_pi_step`."""
-    return a.ctypes.data
+    """The data address of a C-contiguous float64 array, for :data:`raw_pi_step` (and the
+    joint estimator's calls, :func:`_f64_address`)."""
+    return a.__array_interface__["data"][0]  # the value of a.ctypes.data, without its object
 
 
 # -- radius estimator (fmu/src/pim_estimator.h) -------------------------------------------------
@@ -282,7 +283,7 @@ def _f64_address(a: np.ndarray, name: str) -> int:
     functions once per branch, where numpy's ``ndpointer`` checks cost as much as the work)."""
     if a.dtype != np.float64 or not a.flags.c_contiguous:
         raise TypeError(f"{name}: expected a C-contiguous float64 array")
-    return a.__array_interface__["data"][0]
+    return address(a)
 
 
 def joint_select(v: np.ndarray, y: np.ndarray, s: float, keep_limit: float,

@@ -550,16 +550,27 @@ def _first_grams(Z: np.ndarray, s: Segment, delayed: tuple | None = None) -> lis
     if Z.shape[1] > SCREEN_SAMPLES:
         return None
     cuts = list(chunks(s.y.size))
-    key = (Z.__array_interface__["data"][0], Z.shape, Z.strides, len(cuts))
-    kept = s.__dict__.setdefault("_first_grams", {})  # per thread (module threads)
-    memo = kept.get(threading.get_ident())
-    if memo is None or memo[0] != key:  # memo[1] keeps Z alive: its address stays its own
+
+    def make() -> list:
         grams = None
         if delayed is not None and s.mask is None and Z.shape == delayed[0].shape:
             grams = _delayed_grams(Z, s, cuts, *delayed)
         if grams is None:
             grams = helped_map(lambda c: _first_terms(*_used_chunk((Z[:, c],), s, c)), cuts)
-        memo = kept[threading.get_ident()] = (key, Z, grams)
+        return grams
+
+    return _rows_memo(s, "_first_grams", Z, cuts, make)
+
+
+def _rows_memo(s: Segment, name: str, Z: np.ndarray, cuts: list, make: Callable) -> list:
+    """``make()`` kept on the segment ``s`` (attribute ``name``, one entry per thread: module
+    threads) for the latest rows ``Z``, keyed by their address, shape and strides and the
+    chunk count; the entry keeps ``Z`` alive, so its address stays its own."""
+    key = (Z.__array_interface__["data"][0], Z.shape, Z.strides, len(cuts))
+    kept = s.__dict__.setdefault(name, {})
+    memo = kept.get(threading.get_ident())
+    if memo is None or memo[0] != key:
+        memo = kept[threading.get_ident()] = (key, Z, make())
     return memo[2]
 
 
@@ -570,12 +581,8 @@ def _delayed_grams(Z: np.ndarray, s: Segment, cuts: list, Z0: np.ndarray, d) -> 
     n = int(d) if float(d).is_integer() else 0
     if not 0 < n <= DELAYED_GRAM_MAX:
         return None
-    key = (Z0.__array_interface__["data"][0], Z0.shape, Z0.strides, len(cuts))
-    kept = s.__dict__.setdefault("_base_grams", {})  # per thread (module threads)
-    memo = kept.get(threading.get_ident())
-    if memo is None or memo[0] != key:  # memo[1] keeps Z0 alive: its address stays its own
-        memo = kept[threading.get_ident()] = (key, Z0, helped_map(lambda c: _square(Z0[:, c]),
-                                                                  cuts))
+    base = _rows_memo(s, "_base_grams", Z0, cuts,
+                      lambda: helped_map(lambda c: _square(Z0[:, c]), cuts))
     z0 = Z0[:, :1]
 
     def window(x: int, y: int) -> np.ndarray:  # sum of z_max(j,0) z_max(j,0)^T, j in [x, y)
@@ -583,7 +590,7 @@ def _delayed_grams(Z: np.ndarray, s: Segment, cuts: list, Z0: np.ndarray, d) -> 
         return G + (min(y, 0) - x) * _square(z0) if x < 0 else G
 
     return [((G0 - window(c.stop - n, c.stop)) + window(c.start - n, c.start), Z[:, c] @ s.y[c])
-            for c, G0 in zip(cuts, memo[2], strict=True)]
+            for c, G0 in zip(cuts, base, strict=True)]
 
 
 def _first_terms(Pc: tuple, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
