@@ -297,6 +297,11 @@ def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
      ({"n": 129}, "parameter n = 129 out of range: 1 <= n <= 128"),
      ({"n_lags": 1, "creep_tau[1]": 0.0}, "time constant creep_tau[1] = 0 is not positive"),
      ({"n_lags": 65}, "parameter n_lags = 65 out of range"),
+     ({"creep_start": 2}, "parameter creep_start = 2 out of range: 0 at rest at h0[0], 1 at "
+                         "rest at creep_start_level"),
+     ({"n_lags": 2, "creep_tau[1]": 0.1, "creep_tau[2]": 1.0, "creep_start": 1,
+       "creep_start_level[2]": float("nan")},
+      "creep start level creep_start_level[2] = nan is not finite"),
      ({"half_range": -1.0}, "parameter half_range = -1: must be finite and > 0"),
      ({"rate_scale": 0.0}, "parameter rate_scale = 0"),
      ({"rate_family": 3}, "parameter rate_family = 3 out of range: 0 radius, 1 weight, 2 scaled"),

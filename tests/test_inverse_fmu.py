@@ -116,7 +116,12 @@ def test_unit_with_more_than_64_plays_and_a_start_memory(fmus, fmi):
      ({"n_post_sections": 1}, "parameter latency = 0: post sections (n_post_sections = 1) need "
                               "a latency >= 1"),
      ({"rate_band_gain[1]": 0.1, "rate_scale": 0.0}, "parameter rate_scale = 0"),
-     ({"n_lags": 1, "creep_tau[1]": 0.0}, "time constant creep_tau[1] = 0 is not positive")])
+     ({"n_lags": 1, "creep_tau[1]": 0.0}, "time constant creep_tau[1] = 0 is not positive"),
+     ({"creep_start": 2}, "parameter creep_start = 2 out of range: 0 at rest at h0[0], 1 at "
+                         "rest at creep_start_level"),
+     ({"n_lags": 2, "creep_tau[1]": 0.1, "creep_tau[2]": 1.0, "creep_start": 1,
+       "creep_start_level[2]": float("nan")},
+      "creep start level creep_start_level[2] = nan is not finite")])
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 def test_bad_parameters_give_logged_errors(fmus, fmi, start, message):
     with pytest.raises(ValueError, match="initialisation failed") as err:
