@@ -35,7 +35,7 @@ from .. import _native
 from ..blocks.framework import labelled_values, signal_labels
 from .checks import checked_signal
 from .limits import MAX_LATENCY, MAX_SECTIONS, NMAX
-from .native_model import _band_gains
+from .native_model import _band_gains, _static_effect_values
 from .rate import FAMILY_CODES
 from .reference_inverse import StaticInverse, _delay, _filter, feedforward_block, inverse_latency
 from .wiener import inverse_sections
@@ -360,19 +360,7 @@ def inverse_fmu_parameters(inverse, *, input_range: float | None = None,
            **arr("w0", k["w0"]), "offset": d.c, "reference_offset": d.c0,
            "input_range": d.input_range, "reference_range": d.reference_range,
            "latency": int(d.latency), "delay_fraction": d.frac}
-    if d.m:
-        out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
-                    **arr("creep_tau", inverse.model.params["creep_time_constants_s"])})
-        if "lag_start" in k:  # the lags at a common rest (module creep)
-            out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
-    if d.asym:
-        out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
-                    "half_range": d.half})
-    if "rate_w" in k:
-        out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
-                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau,
-                    "rate_saturation": d.rate_saturation,
-                    **({"rate_growth": d.rate_growth} if d.rate_family == 2 else {})})
+    out.update(_static_effect_values(d, k, inverse.model.params))
     if d.ns:
         out.update({"n_sections": int(d.ns), **arr("section", k["sos"].ravel())})
     if d.npost:

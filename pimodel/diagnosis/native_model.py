@@ -579,6 +579,31 @@ def diagnosed_block(model, dt: float | None = None, *, name: str = "diagnosed",
                           output=output)
 
 
+def _static_effect_values(d, k: dict, params: dict) -> dict:
+    """The creep, asymmetry and rate variables shared by the DiagnosedModel and
+    DiagnosedInverse FMU units: ``d`` and ``k`` are a checked parameter set and its kept
+    arrays (:class:`NativeModel` or :class:`~.native_inverse.NativeInverse`), ``params`` the
+    model's parameters (the creep's time constants)."""
+    def arr(name, values):
+        return labelled_values(name, values, split=NMAX)
+
+    out = {}
+    if d.m:
+        out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
+                    **arr("creep_tau", params["creep_time_constants_s"])})
+        if "lag_start" in k:  # the lags' common rest (module creep)
+            out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
+    if d.asym:
+        out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
+                    "half_range": d.half})
+    if "rate_w" in k:
+        out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
+                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau,
+                    "rate_saturation": d.rate_saturation,
+                    **({"rate_growth": d.rate_growth} if d.rate_family == 2 else {})})
+    return out
+
+
 def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dict]:
     """The DiagnosedModel FMU unit and its variable values for ``model`` (``Ts = dt``).
 
@@ -623,19 +648,7 @@ def fmu_parameters(model, *, input_range: float | None = None) -> tuple[str, dic
            **arr("p", model.weights), **arr("r", model.radii),
            **arr("w0", model.reference_weights), "offset": d.c,
            "reference_offset": model.reference_offset, "input_range": nm.input_range}
-    if d.m:
-        out.update({"n_lags": int(d.m), **arr("creep_gain", k["lag_g"]),
-                    **arr("creep_tau", model.params["creep_time_constants_s"])})
-        if "lag_start" in k:  # the lags' common rest (module creep)
-            out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
-    if d.asym:
-        out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
-                    "half_range": d.half})
-    if "rate_w" in k:
-        out.update({**arr("rate_band_gain", k["rate_w"]), "rate_scale": d.rate_scale,
-                    "rate_family": int(d.rate_family), "rate_tau": d.rate_tau,
-                    "rate_saturation": d.rate_saturation,
-                    **({"rate_growth": d.rate_growth} if d.rate_family == 2 else {})})
+    out.update(_static_effect_values(d, k, model.params))
     if d.order:
         out.update({"lti_order": int(d.order), **arr("lti_b", k["b"]), **arr("lti_a", k["a"])})
     if d.ne:
