@@ -1082,6 +1082,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                "gap_after_percent": after["rms_percent"], "noise_floor": noise,
                "noise_floor_method": noise_info["method"],
                "noise_floor_detail": noise_info["detail"],
+               # records whose input follows the measured noise (noise.py): taken in closed loop
+               "closed_loop_records": [(train + validate)[i].source
+                                       for i in noise_info.get("closed_loop", ())],
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
                "unexplained": unexplained, "alternatives": alternatives,
                "model": current.params, "evidence": evidence}

@@ -162,12 +162,14 @@ def _local_model_residual(h: np.ndarray, r: np.ndarray) -> np.ndarray:
     The linear model is ``B(q) / A(q)`` from ``h`` (``ARX_LEAD`` samples ahead, so it may also
     lead; no lead on a record taken in closed loop, :func:`_feedback`) to ``r``: first fitted
     in equation-error (ARX) form by least squares, then simulated in output-error form (stable
-    poles only; else the ARX residual itself is kept)."""
+    poles only; else the ARX residual itself is kept). Returns that residual and whether the
+    record was taken in closed loop (``False`` on a record too short to tell)."""
     n, na, nb, m = r.size, ARX_NA, ARX_NB, ARX_LEAD
-    if n > 10 * (na + nb) + SG_WINDOW and _feedback(h, r):
-        m = 0  # the leads would explain the noise the loop fed back into the input
     if n <= 10 * (na + nb) + SG_WINDOW:
-        return r - savgol_filter(r, SG_WINDOW, SG_ORDER)
+        return r - savgol_filter(r, SG_WINDOW, SG_ORDER), False
+    closed = _feedback(h, r)
+    if closed:
+        m = 0  # the leads would explain the noise the loop fed back into the input
     u = np.concatenate((h[m:], np.full(m, h[-1]))) - h.mean()
     k0 = max(na, nb)
     cols = [np.ones(n - k0)]
@@ -185,7 +187,7 @@ def _local_model_residual(h: np.ndarray, r: np.ndarray) -> np.ndarray:
             e = None
     if e is None:
         e = r[k0:] - A @ c
-    return e - savgol_filter(e, SG_WINDOW, SG_ORDER)
+    return e - savgol_filter(e, SG_WINDOW, SG_ORDER), closed
 
 
 def measure_noise_floor(signals, outputs) -> dict:
@@ -203,7 +205,9 @@ def measure_noise_floor(signals, outputs) -> dict:
     dict
         ``value`` (standard deviation of the noise, output units), ``method``
         (``"repeated periods"`` or ``"local model"``), ``samples`` (how many samples the
-        estimate rests on) and ``detail`` (a sentence saying how it was measured).
+        estimate rests on), ``detail`` (a sentence saying how it was measured) and, with the
+        local model, ``closed_loop``: the indices of the records that look taken in closed
+        loop (the fast part of ``h[k + 1]`` follows that of the residual ``y[k] - h[k]``).
 
     Examples
     --------
@@ -226,11 +230,13 @@ def measure_noise_floor(signals, outputs) -> dict:
                           "apart (input identical over the period before), detrended per "
                           "run, divided by sqrt(2)"}
     h0 = float(savgol_coeffs(SG_WINDOW, SG_ORDER)[SG_WINDOW // 2])
-    res = [_local_model_residual(np.asarray(h, float), np.asarray(y, float) - np.asarray(h, float))
-           for (_, y), h in zip(signals, outputs, strict=True)]
+    res, closed = zip(*(_local_model_residual(np.asarray(h, float),
+                                              np.asarray(y, float) - np.asarray(h, float))
+                        for (_, y), h in zip(signals, outputs, strict=True)), strict=True)
     e = np.concatenate(res)
     value = float(robust_std(e) / np.sqrt(1.0 - h0))
     return {"value": value, "method": "local model", "samples": int(e.size),
+            "closed_loop": [i for i, c in enumerate(closed) if c],
             "detail": f"robust std of the model residual after a linear model of the model "
                       f"output (ARX {ARX_NA}/{ARX_NB}, simulated) and a Savitzky-Golay fit (window "
                       f"{SG_WINDOW}, order {SG_ORDER}), corrected by 1/sqrt(1 - {h0:.3f})"}

@@ -107,8 +107,8 @@ def hints(rep) -> list[str]:
     Parameters
     ----------
     rep : DiagnosisReport
-        Uses ``verdict``, ``where``, ``nominal["initial_state"]`` and ``nominal["coverage"]``
-        (when present).
+        Uses ``verdict`` (``closed_loop_records`` among it, when present), ``where``,
+        ``nominal["initial_state"]`` and ``nominal["coverage"]`` (when present).
 
     Returns
     -------
@@ -158,6 +158,13 @@ def hints(rep) -> list[str]:
         out.append(f"{v['effects'][0]} and {' and '.join(alts)} explain the gap about as well: "
                    "add a record at other input frequencies or with holds after steps to "
                    "tell them apart")
+    closed = v.get("closed_loop_records") or []
+    if closed:  # the noise floor's check (noise.py): the input follows the measured noise
+        out.append(f"{', '.join(closed[:3])}{' ...' if len(closed) > 3 else ''} look taken in "
+                   "closed loop (the input follows the measured noise one sample later): a "
+                   "loop keeps the input slow, so an effect faster than it (a mode, a delay, a "
+                   "rate dependence) is barely excited and may go unnamed; a record in open "
+                   "loop, or with a faster reference, shows such effects")
     un = v.get("unexplained") or {}
     if "unexplained" in v["effects"]:
         where = "; ".join(un.get("where", [])[:2]) or "no one region"
