@@ -51,7 +51,7 @@ import math
 import numpy as np
 
 __all__ = ["CREEP_STARTS", "creep_law", "creep_start_levels", "creep_starts",
-           "creep_time_constants", "start_columns"]
+           "creep_time_constants", "start_columns", "start_hint"]
 
 CREEP_STARTS = ("rest", "common")  # where the lags start (module docstring)
 MIN_LAG_SAMPLES = 10  # the shortest lag spans at least this many samples
@@ -155,30 +155,61 @@ def creep_law(gains, time_constants) -> dict:
             "span_s": [float(t[0]), float(t[-1])]}
 
 
-def creep_starts(effects) -> list[dict]:
-    """The creep's starts a diagnosis scores on validate (by BIC) whenever ``effects`` hold a
+def creep_starts(effects, held: str | None = None) -> list[dict]:
+    """The creep's starts a diagnosis scores on validate (by BIC) when ``effects`` hold a
     creep: each lag at rest at the record's first output, or at a level shared by the records
-    (module docstring). Chosen anew for every combination, as the drift's variants.
+    (module docstring). Both are scored for the creep candidate alone; every other fit that
+    holds a creep keeps the start that candidate chose (``held``), as the dynamics keep the
+    position chosen alone (:func:`.wiener.position_hint`).
 
     Parameters
     ----------
     effects : tuple of str
         The effects of the model being fitted.
+    held : str or None
+        The start held (one of ``CREEP_STARTS``, the creep candidate's choice); None: both.
 
     Returns
     -------
     list of dict
-        ``[{}]`` without a creep, else ``{"creep_start": s}`` for each ``s`` of
-        ``CREEP_STARTS``.
+        ``[{}]`` without a creep, else ``{"creep_start": s}`` for ``s`` of ``CREEP_STARTS``
+        (only ``held`` when given).
 
     Examples
     --------
     >>> creep_starts(("drift",)), creep_starts(("creep", "delay"))
     ([{}], [{'creep_start': 'rest'}, {'creep_start': 'common'}])
+    >>> creep_starts(("creep", "delay"), held="common")
+    [{'creep_start': 'common'}]
     """
     if "creep" not in effects:
         return [{}]
-    return [{"creep_start": s} for s in CREEP_STARTS]
+    if held is not None and held not in CREEP_STARTS:
+        raise ValueError(f"held: expected one of {CREEP_STARTS} or None, got {held!r}")
+    return [{"creep_start": s} for s in ((held,) if held is not None else CREEP_STARTS)]
+
+
+def start_hint(alone_grid: dict) -> str:
+    """The creep's start held when the creep is fitted beside other effects: the one the
+    creep candidate chose alone (``"common"`` when its grid says so, else ``"rest"``: a fit
+    at rest leaves the grid without the key).
+
+    Parameters
+    ----------
+    alone_grid : dict
+        The grid parameters of the ``creep`` candidate fitted alone (``Model.grid``).
+
+    Returns
+    -------
+    str
+        One of ``CREEP_STARTS``.
+
+    Examples
+    --------
+    >>> start_hint({}), start_hint({"creep_start": "common"})
+    ('rest', 'common')
+    """
+    return alone_grid.get("creep_start", CREEP_STARTS[0])
 
 
 def start_columns(samples, dt: float, taus) -> np.ndarray:
