@@ -40,9 +40,10 @@ other effect), and the path with the lowest validate BIC is kept: a first effect
 in for two others that pass only together (a broad lag for creep and rate-dependent
 hysteresis). The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or,
 where the train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock,
-or a level per record, :mod:`.drift`) is chosen on validate for every combination, and so is
-the creep's start (its lags at rest at each record's first output, or at levels shared by the
-records: a stage parked between records, :mod:`.creep`).
+or a level per record, :mod:`.drift`) is chosen on validate for every combination; the creep's
+start (its lags at rest at each record's first output, or at levels shared by the records: a
+stage parked between records, :mod:`.creep`) is chosen on validate where the creep enters a
+combination and held for the fits built on the model that holds it.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
