@@ -1315,7 +1315,9 @@ def _lag_calls(chosen, fixed) -> list[tuple]:
     lags = [e for e in chosen if e in LAG_EFFECTS]
     if len(chosen) < 2 or len(lags) != 1:
         return []
-    kept = {k: x for k, x in fixed.items() if k not in LAG_KEYS} | {"search_all": True}
+    # the creep's start scored again with the lag (chosen beside the lag searched before)
+    kept = {k: x for k, x in fixed.items() if k not in (*LAG_KEYS, "creep_start")} | \
+        {"search_all": True}
     other = next(e for e in LAG_EFFECTS if e != lags[0])
     return [(option[-1], option[:-1], dict(kept))
             for option in (chosen, tuple(other if e == lags[0] else e for e in chosen))]
