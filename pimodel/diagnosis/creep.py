@@ -160,9 +160,9 @@ def creep_starts(effects, held: str | None = None) -> list[dict]:
     """The creep's starts a diagnosis scores on validate (by BIC) when ``effects`` hold a
     creep: each lag at rest at the record's first output, or at a level shared by the records
     (module docstring). Both are scored where the creep enters a combination (the candidate
-    alone, a pair, the creep added beside chosen effects); a fit built on a model that holds
-    a creep keeps that creep's start (``held``, :func:`start_hint`), so the start is chosen
-    once per search path, not anew for every combination.
+    alone, a pair, the creep added beside chosen effects) and where the lag beside it is
+    searched again; another fit built on a model that holds a creep keeps that creep's start
+    (``held``, :func:`start_hint`), so the start is not chosen anew for every combination.
 
     Parameters
     ----------

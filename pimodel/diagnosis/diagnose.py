@@ -1242,8 +1242,8 @@ def _hold(fixed: dict, effects: tuple, grid: dict) -> dict:
     chosen for ``effects``, and the start of its creep (:func:`.creep.start_hint`: the rest
     start is no grid key) held as ``fixed["creep_start"]`` (none without a creep): every fit
     built on that model keeps it (:func:`.creep.creep_starts`), while a creep entering a
-    combination has both starts scored (creep61: chosen once per search path, not anew for
-    every combination)."""
+    combination, or beside a lag searched again (:func:`_lag_calls`), has both starts scored
+    (creep61: not anew for every combination)."""
     fixed.pop("creep_start", None)
     fixed.update(grid)
     if "creep" in effects:
