@@ -28,9 +28,10 @@ creep law. On the existing generators' records (10 kHz over 3 s; 5 kHz over 1.7 
 s) the grid is the one before this rule (3 ms to 3 s; 30 ms to 3 s); on a 200 Hz record of 100
 s it is 0.3 s to 30 s, on 5 kHz records of 1 s 3 ms to 0.3 s.
 
-Where the lags start (``creep_start``, a variant of the creep scored on validate by BIC as the
-drift's variants are: :func:`creep_starts`). ``"rest"``: each lag at rest at the record's first
-reference output, ``L_i[-1] = h0[0]`` (the stage sat at the record's first input before it).
+Where the lags start (``creep_start``, a variant of the creep scored on validate by BIC where
+the creep enters a combination, then held for the fits built on it: :func:`creep_starts`).
+``"rest"``: each lag at rest at the record's first reference output, ``L_i[-1] = h0[0]`` (the
+stage sat at the record's first input before it).
 ``"common"``: each lag at rest at one level ``s_i`` shared by every record, ``L_i[-1] = s_i``
 (a piezo stage parked at one voltage between records: its lags rest where it rested, then
 settle from the step to the record's first input through the record). Since
@@ -51,7 +52,7 @@ import math
 import numpy as np
 
 __all__ = ["CREEP_STARTS", "creep_law", "creep_start_levels", "creep_starts",
-           "creep_time_constants", "start_columns"]
+           "creep_time_constants", "start_columns", "start_hint"]
 
 CREEP_STARTS = ("rest", "common")  # where the lags start (module docstring)
 MIN_LAG_SAMPLES = 10  # the shortest lag spans at least this many samples
@@ -155,30 +156,63 @@ def creep_law(gains, time_constants) -> dict:
             "span_s": [float(t[0]), float(t[-1])]}
 
 
-def creep_starts(effects) -> list[dict]:
-    """The creep's starts a diagnosis scores on validate (by BIC) whenever ``effects`` hold a
+def creep_starts(effects, held: str | None = None) -> list[dict]:
+    """The creep's starts a diagnosis scores on validate (by BIC) when ``effects`` hold a
     creep: each lag at rest at the record's first output, or at a level shared by the records
-    (module docstring). Chosen anew for every combination, as the drift's variants.
+    (module docstring). Both are scored where the creep enters a combination (the candidate
+    alone, a pair, the creep added beside chosen effects) and where the lag beside it is
+    searched again; another fit built on a model that holds a creep keeps that creep's start
+    (``held``, :func:`start_hint`), so the start is not chosen anew for every combination.
 
     Parameters
     ----------
     effects : tuple of str
         The effects of the model being fitted.
+    held : str or None
+        The start held (one of ``CREEP_STARTS``: that of the creep already chosen); None:
+        both.
 
     Returns
     -------
     list of dict
-        ``[{}]`` without a creep, else ``{"creep_start": s}`` for each ``s`` of
-        ``CREEP_STARTS``.
+        ``[{}]`` without a creep, else ``{"creep_start": s}`` for ``s`` of ``CREEP_STARTS``
+        (only ``held`` when given).
 
     Examples
     --------
     >>> creep_starts(("drift",)), creep_starts(("creep", "delay"))
     ([{}], [{'creep_start': 'rest'}, {'creep_start': 'common'}])
+    >>> creep_starts(("creep", "delay"), held="common")
+    [{'creep_start': 'common'}]
     """
     if "creep" not in effects:
         return [{}]
-    return [{"creep_start": s} for s in CREEP_STARTS]
+    if held is not None and held not in CREEP_STARTS:
+        raise ValueError(f"held: expected one of {CREEP_STARTS} or None, got {held!r}")
+    return [{"creep_start": s} for s in ((held,) if held is not None else CREEP_STARTS)]
+
+
+def start_hint(grid: dict) -> str:
+    """The start of the creep of a fitted model, held for the fits built on it:
+    ``"common"`` when its grid says so, else ``"rest"`` (a fit at rest leaves the grid
+    without the key, as before the common start).
+
+    Parameters
+    ----------
+    grid : dict
+        The grid parameters of a model that holds a creep (``Model.grid``).
+
+    Returns
+    -------
+    str
+        One of ``CREEP_STARTS``.
+
+    Examples
+    --------
+    >>> start_hint({}), start_hint({"creep_start": "common"})
+    ('rest', 'common')
+    """
+    return grid.get("creep_start", CREEP_STARTS[0])
 
 
 def start_columns(samples, dt: float, taus) -> np.ndarray:

@@ -40,9 +40,10 @@ other effect), and the path with the lowest validate BIC is kept: a first effect
 in for two others that pass only together (a broad lag for creep and rate-dependent
 hysteresis). The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or,
 where the train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock,
-or a level per record, :mod:`.drift`) is chosen on validate for every combination, and so is
-the creep's start (its lags at rest at each record's first output, or at levels shared by the
-records: a stage parked between records, :mod:`.creep`).
+or a level per record, :mod:`.drift`) is chosen on validate for every combination; the creep's
+start (its lags at rest at each record's first output, or at levels shared by the records: a
+stage parked between records, :mod:`.creep`) is chosen on validate where the creep enters a
+combination and held for the fits built on the model that holds it.
 
 Verdict: ``["none"]`` when no effect is accepted and the validate gap is within 2 times the
 noise floor; the accepted effects; and ``"unexplained"`` (alone or after the effects) when the
@@ -67,7 +68,7 @@ from threadpoolctl import threadpool_limits
 from ..records import Record
 from .chunked import NormalEquations
 from .coverage import coverage, informed_radii, span_and_reach
-from .creep import creep_law, creep_starts
+from .creep import creep_law, creep_starts, start_hint
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
 from .effects import (
@@ -872,8 +873,10 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
+        # a creep's start: both scored where the creep enters (alone, a pair, the creep
+        # added or swapped in); held where ``fixed_`` carries the chosen creep's (_hold)
         shapes = [{**r, **c} for r in rate_shapes((*combo, name), fixed_ or {})
-                  for c in creep_starts((*combo, name))]  # a creep's start: chosen anew
+                  for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"))]
         out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):
@@ -1006,7 +1009,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if accepted(best) and pool.workers > 1:  # the fits the acceptance may need next
                 then = chosen + (best[1] if isinstance(best[1], tuple) else (best[1],))
                 prefetch((_refined_calls(chosen, fixed) if chosen else []) +
-                         _lag_calls(then, {**fixed, **best[2].grid}))
+                         _lag_calls(then, _hold(dict(fixed), then, best[2].grid)))
             # accepted(best) is _passes against the current choice (its BIC difference known)
             if not accepted(best) and not (chosen and aside(best[2:], (current, cur_out),
                                                             chosen, fixed, best[1])):
@@ -1015,7 +1018,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 break  # the misfit of the effects chosen, not a further effect
             dbic, name, m, o = best
             chosen += name if isinstance(name, tuple) else (name,)
-            fixed.update(m.grid)
+            _hold(fixed, chosen, m.grid)
             current, cur_out = m, o
             chosen, current, cur_out = _research_lag(chosen, (current, cur_out), fixed,
                                                      fit, va)
@@ -1186,7 +1189,8 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
     def keys_of(e):  # grid parameters of an effect, as its single fit reports them (a drift's
         # and a rate's all of their kind: a single fit of another family or variant lacks some,
         # e.g. rate_growth, which a held SCALED rate needs)
-        return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS}.get(e, ()))
+        return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS,
+                                          "creep": ("creep_start",)}.get(e, ()))
 
     def call(effects):  # fit's arguments for the combination ``effects`` (not empty)
         kept = {k: x for k, x in fixed.items() if any(k in keys_of(e) for e in effects)}
@@ -1214,7 +1218,7 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
         if best is None:
             break
         chosen, cur = best[1], best[2]
-        fixed.update(cur[0].grid)
+        _hold(fixed, chosen, cur[0].grid)
     while chosen:  # drops, the least needed first
         worst = None
         if prefetch is not None:
@@ -1234,6 +1238,20 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
             break
         chosen, cur = worst[1], worst[2]
     return chosen, cur[0], cur[1]
+
+
+def _hold(fixed: dict, effects: tuple, grid: dict) -> dict:
+    """``fixed`` (changed in place and returned) updated with the grid parameters of the model
+    chosen for ``effects``, and the start of its creep (:func:`.creep.start_hint`: the rest
+    start is no grid key) held as ``fixed["creep_start"]`` (none without a creep): every fit
+    built on that model keeps it (:func:`.creep.creep_starts`), while a creep entering a
+    combination, or beside a lag searched again (:func:`_lag_calls`), has both starts scored
+    (creep61: not anew for every combination)."""
+    fixed.pop("creep_start", None)
+    fixed.update(grid)
+    if "creep" in effects:
+        fixed["creep_start"] = start_hint(grid)
+    return fixed
 
 
 def _passes(va, new, old) -> bool:
@@ -1300,7 +1318,9 @@ def _lag_calls(chosen, fixed) -> list[tuple]:
     lags = [e for e in chosen if e in LAG_EFFECTS]
     if len(chosen) < 2 or len(lags) != 1:
         return []
-    kept = {k: x for k, x in fixed.items() if k not in LAG_KEYS} | {"search_all": True}
+    # the creep's start scored again with the lag (chosen beside the lag searched before)
+    kept = {k: x for k, x in fixed.items() if k not in (*LAG_KEYS, "creep_start")} | \
+        {"search_all": True}
     other = next(e for e in LAG_EFFECTS if e != lags[0])
     return [(option[-1], option[:-1], dict(kept))
             for option in (chosen, tuple(other if e == lags[0] else e for e in chosen))]
@@ -1339,7 +1359,7 @@ def _research_lag(chosen, cur, fixed, fit, va):
     if best[1] is not chosen or best[2] is not cur:
         for k in LAG_KEYS:
             fixed.pop(k, None)
-        fixed.update(best[2][0].grid)
+        _hold(fixed, best[1], best[2][0].grid)
     return best[1], best[2][0], best[2][1]
 
 
