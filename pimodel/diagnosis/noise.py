@@ -159,7 +159,7 @@ def _feedback(h: np.ndarray, r: np.ndarray) -> bool:
     return ahead > FEEDBACK_CORR and ahead > 2.0 * behind
 
 
-def _local_model_residual(h: np.ndarray, r: np.ndarray) -> np.ndarray:
+def _local_model_residual(h: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, bool]:
     """What neither a linear model of the model output ``h`` nor a smoothing fit explains.
 
     The linear model is ``B(q) / A(q)`` from ``h`` (``ARX_LEAD`` samples ahead, so it may also
