@@ -65,7 +65,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
-from .chunked import NormalEquations
+from .chunked import ChunkedQR, NormalEquations
 from .coverage import coverage, informed_radii, span_and_reach
 from .creep import creep_law, creep_starts
 from .delaylike import is_delay_like
@@ -426,16 +426,18 @@ def _bare(records: list[Record], initial_state: str, samples: int | None = None)
 
 
 def _plain_fit(records: list[Record], radii, initial_state: str,
-               at_rest: bool = True, samples: int | None = None
-               ) -> tuple[list[Segment], NormalEquations]:
+               at_rest: bool = True, samples: int | None = None, qr: bool = False
+               ) -> tuple[list[Segment], NormalEquations | ChunkedQR]:
     """The PI fit (play weights and an offset) that :func:`.effects.fit_nominal` makes, in one
     pass over the records with one chunk of play outputs at a time (:func:`.effects.play_chunks`
     into :class:`.chunked.NormalEquations`): nothing of size (samples x plays) is kept. Returns
     the records as segments without play outputs (:func:`_bare`, their first ``samples``
     samples; None: whole) and the normal equations (``solve()`` gives the coefficients, ``G``
-    the Gram matrix of the plays and the offset on the fitted samples)."""
+    the Gram matrix of the plays and the offset on the fitted samples); with ``qr`` a running
+    triangular factor of the same samples instead (:class:`.chunked.ChunkedQR`, for the bounded
+    weights of :func:`_bounded`)."""
     segs = _bare(records, initial_state, samples)
-    ne = NormalEquations(np.size(radii) + 1)
+    ne = (ChunkedQR if qr else NormalEquations)(np.size(radii) + 1)
     for s in segs:
         for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
             if s.mask is None:
@@ -642,7 +644,8 @@ def _baseline(train, validate, initial_state) -> dict:
 
 def _bounded(train, validate, radii, initial_state: str, at_rest: bool) -> np.ndarray | None:
     """The plays held at or above 0 in the nominal's weights: radius above 0 (the radius-0 play
-    and the offset free), when the fit so bounded (:func:`.chunked.nnls_gram`) has a validate
+    and the offset free), when the fit so bounded (bounded-variable least squares on the
+    triangular factor of the plays, :meth:`.chunked.ChunkedQR.solve_nonneg`) has a validate
     BIC not above the least-squares fit's (both on the records' first ``SCREEN_SAMPLES``
     samples, as :func:`_validate_bic`); else None (least squares, as before), and None when
     ``NONNEG_PLAYS`` is off.
@@ -657,8 +660,9 @@ def _bounded(train, validate, radii, initial_state: str, at_rest: bool) -> np.nd
         return None
     mask = np.asarray(radii) > 0
     ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)[1]
+    qr = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES, qr=True)[1]
     vbic = [_validate_bic(validate, initial_state, (None, radii, coef, at_rest))
-            for coef in (ne.solve(), ne.solve(nonneg=mask))]
+            for coef in (ne.solve(), qr.solve_nonneg(mask))]
     return mask if vbic[1] <= vbic[0] else None
 
 
@@ -684,7 +688,8 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
     n = radii.size
     threads = pool is not None and pool.workers > 1
     segs, ne = _plain_fit(train, radii, initial_state, at_rest)
-    coef = ne.solve(nonneg=nonneg)
+    coef = ne.solve() if nonneg is None else \
+        _plain_fit(train, radii, initial_state, at_rest, qr=True)[1].solve_nonneg(nonneg)
     vsegs = _bare(validate, initial_state)
     out_va = pool.submit(_plain_outputs, vsegs, radii, coef, at_rest) if threads else None
     out_tr = _plain_outputs(segs, radii, coef, at_rest)
