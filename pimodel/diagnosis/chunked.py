@@ -385,8 +385,9 @@ class ChunkedQR:
         R = self._square()
         bounded = np.zeros(self.p, dtype=bool)
         bounded[:np.size(nonneg)] = nonneg
-        return lsq_linear(R[:self.p, :self.p], R[:self.p, self.p],
-                          bounds=(np.where(bounded, 0.0, -np.inf), np.inf), method="bvls").x
+        x = lsq_linear(R[:self.p, :self.p], R[:self.p, self.p],
+                       bounds=(np.where(bounded, 0.0, -np.inf), np.inf), method="bvls").x
+        return np.where(bounded, np.maximum(x, 0.0), x)  # BVLS may leave -1e-19 at a bound
 
     def _square(self) -> np.ndarray:
         """The factor padded with rows of zeros to shape (p + 1, p + 1)."""
