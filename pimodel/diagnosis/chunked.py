@@ -27,7 +27,7 @@ import numpy as np
 from scipy.optimize import lsq_linear
 
 __all__ = ["CHUNK", "RSS_RTOL", "ChunkedQR", "NormalEquations", "chunks", "combine",
-           "nnls_gram", "stack_rows", "transposed"]
+           "stack_rows", "transposed"]
 
 CHUNK = 1 << 14  # samples per chunk (16,384: an 80-column chunk of rows is 10 MB)
 RSS_RTOL = 1e-8  # NormalEquations.rss: largest relative rounding error accepted
@@ -145,38 +145,22 @@ class NormalEquations:
         self.samples += samples
         self.yy += float("nan") if yy is None else yy
 
-    def solve(self, rcond: float = 1e-13, nonneg: np.ndarray | None = None) -> np.ndarray:
+    def solve(self, rcond: float = 1e-13) -> np.ndarray:
         """The least-squares coefficients (columns scaled to unit norm for the solve).
 
         Parameters
         ----------
         rcond : float
             Relative cut-off of the singular values of the scaled ``G``.
-        nonneg : numpy.ndarray or None
-            Boolean mask, shape (p,) or shorter (the leading columns): the coefficients held
-            at or above 0 (:func:`nnls_gram`, the same scaled sums); None: none bounded.
 
         Returns
         -------
         numpy.ndarray
             Shape (p,); coefficients of columns that are all zero are 0.
-
-        Examples
-        --------
-        >>> X = np.array([[1.0, 0.0, 1.0], [1.0, 1.0, 0.0]])
-        >>> ne = NormalEquations(2)
-        >>> ne.add(X, np.array([1.0, -1.0, 2.0]))
-        >>> ne.solve().round(6).tolist(), ne.solve(nonneg=np.array([False, True])).tolist()
-        ([2.0, -1.0], [1.5, 0.0])
         """
         d = np.sqrt(np.diag(self.G))
         d[d == 0] = 1.0
-        A, b = self.G / d[:, None] / d[None, :], self.g / d
-        if nonneg is not None and np.any(nonneg):
-            bounded = np.zeros(b.size, dtype=bool)
-            bounded[:np.size(nonneg)] = nonneg
-            return nnls_gram(A, b, bounded, rcond) / d
-        c, *_ = np.linalg.lstsq(A, b, rcond=rcond)
+        c, *_ = np.linalg.lstsq(self.G / d[:, None] / d[None, :], self.g / d, rcond=rcond)
         return c / d
 
     def rss(self, coef: np.ndarray, rtol: float = RSS_RTOL) -> float | None:
@@ -222,82 +206,6 @@ class NormalEquations:
         rounding = RSS_SAFETY * np.finfo(float).eps * scale * scale \
             * np.sqrt(max(1.0, self.samples / CHUNK))
         return float(rss) if rss > 0 and rounding <= rtol * rss else None
-
-
-def nnls_gram(A: np.ndarray, b: np.ndarray, bounded: np.ndarray,
-              rcond: float = 1e-13) -> np.ndarray:
-    """Least squares with some coefficients held at or above 0, from the normal equations.
-
-    Minimises ``c^T A c / 2 - b^T c`` (``A = X X^T``, ``b = X y``: the least squares of
-    ``y ~ X^T c``) subject to ``c[bounded] >= 0``, by the active-set method of Lawson and
-    Hanson (1974) with the unbounded coefficients always in the passive set: each step frees
-    the bounded coefficient of largest positive gradient ``b - A c`` and solves the passive set
-    by least squares (``numpy.linalg.lstsq``, cut-off ``rcond``), stepping back to the bound
-    where a bounded coefficient would turn negative. A coefficient freed and bound again at
-    once is not freed again until another one has been (rank-deficient ``A``: no cycling).
-
-    Parameters
-    ----------
-    A : numpy.ndarray
-        Gram matrix, shape (p, p), symmetric positive semi-definite.
-    b : numpy.ndarray
-        Shape (p,).
-    bounded : numpy.ndarray
-        Boolean mask, shape (p,): the coefficients held at or above 0.
-    rcond : float
-        Relative cut-off of the singular values in each least-squares solve.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (p,): the coefficients (bounded ones ``>= 0``).
-
-    Examples
-    --------
-    >>> A = np.array([[2.0, 1.0], [1.0, 1.0]])
-    >>> nnls_gram(A, np.array([1.0, -1.0]), np.array([False, True])).tolist()
-    [0.5, 0.0]
-    """
-    p = b.size
-    passive = ~bounded
-    tol = 1e-12 * max(float(np.max(np.abs(b), initial=0.0)), float(np.finfo(float).tiny))
-
-    def sub(P):
-        s = np.zeros(p)
-        idx = np.flatnonzero(P)
-        if idx.size:
-            s[idx] = np.linalg.lstsq(A[np.ix_(idx, idx)], b[idx], rcond=rcond)[0]
-        return s
-
-    x = sub(passive)
-    blocked = np.zeros(p, dtype=bool)
-    for _ in range(3 * p + 3):
-        w = b - A @ x
-        cand = bounded & ~passive & ~blocked & (w > tol)
-        if not cand.any():
-            break
-        j = int(np.argmax(np.where(cand, w, -np.inf)))
-        passive[j] = True
-        for _ in range(p + 1):
-            s = sub(passive)
-            neg = bounded & passive & (s <= 0)
-            if not neg.any():
-                x = s
-                break
-            den = x[neg] - s[neg]
-            ratio = np.where(den > 0, x[neg] / np.where(den > 0, den, 1.0), 0.0)
-            alpha = float(np.min(ratio))
-            x = x + alpha * (s - x)
-            drop = bounded & passive & (x <= 0)
-            drop[np.flatnonzero(neg)[int(np.argmin(ratio))]] = True
-            passive[drop] = False
-            x[drop] = 0.0
-        if passive[j]:
-            blocked[:] = False
-        else:
-            blocked[j] = True
-    x[bounded & (x < 0)] = 0.0
-    return x
 
 
 class ChunkedQR:

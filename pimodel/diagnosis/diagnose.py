@@ -672,24 +672,26 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
                       nonneg: np.ndarray | None = None):
     """The nominal on the chosen grid and the segments the candidates are fitted on, the play
     outputs streamed (:func:`_plain_fit`): the nominal's train and validate outputs, then its
-    play columns replaced by a few combinations (the nominal's own weights, then the 32 leading
-    principal directions of the train play outputs, from the Gram matrix of the same pass)
-    when they keep the nominal train RSS within 1 %; the candidates' grid searches filter these
-    columns only. The projected nominal is fitted by normal equations streamed over the records
-    (:func:`_projected_fit`), and the segments' rows are built chunk by chunk for the records'
-    first ``samples`` samples only (None: whole; the screen of a long record), so neither the
-    full (samples x plays) outputs nor the whole records' projected rows are held; without a
-    projection (20 plays, or a worse RSS) the segments hold the full play outputs of those
-    samples. Returns the train and validate segments, the nominal fitted on them (with the full
-    model's ``params``), the full nominal, the projection ``V`` (play columns = ``Z @ V``;
-    None: not compressed), the full nominal's train and validate outputs (every sample) and
-    the whole records as segments without play rows (:func:`_bare`, for :func:`_with_rows`).
-    With a ``pool`` of several threads, the validate outputs and the slow-drift check are made
-    on it beside the train passes (the same values)."""
+    play columns replaced by a few combinations (the least-squares weights, then the 32 leading
+    principal directions of the train play outputs, from the Gram matrix of the same pass, and
+    last the weights held non-negative where ``nonneg`` says, :func:`_bounded`) when they keep
+    the nominal train RSS within 1 %; the candidates' grid searches filter the leading columns of
+    these only, and refit every weight of them without bound. The projected nominal is fitted by
+    normal equations streamed over the records (:func:`_projected_fit`), and the segments' rows
+    are built chunk by chunk for the records' first ``samples`` samples only (None: whole; the
+    screen of a long record), so neither the full (samples x plays) outputs nor the whole
+    records' projected rows are held; without a projection (20 plays, or a worse RSS) the
+    segments hold the full play outputs of those samples. Returns the train and validate
+    segments, the nominal fitted on them (with the full model's ``params``), the full nominal,
+    the projection ``V`` (play columns = ``Z @ V``; None: not compressed), the full nominal's
+    train and validate outputs (every sample) and the whole records as segments without play rows
+    (:func:`_bare`, for :func:`_with_rows`). With a ``pool`` of several threads, the validate
+    outputs and the slow-drift check are made on it beside the train passes (the same values)."""
     n = radii.size
     threads = pool is not None and pool.workers > 1
     segs, ne = _plain_fit(train, radii, initial_state, at_rest)
-    coef = ne.solve() if nonneg is None else \
+    coef_ls = ne.solve()
+    coef = coef_ls if nonneg is None else \
         _plain_fit(train, radii, initial_state, at_rest, qr=True)[1].solve_nonneg(nonneg)
     vsegs = _bare(validate, initial_state)
     out_va = pool.submit(_plain_outputs, vsegs, radii, coef, at_rest) if threads else None
@@ -701,8 +703,12 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
         rss_full = sum(float(np.sum(np.square(r, out=r))) for r in (
             (o - s.y)[s.used] for s, o in zip(segs, out_tr, strict=True)))
         _, vecs = np.linalg.eigh(ne.G[:n, :n])
-        w = coef[:n]
-        V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
+        # the least-squares weights first, then the principal directions (the grid searches
+        # take the leading columns); a bounded nominal's own weights last, so that its fit is
+        # in the span and the searches see the columns least squares gives them
+        ws = [coef_ls[:n]] + ([] if nonneg is None else [coef[:n]])
+        ws = [w / (np.linalg.norm(w) or 1.0) for w in ws]
+        V = np.column_stack((ws[0], vecs[:, ::-1][:, :PROJECTED], *ws[1:]))
         screen = _bare(train, initial_state, SCREEN_SAMPLES)
         slow = pool.submit(_slow_rss, screen, radii, at_rest, V) if threads else None
         m, rss = _projected_fit(segs, radii, V, at_rest)
@@ -720,8 +726,6 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
             m.params = dict(full.params)
             return (*([_with_rows(s, radii, V, at_rest) for s in h] for h in heads), m, full, V,
                     out_tr, out_va, segs, vsegs)
-    if nonneg is not None:  # the candidates refit the plays under the same bound
-        full.params["nonneg_plays"] = n
     return (*([_with_rows(s, radii, None, at_rest) for s in h] for h in heads), full, full, None,
             out_tr, out_va, segs, vsegs)
 

@@ -425,7 +425,7 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
             if ne is None:
                 ne = NormalEquations(terms[0].shape[0])
             ne.add_gram(*terms)
-    coef = ne.solve(nonneg=getattr(features, "nonneg", None))
+    coef = ne.solve()
     rss = ne.rss(coef)  # from the sums when that is safe from cancellation (RSS_RTOL)
     if rss is None:  # else a second pass, over the residuals
         rss = 0.0
@@ -1333,10 +1333,6 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                             len(static["train"]))
 
     feats.parts = rows
-    bounded = nominal.params.get("nonneg_plays")  # the nominal's plays of radius > 0 held >= 0
-    if bounded:  # the same bound on the refitted plays (not on a projection's columns)
-        nz = bounded if ncols is None else min(ncols, bounded)
-        feats.nonneg = np.arange(nz) > 0
     feats.recipe = (nominal, _exact((tuple(effects), p, ncols)))  # names the regressors (_fit_memo)
     feats.parts_chunks = parts_chunks
     feats.stacked_times = lambda s, coef: stacked_times(parts_chunks, feats, s, coef)
