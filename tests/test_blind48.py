@@ -91,3 +91,20 @@ def test_blind_clean_triangles_from_a_parked_stage_point_to_the_unknown_start():
     rep = diagnose([rt], [rv], workers=1, initial_state="unknown")
     assert rep.verdict["effects"] == ["none"]
     assert rep.verdict["gap_before"] < 2.0 * rep.verdict["noise_floor"]
+
+
+@pytest.mark.parametrize("seed", [2])
+def test_clean_band_noise_stage_is_none_with_non_negative_play_weights(seed):
+    """A clean stage under band-limited noise at 5 kHz (the blind case clean-bandnoise, seed 2)
+    was ``rate`` before the nominal's play weights of radius > 0 were held non-negative (least
+    squares on its 80-play grid validated at 9.6 noise floors, its weights swinging in sign);
+    with them (kept when validate agrees) it is ``none``, the nominal within 2 noise floors on
+    validate and its weights of radius > 0 all >= 0."""
+    rt, rv, _, _ = S.make_records(S.Case("clean-bandnoise", (), "bandnoise", 5000.0, seed))
+    rep = diagnose([rt], [rv], workers=1)
+    v = rep.verdict
+    assert v["effects"] == ["none"]
+    assert v["gap_before"] < 2.0 * v["noise_floor"]
+    model = rep.nominal["model"]
+    w = np.asarray(model["weights"])[np.asarray(model["radii"]) > 0]
+    assert np.all(w >= 0.0)

@@ -413,3 +413,33 @@ def test_transposed_is_the_contiguous_transpose(shape):
     for src in (M, np.asfortranarray(M), M[::1, :]):
         out = transposed(src)
         assert out.flags.c_contiguous and np.array_equal(out, np.ascontiguousarray(src.T))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_bounded_weights_reach_the_bounded_least_squares_optimum(seed):
+    """The weights held >= 0 (all but the first column) from the running QR factor
+    (``ChunkedQR.solve_nonneg``), the samples added in chunks, reach the residual of SciPy's
+    bounded-variable least squares on the whole samples, and equal one chunk's."""
+    from scipy.optimize import lsq_linear
+    rng = np.random.default_rng(seed)
+    p, n = 12, 2000
+    X = np.cumsum(rng.normal(size=(p, n)), axis=1) * np.geomspace(1.0, 30.0, p)[:, None]
+    X[-1] = X[-2] + 1e-9 * rng.normal(size=n)  # nearly collinear, as fine play grids are
+    y = -X[1] + 0.5 * X[3] + rng.normal(size=n)  # one true weight negative
+    bounded = np.arange(p) > 0
+    ref = lsq_linear(X.T, y, bounds=(np.where(bounded, 0.0, -np.inf), np.inf), method="bvls").x
+    rss_ref = float(np.sum((X.T @ ref - y) ** 2))
+    size = int(rng.integers(100, 700))
+    ne, qr, whole = NormalEquations(p), ChunkedQR(p), ChunkedQR(p)
+    for s in chunks(n, size):
+        ne.add(X[:, s], y[s])
+        qr.add(X[:, s], y[s])
+    whole.add(X, y)
+    coef = qr.solve_nonneg(bounded)
+    assert np.all(coef[bounded] >= 0.0)
+    assert float(np.sum((X.T @ coef - y) ** 2)) <= rss_ref * (1 + 1e-8)
+    assert np.allclose(X.T @ qr.solve_nonneg(bounded), X.T @ whole.solve_nonneg(bounded),
+                       rtol=0, atol=1e-6 * np.std(y))
+    unbounded = ne.solve()  # least squares turns the first bounded weight negative here
+    assert unbounded[1] < 0.0
+    assert float(np.sum((X.T @ unbounded - y) ** 2)) < rss_ref

@@ -24,6 +24,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import numpy as np
+from scipy.optimize import lsq_linear
 
 __all__ = ["CHUNK", "RSS_RTOL", "ChunkedQR", "NormalEquations", "chunks", "combine",
            "stack_rows", "transposed"]
@@ -259,11 +260,48 @@ class ChunkedQR:
         rss : float
             ``sum (y - X^T coef)^2`` over every sample added.
         """
-        R = np.zeros((self.p + 1, self.p + 1))
-        R[:self.R.shape[0]] = self.R[:self.p + 1]
+        R = self._square()
         coef, *_ = np.linalg.lstsq(R[:self.p, :self.p], R[:self.p, self.p], rcond=rcond)
         rest = R[:, self.p] - R[:, :self.p] @ coef
         return coef, float(rest @ rest)
+
+    def solve_nonneg(self, nonneg: np.ndarray) -> np.ndarray:
+        """The least-squares coefficients with some held at or above 0, from the factor.
+
+        Bounded-variable least squares (``scipy.optimize.lsq_linear``, ``method="bvls"``) on
+        ``R`` and its last column: the same objective as on the samples, up to a constant,
+        with the condition number of ``X`` (not its square, as from :class:`NormalEquations`).
+
+        Parameters
+        ----------
+        nonneg : numpy.ndarray
+            Boolean mask, shape (p,) or shorter (the leading columns): the coefficients held
+            at or above 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (p,).
+
+        Examples
+        --------
+        >>> qr = ChunkedQR(2)
+        >>> qr.add(np.array([[1.0, 0.0, 1.0], [1.0, 1.0, 0.0]]), np.array([1.0, -1.0, 2.0]))
+        >>> np.round(qr.solve_nonneg(np.array([False, True])), 12).tolist()
+        [1.5, 0.0]
+        """
+        R = self._square()
+        bounded = np.zeros(self.p, dtype=bool)
+        bounded[:np.size(nonneg)] = nonneg
+        x = lsq_linear(R[:self.p, :self.p], R[:self.p, self.p],
+                       bounds=(np.where(bounded, 0.0, -np.inf), np.inf), method="bvls").x
+        return np.where(bounded, np.maximum(x, 0.0), x)  # BVLS may leave -1e-19 at a bound
+
+    def _square(self) -> np.ndarray:
+        """The factor padded with rows of zeros to shape (p + 1, p + 1)."""
+        R = np.zeros((self.p + 1, self.p + 1))
+        R[:self.R.shape[0]] = self.R[:self.p + 1]
+        return R
 
 
 def stack_rows(parts) -> np.ndarray:

@@ -66,7 +66,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..records import Record
-from .chunked import NormalEquations
+from .chunked import ChunkedQR, NormalEquations
 from .coverage import coverage, informed_radii, span_and_reach
 from .creep import creep_law, creep_starts, start_hint
 from .delaylike import is_delay_like
@@ -104,6 +104,7 @@ FEW_SAMPLES_PER_PLAY = 50  # few: fewer train samples than this per play of the 
 ABOVE_POINTS = 40  # with few train samples, radii tried for one play above half the range
 ABOVE_MARGIN = 10.0  # ... kept when it lowers the train BIC by this much (and validate agrees)
 BASELINE_PLAYS = 60  # plays of the plain least-squares baseline (0 to max |v| of train)
+NONNEG_PLAYS = True  # the nominal's play weights of radius > 0 held >= 0 when validate agrees
 PROJECTED = 32  # principal directions of the play outputs kept beside the nominal's weights
 BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor of the baseline's
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
@@ -426,16 +427,18 @@ def _bare(records: list[Record], initial_state: str, samples: int | None = None)
 
 
 def _plain_fit(records: list[Record], radii, initial_state: str,
-               at_rest: bool = True, samples: int | None = None
-               ) -> tuple[list[Segment], NormalEquations]:
+               at_rest: bool = True, samples: int | None = None, qr: bool = False
+               ) -> tuple[list[Segment], NormalEquations | ChunkedQR]:
     """The PI fit (play weights and an offset) that :func:`.effects.fit_nominal` makes, in one
     pass over the records with one chunk of play outputs at a time (:func:`.effects.play_chunks`
     into :class:`.chunked.NormalEquations`): nothing of size (samples x plays) is kept. Returns
     the records as segments without play outputs (:func:`_bare`, their first ``samples``
     samples; None: whole) and the normal equations (``solve()`` gives the coefficients, ``G``
-    the Gram matrix of the plays and the offset on the fitted samples)."""
+    the Gram matrix of the plays and the offset on the fitted samples); with ``qr`` a running
+    triangular factor of the same samples instead (:class:`.chunked.ChunkedQR`, for the bounded
+    weights of :func:`_bounded`)."""
     segs = _bare(records, initial_state, samples)
-    ne = NormalEquations(np.size(radii) + 1)
+    ne = (ChunkedQR if qr else NormalEquations)(np.size(radii) + 1)
     for s in segs:
         for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
             if s.mask is None:
@@ -640,28 +643,56 @@ def _baseline(train, validate, initial_state) -> dict:
             "validate": _errors(va, _plain_outputs(va, radii, coef))}
 
 
+def _bounded(train, validate, radii, initial_state: str, at_rest: bool) -> np.ndarray | None:
+    """The plays held at or above 0 in the nominal's weights: radius above 0 (the radius-0 play
+    and the offset free), when the fit so bounded (bounded-variable least squares on the
+    triangular factor of the plays, :meth:`.chunked.ChunkedQR.solve_nonneg`) has a validate
+    BIC not above the least-squares fit's (both on the records' first ``SCREEN_SAMPLES``
+    samples, as :func:`_validate_bic`); else None (least squares, as before), and None when
+    ``NONNEG_PLAYS`` is off.
+
+    A PI stage's plays of radius above 0 have non-negative weights (a loop traversed
+    anticlockwise); least squares on a fine grid is ill-conditioned (cond ``Z`` about 1e18 on 80
+    plays), so on records whose inputs excite few directions (multisines, band-limited noise,
+    ramps to held levels; issue 28) its weights swing in sign and mispredict validate by several
+    noise floors. The bound is kept only where validate agrees, so a stage whose weights are
+    truly signed keeps least squares."""
+    if not NONNEG_PLAYS or radii.size < 2:
+        return None
+    mask = np.asarray(radii) > 0
+    ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)[1]
+    qr = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES, qr=True)[1]
+    vbic = [_validate_bic(validate, initial_state, (None, radii, coef, at_rest))
+            for coef in (ne.solve(), qr.solve_nonneg(mask))]
+    return mask if vbic[1] <= vbic[0] else None
+
+
 def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
-                      samples: int | None = None, pool: Pool | None = None):
+                      samples: int | None = None, pool: Pool | None = None,
+                      nonneg: np.ndarray | None = None):
     """The nominal on the chosen grid and the segments the candidates are fitted on, the play
     outputs streamed (:func:`_plain_fit`): the nominal's train and validate outputs, then its
-    play columns replaced by a few combinations (the nominal's own weights, then the 32 leading
-    principal directions of the train play outputs, from the Gram matrix of the same pass)
-    when they keep the nominal train RSS within 1 %; the candidates' grid searches filter these
-    columns only. The projected nominal is fitted by normal equations streamed over the records
-    (:func:`_projected_fit`), and the segments' rows are built chunk by chunk for the records'
-    first ``samples`` samples only (None: whole; the screen of a long record), so neither the
-    full (samples x plays) outputs nor the whole records' projected rows are held; without a
-    projection (20 plays, or a worse RSS) the segments hold the full play outputs of those
-    samples. Returns the train and validate segments, the nominal fitted on them (with the full
-    model's ``params``), the full nominal, the projection ``V`` (play columns = ``Z @ V``;
-    None: not compressed), the full nominal's train and validate outputs (every sample) and
-    the whole records as segments without play rows (:func:`_bare`, for :func:`_with_rows`).
-    With a ``pool`` of several threads, the validate outputs and the slow-drift check are made
-    on it beside the train passes (the same values)."""
+    play columns replaced by a few combinations (the least-squares weights, then the 32 leading
+    principal directions of the train play outputs, from the Gram matrix of the same pass, and
+    last the weights held non-negative where ``nonneg`` says, :func:`_bounded`) when they keep
+    the nominal train RSS within 1 %; the candidates' grid searches filter the leading columns of
+    these only, and refit every weight of them without bound. The projected nominal is fitted by
+    normal equations streamed over the records (:func:`_projected_fit`), and the segments' rows
+    are built chunk by chunk for the records' first ``samples`` samples only (None: whole; the
+    screen of a long record), so neither the full (samples x plays) outputs nor the whole
+    records' projected rows are held; without a projection (20 plays, or a worse RSS) the
+    segments hold the full play outputs of those samples. Returns the train and validate
+    segments, the nominal fitted on them (with the full model's ``params``), the full nominal,
+    the projection ``V`` (play columns = ``Z @ V``; None: not compressed), the full nominal's
+    train and validate outputs (every sample) and the whole records as segments without play rows
+    (:func:`_bare`, for :func:`_with_rows`). With a ``pool`` of several threads, the validate
+    outputs and the slow-drift check are made on it beside the train passes (the same values)."""
     n = radii.size
     threads = pool is not None and pool.workers > 1
     segs, ne = _plain_fit(train, radii, initial_state, at_rest)
-    coef = ne.solve()
+    coef_ls = ne.solve()
+    coef = coef_ls if nonneg is None else \
+        _plain_fit(train, radii, initial_state, at_rest, qr=True)[1].solve_nonneg(nonneg)
     vsegs = _bare(validate, initial_state)
     out_va = pool.submit(_plain_outputs, vsegs, radii, coef, at_rest) if threads else None
     out_tr = _plain_outputs(segs, radii, coef, at_rest)
@@ -672,8 +703,12 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
         rss_full = sum(float(np.sum(np.square(r, out=r))) for r in (
             (o - s.y)[s.used] for s, o in zip(segs, out_tr, strict=True)))
         _, vecs = np.linalg.eigh(ne.G[:n, :n])
-        w = coef[:n]
-        V = np.column_stack((w / (np.linalg.norm(w) or 1.0), vecs[:, ::-1][:, :PROJECTED]))
+        # the least-squares weights first, then the principal directions (the grid searches
+        # take the leading columns); a bounded nominal's own weights last, so that its fit is
+        # in the span and the searches see the columns least squares gives them
+        ws = [coef_ls[:n]] + ([] if nonneg is None else [coef[:n]])
+        ws = [w / (np.linalg.norm(w) or 1.0) for w in ws]
+        V = np.column_stack((ws[0], vecs[:, ::-1][:, :PROJECTED], *ws[1:]))
         screen = _bare(train, initial_state, SCREEN_SAMPLES)
         slow = pool.submit(_slow_rss, screen, radii, at_rest, V) if threads else None
         m, rss = _projected_fit(segs, radii, V, at_rest)
@@ -817,9 +852,10 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     # the baseline does not depend on the nominal: on a second thread, beside it
     baseline = pool.submit(_baseline, train, validate, initial_state) if pool.workers > 1 \
         else None
+    nonneg = _bounded(train, validate, radii, initial_state, at_rest)
     tr, va, nominal, full_nominal, proj, out_tr, out_va, *whole = _nominal_segments(
         train, validate, radii, initial_state, at_rest, SCREEN_SAMPLES if screened else None,
-        pool)
+        pool, nonneg)
     before = _errors(whole[1], out_va)
     progress("plain least-squares baseline")
     nominal_json = {"model": {"kind": "PI, conventional parametrisation", "radii": radii,
