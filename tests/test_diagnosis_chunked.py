@@ -273,6 +273,11 @@ def test_chunks_reject_bad_sizes():
         NormalEquations(2).add(np.zeros((3, 4)), np.zeros(4))
     with pytest.raises(ValueError, match="y"):
         ChunkedQR(2).add(np.zeros((2, 4)), np.zeros(5))
+    qr = ChunkedQR(2)
+    qr.add(np.eye(2), np.ones(2))
+    for bad in (np.ones(3, dtype=bool), np.array([1, 0]), np.ones((1, 2), dtype=bool)):
+        with pytest.raises(ValueError, match=r"^nonneg: expected a boolean mask of at most p=2"):
+            qr.solve_nonneg(bad)
 
 
 LIMIT_GB = 1.4  # peak resident memory of the child (ru_maxrss); 2 x 1M samples reached 15.5 GB

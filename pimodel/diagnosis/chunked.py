@@ -294,6 +294,11 @@ class ChunkedQR:
         numpy.ndarray
             Shape (p,).
 
+        Raises
+        ------
+        ValueError
+            If ``nonneg`` is not a boolean vector of at most ``p`` entries.
+
         Examples
         --------
         >>> qr = ChunkedQR(2)
@@ -301,9 +306,13 @@ class ChunkedQR:
         >>> np.round(qr.solve_nonneg(np.array([False, True])), 12).tolist()
         [1.5, 0.0]
         """
+        mask = np.asarray(nonneg)
+        if mask.dtype != bool or mask.ndim != 1 or mask.size > self.p:
+            raise ValueError(f"nonneg: expected a boolean mask of at most p={self.p} entries, "
+                             f"got {mask.dtype} of shape {mask.shape}")
         R = self._square()
         bounded = np.zeros(self.p, dtype=bool)
-        bounded[:np.size(nonneg)] = nonneg
+        bounded[:mask.size] = mask
         x = lsq_linear(R[:self.p, :self.p], R[:self.p, self.p],
                        bounds=(np.where(bounded, 0.0, -np.inf), np.inf), method="bvls").x
         return np.where(bounded, np.maximum(x, 0.0), x)  # BVLS may leave -1e-19 at a bound
