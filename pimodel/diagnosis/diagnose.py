@@ -427,24 +427,24 @@ def _bare(records: list[Record], initial_state: str, samples: int | None = None)
 
 
 def _plain_fit(records: list[Record], radii, initial_state: str,
-               at_rest: bool = True, samples: int | None = None, qr: bool = False
-               ) -> tuple[list[Segment], NormalEquations | ChunkedQR]:
+               at_rest: bool = True, samples: int | None = None,
+               factor: ChunkedQR | None = None) -> tuple[list[Segment], NormalEquations]:
     """The PI fit (play weights and an offset) that :func:`.effects.fit_nominal` makes, in one
     pass over the records with one chunk of play outputs at a time (:func:`.effects.play_chunks`
     into :class:`.chunked.NormalEquations`): nothing of size (samples x plays) is kept. Returns
     the records as segments without play outputs (:func:`_bare`, their first ``samples``
     samples; None: whole) and the normal equations (``solve()`` gives the coefficients, ``G``
-    the Gram matrix of the plays and the offset on the fitted samples); with ``qr`` a running
-    triangular factor of the same samples instead (:class:`.chunked.ChunkedQR`, for the bounded
-    weights of :func:`_bounded`)."""
+    the Gram matrix of the plays and the offset on the fitted samples). A ``factor`` given
+    (:class:`.chunked.ChunkedQR`, for the bounded weights of :func:`_bounded`) takes the same
+    rows in the same pass."""
     segs = _bare(records, initial_state, samples)
-    ne = (ChunkedQR if qr else NormalEquations)(np.size(radii) + 1)
+    ne = NormalEquations(np.size(radii) + 1)
+    sinks = (ne,) if factor is None else (ne, factor)
     for s in segs:
         for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
-            if s.mask is None:
-                ne.add(rows, s.y[c])
-            else:
-                ne.add(rows[:, s.mask[c]], s.y[c][s.mask[c]])
+            X, y = (rows, s.y[c]) if s.mask is None else (rows[:, s.mask[c]], s.y[c][s.mask[c]])
+            for sink in sinks:
+                sink.add(X, y)
     return segs, ne
 
 
@@ -659,9 +659,9 @@ def _bounded(train, validate, radii, initial_state: str, at_rest: bool) -> np.nd
     truly signed keeps least squares."""
     if not NONNEG_PLAYS or radii.size < 2:
         return None
-    mask = np.asarray(radii) > 0
-    ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES)[1]
-    qr = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES, qr=True)[1]
+    mask = radii > 0
+    qr = ChunkedQR(radii.size + 1)
+    ne = _plain_fit(train, radii, initial_state, at_rest, SCREEN_SAMPLES, factor=qr)[1]
     vbic = [_validate_bic(validate, initial_state, (None, radii, coef, at_rest))
             for coef in (ne.solve(), qr.solve_nonneg(mask))]
     return mask if vbic[1] <= vbic[0] else None
@@ -689,10 +689,10 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
     outputs and the slow-drift check are made on it beside the train passes (the same values)."""
     n = radii.size
     threads = pool is not None and pool.workers > 1
-    segs, ne = _plain_fit(train, radii, initial_state, at_rest)
+    qr = None if nonneg is None else ChunkedQR(n + 1)  # the bounded weights: same pass
+    segs, ne = _plain_fit(train, radii, initial_state, at_rest, factor=qr)
     coef_ls = ne.solve()
-    coef = coef_ls if nonneg is None else \
-        _plain_fit(train, radii, initial_state, at_rest, qr=True)[1].solve_nonneg(nonneg)
+    coef = coef_ls if qr is None else qr.solve_nonneg(nonneg)
     vsegs = _bare(validate, initial_state)
     out_va = pool.submit(_plain_outputs, vsegs, radii, coef, at_rest) if threads else None
     out_tr = _plain_outputs(segs, radii, coef, at_rest)
