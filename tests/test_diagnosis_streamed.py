@@ -96,6 +96,8 @@ CASES = [
     ("creep", (), {"creep_start": "common"}),  # the lags at a common rest (module creep)
     ("asymmetry", ("creep",), {"creep_start": "common"}),
     ("delay", ("creep",), {"creep_start": "common", "d": 1.5}),
+    ("creep", (), {"creep_start": "record"}),  # counted from each record's start
+    ("delay", ("creep",), {"creep_start": "record", "d": 1.5}),
 ]
 
 

@@ -43,6 +43,15 @@ the same starts, so nothing is fitted on it. The report gives ``creep_start_leve
 ``s_i`` (output unit), and the exported model starts its lags there (issue 28: on the blind
 generator parked as its docstring says, drift50 measured 11 of 15 creep cases right against 5
 of 15, a spurious `drift` in 2 against 5; docs/notes/creep60.md).
+``"record"``: the creep counted from each record's start. The lags start as at rest
+(``L_i[-1] = h0[0]``) and the term is ``g_i (L_i[k] - h0[k] - L_i[-1])``: the rest start plus
+the level ``-sum_i g_i h0[0]`` of each record, so the record's first output is the un-crept
+``h0[0] (1 - sum g)``, not the crept ``h0[0]`` (a stage whose creep restarts with each record, as a
+generator that writes creep as lags of ``h - h[0]`` makes it). No further parameter. With the
+rest start, a validate record that starts elsewhere than train then carries a level error of
+``sum g`` times the difference of their first outputs, which a drift with a level per record
+took up (issue 28, the blind generator: `creep` beside a spurious `drift` in 7 of 20
+creep-bearing cases; docs/diagnosis.md gives the figures after).
 """
 
 from __future__ import annotations
@@ -54,7 +63,7 @@ import numpy as np
 __all__ = ["CREEP_STARTS", "creep_law", "creep_start_levels", "creep_starts",
            "creep_time_constants", "start_columns", "start_hint"]
 
-CREEP_STARTS = ("rest", "common")  # where the lags start (module docstring)
+CREEP_STARTS = ("rest", "common", "record")  # where the lags start (module docstring)
 MIN_LAG_SAMPLES = 10  # the shortest lag spans at least this many samples
 DECADE_ANCHOR = 3.0  # lags at DECADE_ANCHOR 10^j s
 LONGEST_LAG = 2.0  # the last lag is the last at most this many times the longest train record
@@ -158,8 +167,8 @@ def creep_law(gains, time_constants) -> dict:
 
 def creep_starts(effects, held: str | None = None) -> list[dict]:
     """The creep's starts a diagnosis scores on validate (by BIC) when ``effects`` hold a
-    creep: each lag at rest at the record's first output, or at a level shared by the records
-    (module docstring). Both are scored where the creep enters a combination (the candidate
+    creep: each lag at rest at the record's first output, at a level shared by the records, or
+    at rest with the creep counted from the record's start (module docstring). All are scored where the creep enters a combination (the candidate
     alone, a pair, the creep added beside chosen effects) and where the lag beside it is
     searched again; another fit built on a model that holds a creep keeps that creep's start
     (``held``, :func:`start_hint`), so the start is not chosen anew for every combination.
@@ -170,7 +179,7 @@ def creep_starts(effects, held: str | None = None) -> list[dict]:
         The effects of the model being fitted.
     held : str or None
         The start held (one of ``CREEP_STARTS``: that of the creep already chosen); None:
-        both.
+        all.
 
     Returns
     -------
@@ -181,7 +190,7 @@ def creep_starts(effects, held: str | None = None) -> list[dict]:
     Examples
     --------
     >>> creep_starts(("drift",)), creep_starts(("creep", "delay"))
-    ([{}], [{'creep_start': 'rest'}, {'creep_start': 'common'}])
+    ([{}], [{'creep_start': 'rest'}, {'creep_start': 'common'}, {'creep_start': 'record'}])
     >>> creep_starts(("creep", "delay"), held="common")
     [{'creep_start': 'common'}]
     """
@@ -194,8 +203,8 @@ def creep_starts(effects, held: str | None = None) -> list[dict]:
 
 def start_hint(grid: dict) -> str:
     """The start of the creep of a fitted model, held for the fits built on it:
-    ``"common"`` when its grid says so, else ``"rest"`` (a fit at rest leaves the grid
-    without the key, as before the common start).
+    ``"common"`` or ``"record"`` when its grid says so, else ``"rest"`` (a fit at rest leaves
+    the grid without the key, as before the other starts).
 
     Parameters
     ----------
@@ -209,8 +218,8 @@ def start_hint(grid: dict) -> str:
 
     Examples
     --------
-    >>> start_hint({}), start_hint({"creep_start": "common"})
-    ('rest', 'common')
+    >>> start_hint({}), start_hint({"creep_start": "common"}), start_hint({"creep_start": "record"})
+    ('rest', 'common', 'record')
     """
     return grid.get("creep_start", CREEP_STARTS[0])
 
@@ -245,8 +254,8 @@ def start_columns(samples, dt: float, taus) -> np.ndarray:
 
 def creep_start_levels(params: dict) -> np.ndarray | None:
     """The creep lags' common rest levels of a model's ``params`` (module docstring), or None
-    when the lags start at rest at each record's first output (``creep_start`` absent or
-    ``"rest"``).
+    when the lags start at rest at each record's first output (``creep_start`` absent,
+    ``"rest"`` or ``"record"``).
 
     Parameters
     ----------
@@ -261,7 +270,7 @@ def creep_start_levels(params: dict) -> np.ndarray | None:
     Raises
     ------
     ValueError
-        ``creep_start`` other than ``"rest"`` or ``"common"``, or levels that are not one
+        ``creep_start`` not one of ``CREEP_STARTS``, or levels that are not one
         finite value per lag.
 
     Examples
@@ -275,7 +284,7 @@ def creep_start_levels(params: dict) -> np.ndarray | None:
     start = params.get("creep_start", "rest")
     if start not in CREEP_STARTS:
         raise ValueError(f"params: creep_start: expected one of {CREEP_STARTS}, got {start!r}")
-    if start == "rest":
+    if start != "common":
         return None
     levels = np.asarray(params.get("creep_start_levels", ()), float)
     n = len(params.get("creep_lag_gains", ()))

@@ -909,7 +909,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
-        # a creep's start: both scored where the creep enters (alone, a pair, the creep
+        # a creep's start: each scored where the creep enters (alone, a pair, the creep
         # added or swapped in); held where ``fixed_`` carries the chosen creep's (_hold)
         shapes = [{**r, **c} for r in rate_shapes((*combo, name), fixed_ or {})
                   for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"))]
@@ -1281,7 +1281,7 @@ def _hold(fixed: dict, effects: tuple, grid: dict) -> dict:
     chosen for ``effects``, and the start of its creep (:func:`.creep.start_hint`: the rest
     start is no grid key) held as ``fixed["creep_start"]`` (none without a creep): every fit
     built on that model keeps it (:func:`.creep.creep_starts`), while a creep entering a
-    combination, or beside a lag searched again (:func:`_lag_calls`), has both starts scored
+    combination, or beside a lag searched again (:func:`_lag_calls`), has every start scored
     (creep61: not anew for every combination)."""
     fixed.pop("creep_start", None)
     fixed.update(grid)

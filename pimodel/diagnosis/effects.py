@@ -916,8 +916,8 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
     # the creep's lags at rest at a level shared by the records (module creep): one further
     # coefficient per lag, g_i s_i
-    common = "creep" in effects and fixed.get("creep_start") == "common"
-    k += len(nominal.params["creep_taus"]) if common else 0
+    start = fixed.get("creep_start") if "creep" in effects else None
+    k += len(nominal.params["creep_taus"]) if start == "common" else 0
     if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
         k -= RATE_BANDS - 1
     # held: one point, no search; its play rows' Gram formed as a streamed refit forms it
@@ -962,7 +962,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING] +
                          [{"fn": f, "zeta": MODE_HEAVY[1]} for f in MODE_HEAVY[0] if f <= fmax])
         elif e == "creep":  # the start: a variant chosen on validate (module creep)
-            grids.append([{"creep_start": "common"}] if common else [{}])
+            grids.append([{"creep_start": start}] if start in ("common", "record") else [{}])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
@@ -1264,10 +1264,11 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     of rows (``feats.parts(s)``: the play rows, then the others; :func:`_row_parts`);
     ``feats(s)`` is the transpose of their stack."""
 
-    common = "creep" in effects and p.get("creep_start") == "common"
+    start = p.get("creep_start") if "creep" in effects else None
+    common = start == "common"
 
     def static_rows(s: Segment) -> np.ndarray:
-        key = ("common", id(s)) if common else id(s)
+        key = (start, id(s)) if start in ("common", "record") else id(s)
         if key not in static:
             out = [np.ones(s.t.size)]
             h0 = nominal.predict(s)
@@ -1279,7 +1280,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                 # the stage's memory at the start unknown (a start-up mask): the creep's
                 # too; its lags start at the measured first output, not at h0[0]
                 y0 = None if s.mask is None else float(s.y[0])
-                out += [lag(h0, tau, s.dt, y0) - h0 for tau in taus]
+                # "record": counted from the record's start, less the lags' start
+                less = (float(h0[0]) if y0 is None else y0) if start == "record" else 0.0
+                out += [lag(h0, tau, s.dt, y0) - h0 - less for tau in taus]
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 out += [u**2, u**3]
@@ -1393,6 +1396,8 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["creep_lag_gains"] = gains.tolist()
             out["creep_time_constants_s"] = list(taus)
             i += len(taus)
+            if model.params.get("creep_start") == "record":  # counted from each start
+                out["creep_start"] = "record"
             if model.params.get("creep_start") == "common":  # g_i s_i, then the levels s_i
                 out["creep_start"] = "common"
                 out["creep_start_levels"] = _start_levels(gains, extra[i:i + len(taus)])
