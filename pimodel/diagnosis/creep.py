@@ -60,7 +60,9 @@ import math
 
 import numpy as np
 
-__all__ = ["CREEP_STARTS", "creep_law", "creep_start_levels", "creep_starts",
+from .drift import has_levels
+
+__all__ = ["CREEP_STARTS", "creep_law", "creep_levels", "creep_start_levels", "creep_starts",
            "creep_time_constants", "start_columns", "start_hint"]
 
 CREEP_STARTS = ("rest", "common", "record")  # where the lags start (module docstring)
@@ -165,13 +167,14 @@ def creep_law(gains, time_constants) -> dict:
             "span_s": [float(t[0]), float(t[-1])]}
 
 
-def creep_starts(effects, held: str | None = None) -> list[dict]:
+def creep_starts(effects, held: str | None = None, n_validate: int = 1) -> list[dict]:
     """The creep's starts a diagnosis scores on validate (by BIC) when ``effects`` hold a
     creep: each lag at rest at the record's first output, at a level shared by the records, or
-    at rest with the creep counted from the record's start (module docstring). All are scored where the creep enters a combination (the candidate
-    alone, a pair, the creep added beside chosen effects) and where the lag beside it is
-    searched again; another fit built on a model that holds a creep keeps that creep's start
-    (``held``, :func:`start_hint`), so the start is not chosen anew for every combination.
+    at rest with the creep counted from the record's start (module docstring). All are scored
+    where the creep enters a combination (the candidate alone, a pair, the creep added beside
+    chosen effects) and where the lag beside it is searched again; another fit built on a
+    model that holds a creep keeps that creep's start (``held``, :func:`start_hint`), so the
+    start is not chosen anew for every combination.
 
     Parameters
     ----------
@@ -180,17 +183,22 @@ def creep_starts(effects, held: str | None = None) -> list[dict]:
     held : str or None
         The start held (one of ``CREEP_STARTS``: that of the creep already chosen); None:
         all.
+    n_validate : int
+        Validate records: the levels of the start ``"record"`` (``creep_levels``).
 
     Returns
     -------
     list of dict
         ``[{}]`` without a creep, else ``{"creep_start": s}`` for ``s`` of ``CREEP_STARTS``
-        (only ``held`` when given).
+        (only ``held`` when given), with ``creep_levels`` for ``"record"``.
 
     Examples
     --------
-    >>> creep_starts(("drift",)), creep_starts(("creep", "delay"))
-    ([{}], [{'creep_start': 'rest'}, {'creep_start': 'common'}, {'creep_start': 'record'}])
+    >>> creep_starts(("drift",))
+    [{}]
+    >>> creep_starts(("creep", "delay"), n_validate=2)  # doctest: +NORMALIZE_WHITESPACE
+    [{'creep_start': 'rest'}, {'creep_start': 'common'},
+     {'creep_start': 'record', 'creep_levels': 2}]
     >>> creep_starts(("creep", "delay"), held="common")
     [{'creep_start': 'common'}]
     """
@@ -198,7 +206,40 @@ def creep_starts(effects, held: str | None = None) -> list[dict]:
         return [{}]
     if held is not None and held not in CREEP_STARTS:
         raise ValueError(f"held: expected one of {CREEP_STARTS} or None, got {held!r}")
-    return [{"creep_start": s} for s in ((held,) if held is not None else CREEP_STARTS)]
+    return [{"creep_start": s, **({"creep_levels": n_validate} if s == "record" else {})}
+            for s in ((held,) if held is not None else CREEP_STARTS)]
+
+
+def creep_levels(effects, p: dict) -> int:
+    """The levels a creep counted from each record's start adds on validate (module docstring):
+    one per validate record (``p["creep_levels"]``), none for the other starts, without a
+    creep, or beside a drift that has its own levels (they are the same columns).
+
+    Parameters
+    ----------
+    effects : tuple of str
+        The effects of the model.
+    p : dict
+        Its grid parameters (``creep_start``, ``creep_levels``; a drift's ``clock`` and
+        ``levels``).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> creep_levels(("creep",), {"creep_start": "record", "creep_levels": 2})
+    2
+    >>> creep_levels(("creep", "drift"), {"creep_start": "record", "creep_levels": 1,
+    ...                                   "clock": "levels", "levels": 1})
+    0
+    """
+    if "creep" not in effects or p.get("creep_start") != "record":
+        return 0
+    if "drift" in effects and has_levels(p):
+        return 0
+    return int(p.get("creep_levels", 0))
 
 
 def start_hint(grid: dict) -> str:

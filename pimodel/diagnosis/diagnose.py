@@ -912,7 +912,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         # a creep's start: each scored where the creep enters (alone, a pair, the creep
         # added or swapped in); held where ``fixed_`` carries the chosen creep's (_hold)
         shapes = [{**r, **c} for r in rate_shapes((*combo, name), fixed_ or {})
-                  for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"))]
+                  for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"),
+                                        len(va))]
         out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):
@@ -1226,7 +1227,7 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
         # and a rate's all of their kind: a single fit of another family or variant lacks some,
         # e.g. rate_growth, which a held SCALED rate needs)
         return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS,
-                                          "creep": ("creep_start",)}.get(e, ()))
+                                          "creep": ("creep_start", "creep_levels")}.get(e, ()))
 
     def call(effects):  # fit's arguments for the combination ``effects`` (not empty)
         kept = {k: x for k, x in fixed.items() if any(k in keys_of(e) for e in effects)}

@@ -22,13 +22,14 @@ from .._native import pi_run_rows
 from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
-from .creep import creep_time_constants, start_columns
+from .creep import creep_levels, creep_time_constants, start_columns
 from .drift import (
     DRIFT_VARIANTS,
     SETTLE_POINTS,
     drift_columns,
     drift_k,
     has_levels,
+    level_rows,
     out_of_fold_level,
     settle_grid,
     settle_start,
@@ -918,6 +919,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     # coefficient per lag, g_i s_i
     start = fixed.get("creep_start") if "creep" in effects else None
     k += len(nominal.params["creep_taus"]) if start == "common" else 0
+    # a creep counted from each record's start: a level per validate record (module creep),
+    # unless a drift's levels are there already
+    k += creep_levels(effects, fixed)
     if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
         k -= RATE_BANDS - 1
     # held: one point, no search; its play rows' Gram formed as a streamed refit forms it
@@ -962,7 +966,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING] +
                          [{"fn": f, "zeta": MODE_HEAVY[1]} for f in MODE_HEAVY[0] if f <= fmax])
         elif e == "creep":  # the start: a variant chosen on validate (module creep)
-            grids.append([{"creep_start": start}] if start in ("common", "record") else [{}])
+            grids.append([{"creep_start": start}] if start == "common" else
+                         [{"creep_start": start, "creep_levels": fixed["creep_levels"]}]
+                         if start == "record" else [{}])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
@@ -1136,13 +1142,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                 effects, p, ref, {"train": static["train"], "held": held}), train, p)[0]
             model.reference = ref
     model.grid = dict(model.params)
-    model.params = _describe(effects, model, nominal)
+    model.params = _describe(effects, model, nominal, len(static["train"]))
     if lti_trace:
         model.params["dynamics_structures_tried"] = lti_trace
     if positions:
         model.params["dynamics_positions_tried"] = positions
     if "drift" in effects and has_levels(p):  # a level per record
         model.params["drift_t0_train"] = float(train[0].t[0])
+    if ("drift" in effects and has_levels(p)) or creep_levels(effects, p):
         in_train = static["train"]
 
         def with_level(seg, out):  # a record's own level, out of fold (not for train records)
@@ -1268,7 +1275,8 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     common = start == "common"
 
     def static_rows(s: Segment) -> np.ndarray:
-        key = (start, id(s)) if start in ("common", "record") else id(s)
+        key = (start, creep_levels(effects, p), id(s)) if start in ("common", "record") \
+            else id(s)
         if key not in static:
             out = [np.ones(s.t.size)]
             h0 = nominal.predict(s)
@@ -1283,6 +1291,9 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                 # "record": counted from the record's start, less the lags' start
                 less = (float(h0[0]) if y0 is None else y0) if start == "record" else 0.0
                 out += [lag(h0, tau, s.dt, y0) - h0 - less for tau in taus]
+                if creep_levels(effects, p):  # a level per train record after the first
+                    out += list(level_rows(static["train"].index(s), len(static["train"]),
+                                           s.t.size))
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 out += [u**2, u**3]
@@ -1384,7 +1395,7 @@ def _start_levels(gains: np.ndarray, terms: np.ndarray) -> list:
     return [float(b / g) if g != 0 else 0.0 for g, b in zip(gains, terms, strict=True)]
 
 
-def _describe(effects, model: Model, nominal: Model) -> dict:
+def _describe(effects, model: Model, nominal: Model, n_train: int = 1) -> dict:
     out: dict = {}
     n = nominal.coef.size - 1
     extra = model.coef[n + 1:]
@@ -1398,6 +1409,8 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             i += len(taus)
             if model.params.get("creep_start") == "record":  # counted from each start
                 out["creep_start"] = "record"
+                # its levels of the train records after the first (their own columns)
+                i += max(n_train - 1, 0) if creep_levels(effects, model.params) else 0
             if model.params.get("creep_start") == "common":  # g_i s_i, then the levels s_i
                 out["creep_start"] = "common"
                 out["creep_start_levels"] = _start_levels(gains, extra[i:i + len(taus)])

@@ -43,8 +43,8 @@ from scipy.signal import lfilter
 
 from .._native import biquad_rows_carry
 from .chunked import combine, stack_rows
-from .creep import start_columns
-from .drift import drift_columns
+from .creep import creep_levels, start_columns
+from .drift import drift_columns, level_rows
 from .filters import mode_coefficients, shift
 from .lti import element_coefficients
 
@@ -142,6 +142,7 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
     taus = nominal.params["creep_taus"] if "creep" in effects else ()
     common = bool(taus) and p.get("creep_start") == "common"  # lags at a common rest
     record = bool(taus) and p.get("creep_start") == "record"  # counted from the start
+    levels = creep_levels(effects, p) > 0
     lags = [_Lag(tau, dt, 0.0 if common else y0) for tau in taus]
     mode_f = _Biquad(*mode_coefficients(p["fn"], p["zeta"], dt)) if "dynamics" in effects \
         else None
@@ -164,6 +165,8 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
         h0 = combine((rows,), nominal.coef)
         out = [np.ones(h0.size)]
         out += [lag(h0) - h0 - (lag.rest if record else 0.0) for lag in lags]
+        if levels:  # a creep counted from each start: a level per train record after the first
+            out += list(level_rows(train_record, n_train, h0.size))
         if common:
             out += list(start_columns(np.arange(c.start, c.stop), dt, taus))
         if "asymmetry" in effects:
