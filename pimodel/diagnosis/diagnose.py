@@ -68,7 +68,7 @@ from threadpoolctl import threadpool_limits
 from ..records import Record
 from .chunked import ChunkedQR, NormalEquations
 from .coverage import coverage, informed_radii, span_and_reach
-from .creep import creep_law, creep_starts, start_hint
+from .creep import creep_law, creep_levels, creep_starts, start_hint
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
 from .effects import (
@@ -932,15 +932,24 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return cache[key]
 
     def fit(name, combo=(), fixed_=None):
-        """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
-        best = None
+        """Best variant of ``name`` on top of ``combo``: (model, validate outputs). A creep
+        with a level per record (its start ``"record"``, module creep) is kept only when it
+        passes against the best other variant as an effect would (:func:`_passes`): a level
+        measured on each validate record takes up any constant misfit, so by BIC alone it
+        would replace a creep at rest that fits (3 of 4 such stages measured)."""
+        best = levels = None
         for key, fx in variants(name, combo, fixed_):
             m, o = single(key, fx)
             score = _bic(va, o, m.k)
             if _flat_settling(m, tr, va, noise):  # a settling no bow tells from a trend
                 continue
-            if best is None or score < best[0]:
+            if creep_levels((*combo, name), fx):
+                if levels is None or score < levels[0]:
+                    levels = (score, m, o)
+            elif best is None or score < best[0]:
                 best = (score, m, o)
+        if levels is not None and (best is None or _passes(va, levels[1:], best[1:])):
+            best = levels
         return best[1], best[2]
 
     def fit_one(name, combo, fx):
