@@ -22,7 +22,7 @@ from .._native import pi_run_rows
 from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
-from .creep import creep_levels, creep_time_constants, start_columns
+from .creep import RECORD_LEVEL_SHARE, creep_levels, creep_time_constants, start_columns
 from .drift import (
     DRIFT_VARIANTS,
     SETTLE_POINTS,
@@ -1149,12 +1149,23 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
         model.params["dynamics_positions_tried"] = positions
     if "drift" in effects and has_levels(p):  # a level per record
         model.params["drift_t0_train"] = float(train[0].t[0])
-    if ("drift" in effects and has_levels(p)) or creep_levels(effects, p):
-        in_train = static["train"]
+    in_train = static["train"]
+    if "drift" in effects and has_levels(p):
 
         def with_level(seg, out):  # a record's own level, out of fold (not for train records)
             return out if seg in in_train else out + out_of_fold_level(seg.y - out, seg.mask)
         model.adjust = with_level
+    elif creep_levels(effects, p):  # the creep's level, bounded by its first output's change
+        first = {id(full[0]): float(nominal.predict(full[0])[0])}
+
+        def with_creep_level(seg, out):
+            if seg in in_train:
+                return out
+            if id(seg) not in first:
+                first[id(seg)] = float(nominal.predict(seg)[0])
+            bound = RECORD_LEVEL_SHARE * abs(first[id(seg)] - first[id(full[0])])
+            return out + np.clip(out_of_fold_level(seg.y - out, seg.mask), -bound, bound)
+        model.adjust = with_creep_level
     return model
 
 
