@@ -14,6 +14,8 @@ import pytest
 from scipy.signal import lfilter
 
 from pimodel import Record, diagnose
+from pimodel.diagnosis.creep import RECORD_LEVEL_SHARE
+from pimodel.diagnosis.drift import LEVEL_FOLDS
 
 FS = 1000.0
 
@@ -75,3 +77,26 @@ def test_creep_counted_from_each_record_is_creep_alone(seed):
     assert rep.verdict["effects"] == ["creep"], rep.verdict["effects"]
     assert rep.verdict["model"]["creep_start"] == "record"
     assert rep.verdict["gap_after_over_noise"] < 1.5
+
+
+def test_exported_model_predicts_as_the_diagnosis():
+    """The exported model of a record-start creep predicts the validate record as the
+    diagnosis did, given the measured output (its level out of fold, bounded); without it, the
+    creep's own level ``-sum g h0[0]`` and no measured level; the model file keeps it."""
+    from pimodel.diagnosis.model import DiagnosedModel
+
+    train, validate = _case(1)
+    rep = diagnose(train, validate, workers=1)
+    assert rep.verdict["model"]["creep_start"] == "record"
+    aug = rep.model()
+    va = validate[0]
+    got = aug.simulate(va.v, va.t, measured=va.y)
+    assert np.max(np.abs(got - rep.after[0])) < 1e-9
+    bare = aug.simulate(va.v, va.t)
+    level = got - bare  # out of fold: one value per block of the record, within the bound
+    assert 1 <= np.unique(level.round(12)).size <= LEVEL_FOLDS
+    h0 = rep.model(augmented=False).simulate(va.v)  # the creep's reference, the nominal
+    bound = RECORD_LEVEL_SHARE * abs(h0[0] - aug.params["creep_record_reference"])
+    assert np.all(np.abs(level) <= bound + 1e-12) and np.any(level != 0.0)
+    again = DiagnosedModel.from_dict(aug.to_dict())
+    assert np.array_equal(again.simulate(va.v, va.t, measured=va.y), got)

@@ -72,11 +72,11 @@ import math
 
 import numpy as np
 
-from .drift import has_levels
+from .drift import has_levels, out_of_fold_level
 
 __all__ = ["CREEP_STARTS", "RECORD_LEVEL_SHARE", "creep_law", "creep_levels",
-           "creep_start_levels", "creep_starts", "creep_time_constants", "start_columns",
-           "start_hint"]
+           "creep_start_levels", "creep_starts", "creep_time_constants", "record_level",
+           "start_columns", "start_hint"]
 
 CREEP_STARTS = ("rest", "common", "record")  # where the lags start (module docstring)
 MIN_LAG_SAMPLES = 10  # the shortest lag spans at least this many samples
@@ -254,6 +254,41 @@ def creep_levels(effects, p: dict) -> int:
     if "drift" in effects and has_levels(p):
         return 0
     return int(p.get("creep_levels", 0))
+
+
+def record_level(params: dict, h0_first: float, residual: np.ndarray,
+                 used=None) -> np.ndarray:
+    """The level of a record under a creep counted from each record's start (module
+    docstring): the residual's level out of fold (:func:`.drift.out_of_fold_level`),
+    bounded by ``RECORD_LEVEL_SHARE`` of ``|h0_first - params["creep_record_reference"]|``.
+
+    Parameters
+    ----------
+    params : dict
+        The model's parameters, with ``creep_record_reference`` (the first train record's
+        first reference output, output unit).
+    h0_first : float
+        The record's first reference output ``h0[0]`` (output unit).
+    residual : numpy.ndarray
+        Measured output minus the model without the level (output unit).
+    used : numpy.ndarray or None
+        Boolean mask of the scored samples (None: every sample, as a model's ``simulate``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The level at each sample (output unit).
+
+    Examples
+    --------
+    >>> p = {"creep_record_reference": 1.0}
+    >>> record_level(p, 3.0, np.full(4, 0.5)).tolist()  # bounded by 0.1 * |3 - 1|
+    [0.2, 0.2, 0.2, 0.2]
+    >>> record_level(p, 1.0, np.full(4, 0.5)).tolist()  # a record that starts where train did
+    [0.0, 0.0, 0.0, 0.0]
+    """
+    bound = RECORD_LEVEL_SHARE * abs(float(h0_first) - float(params["creep_record_reference"]))
+    return np.clip(out_of_fold_level(np.asarray(residual, float), used), -bound, bound)
 
 
 def start_hint(grid: dict) -> str:

@@ -22,7 +22,7 @@ from .._native import pi_run_rows
 from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
-from .creep import RECORD_LEVEL_SHARE, creep_levels, creep_time_constants, start_columns
+from .creep import creep_levels, creep_time_constants, record_level, start_columns
 from .drift import (
     DRIFT_VARIANTS,
     SETTLE_POINTS,
@@ -1157,14 +1157,14 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
         model.adjust = with_level
     elif creep_levels(effects, p):  # the creep's level, bounded by its first output's change
         first = {id(full[0]): float(nominal.predict(full[0])[0])}
+        model.params["creep_record_reference"] = first[id(full[0])]  # the bound's origin
 
         def with_creep_level(seg, out):
             if seg in in_train:
                 return out
             if id(seg) not in first:
                 first[id(seg)] = float(nominal.predict(seg)[0])
-            bound = RECORD_LEVEL_SHARE * abs(first[id(seg)] - first[id(full[0])])
-            return out + np.clip(out_of_fold_level(seg.y - out, seg.mask), -bound, bound)
+            return out + record_level(model.params, first[id(seg)], seg.y - out, seg.mask)
         model.adjust = with_creep_level
     return model
 

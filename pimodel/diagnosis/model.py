@@ -100,7 +100,7 @@ from .._native import LIMITS
 from ..operators.base import check_finite
 from ..operators.pi import PIOperator
 from .checks import checked_signal
-from .creep import creep_start_levels
+from .creep import creep_start_levels, record_level
 from .drift import drift_term
 from .filters import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
@@ -279,7 +279,9 @@ class DiagnosedModel:
             (:func:`.drift.drift_term`; without it, the level the drift's clock predicts);
             with :attr:`initial_state` ``"unknown"``, the creep's lags start at its first
             sample ``measured[0]`` (the creep of the stage's unknown memory; without it, at
-            ``h0[0]``). Ignored by other models.
+            ``h0[0]``); a creep counted from each record's start (``creep_start``
+            ``"record"``) takes the record's level from it out of fold, bounded
+            (:func:`.creep.record_level`; without it, none). Ignored by other models.
 
         Returns
         -------
@@ -324,9 +326,13 @@ class DiagnosedModel:
             y0 = float(y_meas[0]) if y_meas is not None and self.initial_state == "unknown" \
                 else None
             starts = creep_start_levels(p)  # a common rest: where each lag starts
+            # counted from the record's start (module creep): less each lag's start
+            record = p.get("creep_start") == "record"
             for i, (g, tau) in enumerate(zip(p["creep_lag_gains"], p["creep_time_constants_s"],
                                              strict=True)):
-                y = y + g * (lag(h0, tau, self.dt, y0 if starts is None else starts[i]) - h0)
+                start = y0 if starts is None else float(starts[i])
+                less = (float(h0[0]) if start is None else start) if record else 0.0
+                y = y + g * (lag(h0, tau, self.dt, start) - h0 - less)
         if "asymmetry" in e:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
@@ -345,6 +351,8 @@ class DiagnosedModel:
             y = y + R @ gains
         if "drift" in e:
             y = y + drift_term(p, tk, y, y_meas)
+        if "creep_record_reference" in p and y_meas is not None:
+            y = y + record_level(p, h0[0], y_meas - y)
         return check_finite(y, v, "v")
 
     def _plays(self, x: np.ndarray) -> np.ndarray:
