@@ -753,7 +753,8 @@ class DiagnosedInverse:
         total = float(np.sum(m.weights))
         u0 = (float(y_0) - m.offset) / total if total != 0 else 0.0
         if f(u0) == 0.0 or ("asymmetry" not in m.effects and (
-                "creep" not in m.effects or creep_start_levels(m.params) is None)):
+                "creep" not in m.effects or (creep_start_levels(m.params) is None
+                                             and m.params.get("creep_start") != "record"))):
             return u0
         step = 1e-3 * (1.0 + abs(u0) + float(m.radii[-1]))
         while step < 1e6:
@@ -888,7 +889,8 @@ class DiagnosedInverse:
 def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
     """The static part's output on a first sample whose play outputs are ``z`` (hysteresis,
     offset and the asymmetry of ``h0``; rate is 0 there, and creep too unless its lags start
-    at a common rest ``s_j``: then ``sum_j g_j a_j (s_j - h0)``)."""
+    at a common rest ``s_j``: then ``sum_j g_j a_j (s_j - h0)``; or is counted from the
+    record's start, ``creep_start`` ``"record"``: then ``-sum_j g_j h0``)."""
     p = m.params
     y = float(z @ m.weights) + m.offset
     h0 = float(z @ m.reference_weights) + m.reference_offset
@@ -900,6 +902,8 @@ def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
         ga = np.asarray(p["creep_lag_gains"], float) * np.exp(
             -m.dt / np.asarray(p["creep_time_constants_s"], float))
         y += float(ga @ (starts - h0))
+    if "creep" in m.effects and p.get("creep_start") == "record":  # less sum_j g_j h0[0]
+        y -= float(np.sum(p["creep_lag_gains"])) * h0
     return y
 
 
