@@ -5,7 +5,9 @@ reference), on the first sample too (``h0[0]`` itself there), the start kept in 
 
 from __future__ import annotations
 
+import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,17 +16,11 @@ from pimodel.diagnosis.model import DiagnosedModel
 from pimodel.diagnosis.native_inverse import NativeInverse
 from pimodel.diagnosis.reference_inverse import StaticInverse
 
+sys.path.insert(0, str(Path(__file__).parent))
+from test_inverse_native import PARAMS, RADII, WEIGHTS  # noqa: E402
+
 DT = 1e-3
-RADII = [0.0, 0.1, 0.3, 0.6, 0.9, 1.2]
-WEIGHTS = [0.9, 0.35, 0.3, 0.2, 0.15, 0.1]
-PARAMS = {
-    "creep": {"creep_lag_gains": [0.05, 0.03], "creep_time_constants_s": [0.004, 0.05]},
-    "asymmetry": {"asymmetry_quadratic": 0.05, "asymmetry_cubic": 0.015, "center": 0.3,
-                  "half_range": 1.8},
-    "rate": {"rate_gains": [0.15, 0.05], "rate_family": "radius", "rate_time_constant_s": 0.0},
-    "dynamics": {"mode_hz": 35.0, "mode_damping": 0.35},
-    "delay": {"delay_samples": 2},
-}
+
 CASES = {"creep": ("creep",), "creep_asymmetry": ("creep", "asymmetry"),
          "dynamics_delay_creep": ("dynamics", "delay", "creep")}
 

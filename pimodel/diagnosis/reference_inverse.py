@@ -287,7 +287,8 @@ class StaticInverse:
         list of str
             ``started``, ``v_prev``, ``guess`` (the root rule's branch guess), ``z[1..n]``,
             ``L[1..m]`` (creep lags), ``L0`` (the lags' start ``h0[0]`` of a creep counted
-            from each record's start, ``creep_start`` ``"record"``) and, with a rate effect, ``rho_f``, ``m[1..n]``,
+            from each record's start, ``creep_start`` ``"record"``) and, with a rate
+            effect, ``rho_f``, ``m[1..n]``,
             ``v0_prev`` and ``source.*`` (the rate-free inverse that gives the fresh rate);
             the scaled family ``rate`` (its strictly causal rate [input unit / s]) and
             ``zs[1..n]`` (its plays).
