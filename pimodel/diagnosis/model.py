@@ -23,7 +23,9 @@ delay alone. ``E_j`` are the further modes, low-pass and direct term of the line
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
 ``a = exp(-dt / tau)``; with ``creep_start == "common"`` (a stage parked between records,
 :mod:`.creep`) each lag rests instead at its level ``s_i`` of ``creep_start_levels``,
-``L_i[-1] = s_i``, shared by every record. This class evaluates exactly that form, so
+``L_i[-1] = s_i``, shared by every record; with ``creep_start == "record"`` the lags start as
+at rest and the creep is counted from the record's start, ``g_i (L_i[k] - h0[k] - L_i[-1])``
+(the record's first output un-crept). This class evaluates exactly that form, so
 :meth:`simulate` equals the diagnosis' own prediction. The same form, streamed sample by sample on
 the C core (:mod:`.native_model`), is the python-control block (:meth:`DiagnosedModel.block`) and
 the DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
@@ -148,7 +150,8 @@ class DiagnosedModel:
     params : dict
         Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s`` (and
         ``creep_start = "common"`` with ``creep_start_levels``, the lags' rest levels [output
-        unit], when they start at a common rest, :mod:`.creep`);
+        unit], when they start at a common rest; or ``creep_start = "record"``, the creep
+        counted from each record's start, less ``sum_i g_i L_i[-1]``, :mod:`.creep`);
         ``asymmetry_quadratic``, ``asymmetry_cubic``, ``center``, ``half_range``;
         ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
         (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,

@@ -11,7 +11,8 @@ Discrete-time semantics (those of ``simulate``, written per sample): with the pl
 ``y[k]`` depends on ``v[0..k]`` and ``t[k]`` only; the LTI part (the dynamics) and the delay act
 on the hysteresis term ``sum_i w_i z_i[k]`` and start at rest around its first value; the creep
 lags start at rest around ``h0[0]`` (or at the model's ``creep_start_levels`` when its
-``creep_start`` is ``"common"``: :mod:`.creep`); the rate effect (:mod:`.rate`) low-passes the
+``creep_start`` is ``"common"``; with ``"record"`` the term less ``sum_j g_j h0[0]``, the start
+kept in the state ``L0``: :mod:`.creep`); the rate effect (:mod:`.rate`) low-passes the
 normalised input rate from rest at 0 (without a filter, a one-sample jump above ``STEP_SHARE *
 input_range`` counts as a step, no rate); the radius family holds each play's term from its last
 contact, the weight family scales the band's ``sum_i w0_i z_i[k]`` by the current rate.
