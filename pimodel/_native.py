@@ -469,7 +469,7 @@ class DiagParams(ctypes.Structure):
                 ("drift", c_double), ("ne", c_size), ("el_b", _DP), ("el_a", _DP),
                 ("el_g", _DP), ("nw", c_size), ("wf_b", _DP), ("wf_a", _DP),
                 ("plays_start", c_int), ("settle", c_double), ("settle_tau", c_double),
-                ("settle_t0", c_double), ("lag_start", _DP)]
+                ("settle_t0", c_double), ("lag_start", _DP), ("lag_record", c_int)]
 
 
 _check_layout(DiagParams, "pim_diag")

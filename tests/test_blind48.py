@@ -108,3 +108,16 @@ def test_clean_band_noise_stage_is_none_with_non_negative_play_weights(seed):
     model = rep.nominal["model"]
     w = np.asarray(model["weights"])[np.asarray(model["radii"]) > 0]
     assert np.all(w >= 0.0)
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_creep_restarted_with_each_record_is_creep_alone(seed):
+    """The generator's creep restarts with each record (lags of ``h - h[0]`` from 0): under an
+    offset sine at 1 kHz the verdict is ``creep`` alone (counted from each record's start
+    where that passes, module creep) and the gap shrinks by more than half; before that start,
+    `drift` beside it (8 of 8 seeds drawn, offset sines and multisines)."""
+    rep, info = _diagnose(S.Case("creep", ("creep",), "offset_sine", 1000.0, seed), 0.5)
+    v = rep.verdict
+    assert info["effect_rms_sigma"] > 5.0
+    assert v["effects"] == ["creep"], v["effects"]
+    assert v["shrink"] > 0.5

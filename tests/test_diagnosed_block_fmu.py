@@ -61,6 +61,8 @@ CASES = {
     "rate_saturated": ("rate",),
     "rate_scaled": ("rate",),
     "creep_common": ("creep",),
+    "creep_record": ("creep",),
+    "creep_record_all": tuple(EFFECT_PARAMS),
     "all": tuple(EFFECT_PARAMS),
 }
 
@@ -88,6 +90,8 @@ def model(case: str) -> DiagnosedModel:
         params["rate_family"], params["rate_time_constant_s"] = RATE_VARIANTS[case]
     if case == "creep_common":  # the lags at a common rest, away from h0[0] (module creep)
         params.update({"creep_start": "common", "creep_start_levels": [0.8, -0.5, 1.3]})
+    if case.startswith("creep_record"):  # counted from each record's start (module creep)
+        params["creep_start"] = "record"
     return DiagnosedModel(RADII, [1.2, -0.4, 0.8, -0.3, 0.25], 0.3, dt=DT, effects=effects,
                           reference_weights=[1.0, -0.2, 0.7, -0.2, 0.2], reference_offset=0.1,
                           params=params)
@@ -116,6 +120,31 @@ def test_stream_equals_simulate(case):
     assert np.ptp(want) > 1.0  # the output moved
     if case != "nominal":  # the effect changed the output
         assert np.max(np.abs(want - model("nominal").simulate(v, t))) > 1e-3
+
+
+@pytest.mark.parametrize("case", ["creep_record", "creep_record_all"])
+def test_stream_counts_the_creep_from_the_record_start(case):
+    """creep_start "record": the rest start's stream less sum_j g_j h0[0], a constant per
+    record (the first output holds no creep); the start h0[0] is kept in the state ``L0``
+    (filled on the first sample), so a second record from a fresh state takes its own."""
+    m = model(case)
+    rest = replace(m, params={k: x for k, x in m.params.items() if k != "creep_start"})
+    t, v = signal()
+    h0_first = float(np.dot(m.reference_weights, np.clip(0.0, v[0] - m.radii, v[0] + m.radii))
+                     + m.reference_offset)  # plays at rest at 0 before v[0]
+    gains = np.asarray(m.params["creep_lag_gains"])
+    got = stream_simulate(m, v, t, input_range=RANGE)
+    diff = got - stream_simulate(rest, v, t, input_range=RANGE)
+    assert abs(gains.sum() * h0_first) > 1e-2  # the constant is visible
+    assert np.max(np.abs(diff + gains.sum() * h0_first)) < 1e-12
+    assert state_labels(m)[-1] == "L0" and "L0" not in state_labels(rest)
+    nm = NativeModel(m, RANGE)
+    x = nm.initial_state()
+    nm.step(x, v[0], t[0])
+    assert abs(x[-1] - h0_first) < 1e-12
+    t2, v2 = t[:500], v[1000:1500]  # a second record, its own start
+    assert np.max(np.abs(stream_simulate(m, v2, t2, input_range=RANGE)
+                         - m.simulate(v2, t2, input_range=RANGE))) < 1e-12
 
 
 @pytest.mark.parametrize("case", ["rate", "rate_weight"])
@@ -156,7 +185,7 @@ def test_general_lti_coefficients():
 
 
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
-                                  "delay_whole", "creep_common"])
+                                  "delay_whole", "creep_common", "creep_record"])
 def test_block_equals_simulate(case):
     m = model(case)
     t, v = signal(1200)
@@ -232,7 +261,8 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 @pytest.mark.parametrize("case", ["nominal", "all", "drift_absolute", "drift_settle",
                                   "delay_whole", "rate", "rate_saturated", "rate_scaled",
-                                  "creep_common", *RATE_VARIANTS])
+                                  "creep_common", "creep_record", "creep_record_all",
+                                  *RATE_VARIANTS])
 def test_unit_equals_simulate(fmus, fmi, case):
     """The generic unit with the model's values (FMU time k Ts from 0: the drift clocks read
     t = k Ts)."""
@@ -297,8 +327,10 @@ def test_model_diagnosed_on_a_rate_truth_streams_as_simulate(fmus):
      ({"n": 129}, "parameter n = 129 out of range: 1 <= n <= 128"),
      ({"n_lags": 1, "creep_tau[1]": 0.0}, "time constant creep_tau[1] = 0 is not positive"),
      ({"n_lags": 65}, "parameter n_lags = 65 out of range"),
-     ({"creep_start": 2}, "parameter creep_start = 2 out of range: 0 at rest at h0[0], 1 at "
-                         "rest at creep_start_level"),
+     ({"creep_start": 3}, "parameter creep_start = 3 out of range: 0 at rest at h0[0], 1 at "
+                         "rest at creep_start_level, 2 at rest at h0[0] counted from the "
+                         "record's start"),
+     ({"creep_start": -1}, "parameter creep_start = -1 out of range"),
      ({"n_lags": 2, "creep_tau[1]": 0.1, "creep_tau[2]": 1.0, "creep_start": 1,
        "creep_start_level[2]": float("nan")},
       "creep start level creep_start_level[2] = nan is not finite"),

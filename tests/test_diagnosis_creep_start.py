@@ -64,7 +64,7 @@ def records(seed: int, parked: bool = True) -> tuple[list[Record], list[Record]]
 def _rest_only(monkeypatch) -> None:
     """The diagnosis as before the variant: the creep's lags at rest at each record's first
     output only."""
-    monkeypatch.setattr(D, "creep_starts", lambda effects, held=None: [{}])
+    monkeypatch.setattr(D, "creep_starts", lambda effects, held=None, n_validate=1: [{}])
 
 
 def test_start_columns_and_levels_give_the_lag_from_its_rest():
@@ -77,7 +77,8 @@ def test_start_columns_and_levels_give_the_lag_from_its_rest():
         s = 0.7 - i
         assert np.max(np.abs(lag(h, tau, DT, 0.0) + s * a[i] - lag(h, tau, DT, s))) < 1e-12
     assert creep_starts(("delay",)) == [{}]
-    assert [x["creep_start"] for x in creep_starts(("creep", "drift"))] == ["rest", "common"]
+    assert [x["creep_start"] for x in creep_starts(("creep", "drift"))] == ["rest", "common",
+                                                                         "record"]
     p = {"creep_lag_gains": [0.1, 0.2], "creep_time_constants_s": [0.03, 0.3]}
     assert creep_start_levels(p) is None
     assert creep_start_levels({**p, "creep_start": "common",
@@ -164,8 +165,9 @@ def test_the_start_is_chosen_once_per_path(parked, monkeypatch):
     assert sorted(v["effects"]) == ["asymmetry", "creep"], v["effects"]
     chosen = v["model"].get("creep_start", "rest")
     assert chosen == ("common" if parked else "rest")
-    alone = [fx["creep_start"] for e, fx in calls if e == ("creep",) and set(fx) == {"creep_start"}]
-    assert sorted(alone) == ["common", "rest"]  # both scored for the candidate
+    alone = [fx["creep_start"] for e, fx in calls
+             if e == ("creep",) and set(fx) <= {"creep_start", "creep_levels"}]
+    assert sorted(alone) == ["common", "record", "rest"]  # each scored for the candidate
     starts = [fx["creep_start"] for e, fx in calls if "creep" in e]
     at_chosen = starts.count(chosen)
     assert at_chosen >= 10

@@ -96,6 +96,10 @@ CASES = [
     ("creep", (), {"creep_start": "common"}),  # the lags at a common rest (module creep)
     ("asymmetry", ("creep",), {"creep_start": "common"}),
     ("delay", ("creep",), {"creep_start": "common", "d": 1.5}),
+    ("creep", (), {"creep_start": "record", "creep_levels": 2}),  # from each record's start
+    ("delay", ("creep",), {"creep_start": "record", "creep_levels": 2, "d": 1.5}),
+    ("drift", ("creep",), {"creep_start": "record", "creep_levels": 2, "clock": "levels",
+                           "levels": 2}),
 ]
 
 

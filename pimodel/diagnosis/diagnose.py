@@ -68,7 +68,7 @@ from threadpoolctl import threadpool_limits
 from ..records import Record
 from .chunked import ChunkedQR, NormalEquations
 from .coverage import coverage, informed_radii, span_and_reach
-from .creep import creep_law, creep_starts, start_hint
+from .creep import creep_law, creep_levels, creep_starts, start_hint
 from .delaylike import is_delay_like
 from .drift import DRIFT_KEYS, drift_variants, level_report, settle_bow
 from .effects import (
@@ -909,10 +909,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
             # the position of the dynamics (before or after the hysteresis) as chosen alone
             fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
-        # a creep's start: both scored where the creep enters (alone, a pair, the creep
+        # a creep's start: each scored where the creep enters (alone, a pair, the creep
         # added or swapped in); held where ``fixed_`` carries the chosen creep's (_hold)
         shapes = [{**r, **c} for r in rate_shapes((*combo, name), fixed_ or {})
-                  for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"))]
+                  for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"),
+                                        len(va))]
         out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):
@@ -931,15 +932,24 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         return cache[key]
 
     def fit(name, combo=(), fixed_=None):
-        """Best variant of ``name`` on top of ``combo``: (model, validate outputs)."""
-        best = None
+        """Best variant of ``name`` on top of ``combo``: (model, validate outputs). A creep
+        with a level per record (its start ``"record"``, module creep) is kept only when it
+        passes against the best other variant as an effect would (:func:`_passes`): a level
+        measured on each validate record takes up any constant misfit, so by BIC alone it
+        would replace a creep at rest that fits (3 of 4 such stages measured)."""
+        best = levels = None
         for key, fx in variants(name, combo, fixed_):
             m, o = single(key, fx)
             score = _bic(va, o, m.k)
             if _flat_settling(m, tr, va, noise):  # a settling no bow tells from a trend
                 continue
-            if best is None or score < best[0]:
+            if creep_levels((*combo, name), fx):
+                if levels is None or score < levels[0]:
+                    levels = (score, m, o)
+            elif best is None or score < best[0]:
                 best = (score, m, o)
+        if levels is not None and (best is None or _passes(va, levels[1:], best[1:])):
+            best = levels
         return best[1], best[2]
 
     def fit_one(name, combo, fx):
@@ -1226,7 +1236,7 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
         # and a rate's all of their kind: a single fit of another family or variant lacks some,
         # e.g. rate_growth, which a held SCALED rate needs)
         return set(fit(e)[0].grid) | set({"drift": DRIFT_KEYS, "rate": RATE_KEYS,
-                                          "creep": ("creep_start",)}.get(e, ()))
+                                          "creep": ("creep_start", "creep_levels")}.get(e, ()))
 
     def call(effects):  # fit's arguments for the combination ``effects`` (not empty)
         kept = {k: x for k, x in fixed.items() if any(k in keys_of(e) for e in effects)}
@@ -1281,7 +1291,7 @@ def _hold(fixed: dict, effects: tuple, grid: dict) -> dict:
     chosen for ``effects``, and the start of its creep (:func:`.creep.start_hint`: the rest
     start is no grid key) held as ``fixed["creep_start"]`` (none without a creep): every fit
     built on that model keeps it (:func:`.creep.creep_starts`), while a creep entering a
-    combination, or beside a lag searched again (:func:`_lag_calls`), has both starts scored
+    combination, or beside a lag searched again (:func:`_lag_calls`), has every start scored
     (creep61: not anew for every combination)."""
     fixed.pop("creep_start", None)
     fixed.update(grid)

@@ -59,6 +59,7 @@ __all__ = [
     "drift_variants",
     "has_levels",
     "level_report",
+    "level_rows",
     "out_of_fold_level",
     "record_levels",
     "settle_bow",
@@ -294,10 +295,36 @@ def drift_columns(t: np.ndarray, p: dict, train_record: int | None = None,
         trend = (t if p["clock"] == "absolute" else t - (t[0] if t0 is None else t0))[:, None]
     if not has_levels(p) or n_train < 2:
         return trend
-    ind = np.zeros((t.size, n_train - 1))
+    return np.hstack((level_rows(train_record, n_train, t.size).T, trend))
+
+
+def level_rows(train_record: int | None, n_train: int, size: int) -> np.ndarray:
+    """The rows of a level per train record after the first (the first record's level is
+    the model's offset): one indicator row per such record, 1 on the samples of its own.
+
+    Parameters
+    ----------
+    train_record : int or None
+        Index of the record among the train records (None: not a train record, all 0).
+    n_train : int
+        Number of train records.
+    size : int
+        Samples of the record.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(max(n_train - 1, 0), size)``.
+
+    Examples
+    --------
+    >>> level_rows(2, 3, 2).tolist(), level_rows(None, 2, 2).tolist(), level_rows(0, 1, 2).shape
+    ([[0.0, 0.0], [1.0, 1.0]], [[0.0, 0.0]], (0, 2))
+    """
+    ind = np.zeros((max(n_train - 1, 0), size))
     if train_record is not None and train_record >= 1:
-        ind[:, train_record - 1] = 1.0
-    return np.hstack((ind, trend))
+        ind[train_record - 1] = 1.0
+    return ind
 
 
 def out_of_fold_level(r: np.ndarray, used=None, folds: int = LEVEL_FOLDS) -> np.ndarray:

@@ -22,13 +22,14 @@ from .._native import pi_run_rows
 from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
-from .creep import creep_time_constants, start_columns
+from .creep import creep_levels, creep_time_constants, record_level, start_columns
 from .drift import (
     DRIFT_VARIANTS,
     SETTLE_POINTS,
     drift_columns,
     drift_k,
     has_levels,
+    level_rows,
     out_of_fold_level,
     settle_grid,
     settle_start,
@@ -916,8 +917,11 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     k = _combo_k(effects, nominal) + (drift_k(fixed) - 1 if "drift" in effects else 0)
     # the creep's lags at rest at a level shared by the records (module creep): one further
     # coefficient per lag, g_i s_i
-    common = "creep" in effects and fixed.get("creep_start") == "common"
-    k += len(nominal.params["creep_taus"]) if common else 0
+    start = fixed.get("creep_start") if "creep" in effects else None
+    k += len(nominal.params["creep_taus"]) if start == "common" else 0
+    # a creep counted from each record's start: a level per validate record (module creep),
+    # unless a drift's levels are there already
+    k += creep_levels(effects, fixed)
     if scaled or fixed.get("rate_family") == SCALED:  # tau, S and G, no gains (module rate)
         k -= RATE_BANDS - 1
     # held: one point, no search; its play rows' Gram formed as a streamed refit forms it
@@ -962,7 +966,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                          [{"fn": f, "zeta": z} for f in fgrid for z in MODE_DAMPING] +
                          [{"fn": f, "zeta": MODE_HEAVY[1]} for f in MODE_HEAVY[0] if f <= fmax])
         elif e == "creep":  # the start: a variant chosen on validate (module creep)
-            grids.append([{"creep_start": "common"}] if common else [{}])
+            grids.append([{"creep_start": start}] if start == "common" else
+                         [{"creep_start": start, "creep_levels": fixed["creep_levels"]}]
+                         if start == "record" else [{}])
         elif e == "delay":
             grids.append([{"d": fixed["d"]}] if "d" in fixed else
                          [{"d": int(d)} for d in dgrid])
@@ -1136,18 +1142,30 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                 effects, p, ref, {"train": static["train"], "held": held}), train, p)[0]
             model.reference = ref
     model.grid = dict(model.params)
-    model.params = _describe(effects, model, nominal)
+    model.params = _describe(effects, model, nominal, len(static["train"]))
     if lti_trace:
         model.params["dynamics_structures_tried"] = lti_trace
     if positions:
         model.params["dynamics_positions_tried"] = positions
     if "drift" in effects and has_levels(p):  # a level per record
         model.params["drift_t0_train"] = float(train[0].t[0])
-        in_train = static["train"]
+    in_train = static["train"]
+    if "drift" in effects and has_levels(p):
 
         def with_level(seg, out):  # a record's own level, out of fold (not for train records)
             return out if seg in in_train else out + out_of_fold_level(seg.y - out, seg.mask)
         model.adjust = with_level
+    elif creep_levels(effects, p):  # the creep's level, bounded by its first output's change
+        first = {id(full[0]): float(nominal.predict(full[0])[0])}
+        model.params["creep_record_reference"] = first[id(full[0])]  # the bound's origin
+
+        def with_creep_level(seg, out):
+            if seg in in_train:
+                return out
+            if id(seg) not in first:
+                first[id(seg)] = float(nominal.predict(seg)[0])
+            return out + record_level(model.params, first[id(seg)], seg.y - out, seg.mask)
+        model.adjust = with_creep_level
     return model
 
 
@@ -1264,10 +1282,12 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     of rows (``feats.parts(s)``: the play rows, then the others; :func:`_row_parts`);
     ``feats(s)`` is the transpose of their stack."""
 
-    common = "creep" in effects and p.get("creep_start") == "common"
+    start = p.get("creep_start") if "creep" in effects else None
+    common = start == "common"
 
     def static_rows(s: Segment) -> np.ndarray:
-        key = ("common", id(s)) if common else id(s)
+        key = (start, creep_levels(effects, p), id(s)) if start in ("common", "record") \
+            else id(s)
         if key not in static:
             out = [np.ones(s.t.size)]
             h0 = nominal.predict(s)
@@ -1279,7 +1299,12 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
                 # the stage's memory at the start unknown (a start-up mask): the creep's
                 # too; its lags start at the measured first output, not at h0[0]
                 y0 = None if s.mask is None else float(s.y[0])
-                out += [lag(h0, tau, s.dt, y0) - h0 for tau in taus]
+                # "record": counted from the record's start, less the lags' start
+                less = (float(h0[0]) if y0 is None else y0) if start == "record" else 0.0
+                out += [lag(h0, tau, s.dt, y0) - h0 - less for tau in taus]
+                if creep_levels(effects, p):  # a level per train record after the first
+                    out += list(level_rows(static["train"].index(s), len(static["train"]),
+                                           s.t.size))
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 out += [u**2, u**3]
@@ -1381,7 +1406,7 @@ def _start_levels(gains: np.ndarray, terms: np.ndarray) -> list:
     return [float(b / g) if g != 0 else 0.0 for g, b in zip(gains, terms, strict=True)]
 
 
-def _describe(effects, model: Model, nominal: Model) -> dict:
+def _describe(effects, model: Model, nominal: Model, n_train: int = 1) -> dict:
     out: dict = {}
     n = nominal.coef.size - 1
     extra = model.coef[n + 1:]
@@ -1393,6 +1418,10 @@ def _describe(effects, model: Model, nominal: Model) -> dict:
             out["creep_lag_gains"] = gains.tolist()
             out["creep_time_constants_s"] = list(taus)
             i += len(taus)
+            if model.params.get("creep_start") == "record":  # counted from each start
+                out["creep_start"] = "record"
+                # its levels of the train records after the first (their own columns)
+                i += max(n_train - 1, 0) if creep_levels(effects, model.params) else 0
             if model.params.get("creep_start") == "common":  # g_i s_i, then the levels s_i
                 out["creep_start"] = "common"
                 out["creep_start_levels"] = _start_levels(gains, extra[i:i + len(taus)])

@@ -23,7 +23,9 @@ delay alone. ``E_j`` are the further modes, low-pass and direct term of the line
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
 ``a = exp(-dt / tau)``; with ``creep_start == "common"`` (a stage parked between records,
 :mod:`.creep`) each lag rests instead at its level ``s_i`` of ``creep_start_levels``,
-``L_i[-1] = s_i``, shared by every record. This class evaluates exactly that form, so
+``L_i[-1] = s_i``, shared by every record; with ``creep_start == "record"`` the lags start as
+at rest and the creep is counted from the record's start, ``g_i (L_i[k] - h0[k] - L_i[-1])``
+(the record's first output un-crept). This class evaluates exactly that form, so
 :meth:`simulate` equals the diagnosis' own prediction. The same form, streamed sample by sample on
 the C core (:mod:`.native_model`), is the python-control block (:meth:`DiagnosedModel.block`) and
 the DiagnosedModel FMU unit (``pimodel fmu build --model MODEL.json``); a test holds them equal to
@@ -100,7 +102,7 @@ from .._native import LIMITS
 from ..operators.base import check_finite
 from ..operators.pi import PIOperator
 from .checks import checked_signal
-from .creep import creep_start_levels
+from .creep import creep_start_levels, record_level
 from .drift import drift_term
 from .filters import lag, mode, shift
 from .lti import approximate_inverse, lti_columns
@@ -148,7 +150,8 @@ class DiagnosedModel:
     params : dict
         Effect parameters: ``creep_lag_gains``, ``creep_time_constants_s`` (and
         ``creep_start = "common"`` with ``creep_start_levels``, the lags' rest levels [output
-        unit], when they start at a common rest, :mod:`.creep`);
+        unit], when they start at a common rest; or ``creep_start = "record"``, the creep
+        counted from each record's start, less ``sum_i g_i L_i[-1]``, :mod:`.creep`);
         ``asymmetry_quadratic``, ``asymmetry_cubic``, ``center``, ``half_range``;
         ``rate_gains``, ``rate_family``, ``rate_time_constant_s``, ``rate_scale``
         (:mod:`.rate`); ``drift_per_s``, ``drift_clock`` (and ``drift_variant``,
@@ -279,7 +282,9 @@ class DiagnosedModel:
             (:func:`.drift.drift_term`; without it, the level the drift's clock predicts);
             with :attr:`initial_state` ``"unknown"``, the creep's lags start at its first
             sample ``measured[0]`` (the creep of the stage's unknown memory; without it, at
-            ``h0[0]``). Ignored by other models.
+            ``h0[0]``); a creep counted from each record's start (``creep_start``
+            ``"record"``) takes the record's level from it out of fold, bounded
+            (:func:`.creep.record_level`; without it, none). Ignored by other models.
 
         Returns
         -------
@@ -324,9 +329,13 @@ class DiagnosedModel:
             y0 = float(y_meas[0]) if y_meas is not None and self.initial_state == "unknown" \
                 else None
             starts = creep_start_levels(p)  # a common rest: where each lag starts
+            # counted from the record's start (module creep): less each lag's start
+            record = p.get("creep_start") == "record"
             for i, (g, tau) in enumerate(zip(p["creep_lag_gains"], p["creep_time_constants_s"],
                                              strict=True)):
-                y = y + g * (lag(h0, tau, self.dt, y0 if starts is None else starts[i]) - h0)
+                start = y0 if starts is None else float(starts[i])
+                less = (float(h0[0]) if start is None else start) if record else 0.0
+                y = y + g * (lag(h0, tau, self.dt, start) - h0 - less)
         if "asymmetry" in e:
             u = (h0 - p["center"]) / p["half_range"]
             y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
@@ -345,6 +354,8 @@ class DiagnosedModel:
             y = y + R @ gains
         if "drift" in e:
             y = y + drift_term(p, tk, y, y_meas)
+        if "creep_record_reference" in p and y_meas is not None:
+            y = y + record_level(p, h0[0], y_meas - y)
         return check_finite(y, v, "v")
 
     def _plays(self, x: np.ndarray) -> np.ndarray:
@@ -745,7 +756,8 @@ class DiagnosedInverse:
         total = float(np.sum(m.weights))
         u0 = (float(y_0) - m.offset) / total if total != 0 else 0.0
         if f(u0) == 0.0 or ("asymmetry" not in m.effects and (
-                "creep" not in m.effects or creep_start_levels(m.params) is None)):
+                "creep" not in m.effects or (creep_start_levels(m.params) is None
+                                             and m.params.get("creep_start") != "record"))):
             return u0
         step = 1e-3 * (1.0 + abs(u0) + float(m.radii[-1]))
         while step < 1e6:
@@ -880,7 +892,8 @@ class DiagnosedInverse:
 def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
     """The static part's output on a first sample whose play outputs are ``z`` (hysteresis,
     offset and the asymmetry of ``h0``; rate is 0 there, and creep too unless its lags start
-    at a common rest ``s_j``: then ``sum_j g_j a_j (s_j - h0)``)."""
+    at a common rest ``s_j``: then ``sum_j g_j a_j (s_j - h0)``; or is counted from the
+    record's start, ``creep_start`` ``"record"``: then ``-sum_j g_j h0``)."""
     p = m.params
     y = float(z @ m.weights) + m.offset
     h0 = float(z @ m.reference_weights) + m.reference_offset
@@ -892,6 +905,8 @@ def _first_output(m: DiagnosedModel, z: np.ndarray) -> float:
         ga = np.asarray(p["creep_lag_gains"], float) * np.exp(
             -m.dt / np.asarray(p["creep_time_constants_s"], float))
         y += float(ga @ (starts - h0))
+    if "creep" in m.effects and p.get("creep_start") == "record":  # less sum_j g_j h0[0]
+        y -= float(np.sum(p["creep_lag_gains"])) * h0
     return y
 
 

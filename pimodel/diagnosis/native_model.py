@@ -11,7 +11,8 @@ Discrete-time semantics (those of ``simulate``, written per sample): with the pl
 ``y[k]`` depends on ``v[0..k]`` and ``t[k]`` only; the LTI part (the dynamics) and the delay act
 on the hysteresis term ``sum_i w_i z_i[k]`` and start at rest around its first value; the creep
 lags start at rest around ``h0[0]`` (or at the model's ``creep_start_levels`` when its
-``creep_start`` is ``"common"``: :mod:`.creep`); the rate effect (:mod:`.rate`) low-passes the
+``creep_start`` is ``"common"``; with ``"record"`` the term less ``sum_j g_j h0[0]``, the start
+kept in the state ``L0``: :mod:`.creep`); the rate effect (:mod:`.rate`) low-passes the
 normalised input rate from rest at 0 (without a filter, a one-sample jump above ``STEP_SHARE *
 input_range`` counts as a step, no rate); the radius family holds each play's term from its last
 contact, the weight family scales the band's ``sum_i w0_i z_i[k]`` by the current rate.
@@ -283,6 +284,8 @@ class NativeModel:
             starts = creep_start_levels(p)  # the lags at a common rest (module creep)
             if starts is not None:
                 keep["lag_start"] = starts
+            # counted from each record's start (module creep): less sum_j g_j L_j[-1]
+            d.lag_record = int(p.get("creep_start") == "record")
         if "asymmetry" in e:
             d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
             d.center, d.half = p["center"], p["half_range"]
@@ -463,7 +466,9 @@ def state_labels(model) -> list[str]:
         ``s[1..q]`` (LTI states), ``e[1..2 (ne + 1)]`` (the sections of the linear part's
         further elements and of its base mode on ``h0``), ``x_delay[1..nbuf]`` (delay line),
         and for a Wiener model ``zf[1..n]`` (plays of the filtered input) and ``f[1..2 nw]``
-        (two states per section of the filter before the hysteresis).
+        (two states per section of the filter before the hysteresis), and ``L0`` (the lags'
+        start ``h0[0]``, kept for a creep counted from each record's start, ``creep_start``
+        ``"record"``).
 
     Examples
     --------
@@ -482,7 +487,8 @@ def state_labels(model) -> list[str]:
             + rate + signal_labels("L", d.m)
             + signal_labels("s", d.order) + signal_labels("e", 2 * (d.ne + 1) if d.ne else 0)
             + signal_labels("x_delay", nbuf)
-            + (signal_labels("zf", n) + signal_labels("f", 2 * d.nw) if d.nw else []))
+            + (signal_labels("zf", n) + signal_labels("f", 2 * d.nw) if d.nw else [])
+            + (["L0"] if d.lag_record and d.m else []))
 
 
 def _block_setting(value):
@@ -593,6 +599,8 @@ def _static_effect_values(d, k: dict, params: dict) -> dict:
                     **arr("creep_tau", params["creep_time_constants_s"])})
         if "lag_start" in k:  # the lags' common rest (module creep)
             out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
+        if getattr(d, "lag_record", 0):  # counted from each record's start (DiagnosedModel)
+            out["creep_start"] = 2
     if d.asym:
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,
                     "half_range": d.half})

@@ -230,6 +230,7 @@ class StaticInverse:
         self.span = max(2 * float(r[-1]), rr / max(abs(self.w.sum()), 1e-12), 1.0)
         self.creep = "creep" in e
         self.m = 0
+        self.record = 0
         self.starts = None  # the lags' common rest levels (module creep), or at rest at h0[0]
         if self.creep:
             taus = np.asarray(p["creep_time_constants_s"], float)
@@ -237,6 +238,10 @@ class StaticInverse:
             self.ga = np.asarray(p["creep_lag_gains"], float) * self.a_lag
             self.m = taus.size
             self.starts = creep_start_levels(p)
+            # counted from each record's start (module creep): less sum_j g_j L_j[-1], the
+            # lags' start h0[0] kept in the state (L0)
+            self.record = int(p.get("creep_start") == "record")
+            self.g_sum = float(np.sum(p["creep_lag_gains"]))
         self.asym = "asymmetry" in e
         self.rate = "rate" in e
         self.scaled = False
@@ -262,11 +267,12 @@ class StaticInverse:
             self.source = StaticInverse(replace(m, effects=tuple(x for x in e if x != "rate")),
                                         input_range, reference_range)
             self.source_step = self.step_size if tau == 0 else math.inf
-        # state: started, v_prev, guess, z[n], L[m], (rate) rho_f, memory[n], v0_prev and the
-        # source's state; the positions once, as slices and indices
+        # state: started, v_prev, guess, z[n], L[m], (record start) L0, (rate) rho_f,
+        # memory[n], v0_prev and the source's state; the positions once, as slices and indices
         self._z = slice(3, 3 + n)
         self._lags = slice(3 + n, 3 + n + self.m)
-        self._rho_f = 3 + n + self.m
+        self._l0 = 3 + n + self.m
+        self._rho_f = 3 + n + self.m + self.record
         self._memory = slice(self._rho_f + 1, self._rho_f + 1 + n)
         self._v0_prev = self._rho_f + 1 + n
         self._source = slice(self._v0_prev + 1, None)
@@ -280,7 +286,9 @@ class StaticInverse:
         -------
         list of str
             ``started``, ``v_prev``, ``guess`` (the root rule's branch guess), ``z[1..n]``,
-            ``L[1..m]`` (creep lags) and, with a rate effect, ``rho_f``, ``m[1..n]``,
+            ``L[1..m]`` (creep lags), ``L0`` (the lags' start ``h0[0]`` of a creep counted
+            from each record's start, ``creep_start`` ``"record"``) and, with a rate
+            effect, ``rho_f``, ``m[1..n]``,
             ``v0_prev`` and ``source.*`` (the rate-free inverse that gives the fresh rate);
             the scaled family ``rate`` (its strictly causal rate [input unit / s]) and
             ``zs[1..n]`` (its plays).
@@ -295,7 +303,7 @@ class StaticInverse:
             else (["rho_f"] + signal_labels("m", self.n) + ["v0_prev"]
                   + [f"source.{s}" for s in self.source.labels()])
         return (["started", "v_prev", "guess"] + signal_labels("z", self.n)
-                + signal_labels("L", self.m) + rate)
+                + signal_labels("L", self.m) + ["L0"] * self.record + rate)
 
     def initial_state(self, z0=None) -> np.ndarray:
         """The state before the first sample: not started, the plays at rest at 0 (as
@@ -387,6 +395,8 @@ class StaticInverse:
             h0 = Zc @ w0 + m.reference_offset
             if creep_now:
                 y = y + (self.ga * lags).sum() - self.ga.sum() * h0
+            if self.record:  # less sum_j g_j L_j[-1]: h0[0] itself on the first sample
+                y = y - self.g_sum * (h0 if first else x[self._l0])
             if self.asym:
                 u = (h0 - p["center"]) / p["half_range"]
                 y = y + p["asymmetry_quadratic"] * u**2 + p["asymmetry_cubic"] * u**3
@@ -432,6 +442,8 @@ class StaticInverse:
         x[0], x[1] = 1.0, vk
         x[self._z] = z_new
         x[self._lags] = lags
+        if self.record and first:
+            x[self._l0] = h
         if self.rate:
             x[self._rho_f] = rho_f
             x[self._memory] = memory

@@ -16,7 +16,8 @@ is carried from one chunk to the next, or a per-sample map:
 - the creep lags ``out[k] = a out[k-1] + (1 - a) h0[k]`` (``scipy.signal.lfilter`` with the
   previous chunk's final state ``zf`` as ``zi``: the same sample recursion); with the lags at
   a common rest (``creep_start`` ``"common"``, :mod:`.creep`) the lags from 0 and the columns
-  ``a^(k+1)`` of the chunk's own sample indices ``k`` (:func:`.creep.start_columns`);
+  ``a^(k+1)`` of the chunk's own sample indices ``k`` (:func:`.creep.start_columns`); counted
+  from the record's start (``"record"``) less the lags' state before the first chunk;
 - the mode after the hysteresis and the linear part's elements (the C core's biquad,
   ``pim_biquad_rows_carry``: ``s0[k-1], s1[k-1]`` carried);
 - a delay of ``d`` samples (whole or fractional): the chunk's rows with the last
@@ -42,8 +43,8 @@ from scipy.signal import lfilter
 
 from .._native import biquad_rows_carry
 from .chunked import combine, stack_rows
-from .creep import start_columns
-from .drift import drift_columns
+from .creep import creep_levels, start_columns
+from .drift import drift_columns, level_rows
 from .filters import mode_coefficients, shift
 from .lti import element_coefficients
 
@@ -99,11 +100,13 @@ class _Lag:
 
     def __init__(self, tau: float, dt: float, start: float | None):
         self.a, self.start, self.zi = np.exp(-dt / tau), start, None
+        self.rest = 0.0  # the state before the first sample, set by the first chunk
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         a = self.a
         if self.zi is None:
-            self.zi = [a * (x[0] if self.start is None else self.start)]
+            self.rest = float(x[0]) if self.start is None else float(self.start)
+            self.zi = [a * self.rest]
         out, self.zi = lfilter([1 - a], [1, -a], x, axis=0, zi=self.zi)
         return out
 
@@ -138,6 +141,8 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
     y0 = None if s.mask is None else float(s.y[0])
     taus = nominal.params["creep_taus"] if "creep" in effects else ()
     common = bool(taus) and p.get("creep_start") == "common"  # lags at a common rest
+    record = bool(taus) and p.get("creep_start") == "record"  # counted from the start
+    levels = creep_levels(effects, p) > 0
     lags = [_Lag(tau, dt, 0.0 if common else y0) for tau in taus]
     mode_f = _Biquad(*mode_coefficients(p["fn"], p["zeta"], dt)) if "dynamics" in effects \
         else None
@@ -159,7 +164,9 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
             Z = delayed(Z)
         h0 = combine((rows,), nominal.coef)
         out = [np.ones(h0.size)]
-        out += [lag(h0) - h0 for lag in lags]
+        out += [lag(h0) - h0 - (lag.rest if record else 0.0) for lag in lags]
+        if levels:  # a creep counted from each start: a level per train record after the first
+            out += list(level_rows(train_record, n_train, h0.size))
         if common:
             out += list(start_columns(np.arange(c.start, c.stop), dt, taus))
         if "asymmetry" in effects:

@@ -11,7 +11,7 @@ C. The limits come from the C core (``pimodel._native.LIMITS``, ``fmu/src/core/p
 from __future__ import annotations
 
 import uuid
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from .. import _native
 from .._native import LIMITS
@@ -336,7 +336,9 @@ MODELS: dict[str, dict] = {
                      "v[0] (the diagnosis' nominal, DiagnosedModel.plays_start)"),
                  Var("creep_start", 78, "Integer", "parameter", "0",
                      "creep lags before the first sample: 0 at rest at h0[0], 1 at rest at "
-                     "creep_start_level (a common rest, params creep_start 'common')"),
+                     "creep_start_level (a common rest, params creep_start 'common'), 2 at "
+                     "rest at h0[0] and the creep counted from the record's start: less "
+                     "sum_j g_j h0[0], y[0] un-crept (params creep_start 'record')"),
                  *_arrays("creep_start_level", 2100, "parameter", "0",
                           "rest level s of the creep lag before the first sample when "
                           "creep_start = 1 (output unit), lag"),
@@ -370,6 +372,9 @@ _INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset"
                    "center", "half_range", "rate_band_gain", "rate_scale", "rate_family",
                    "rate_tau", "rate_saturation", "rate_growth", "input_range", "p_hi", "r_hi",
                    "w0_hi", "rate_band_gain_hi"}
+# the inverse unit takes the rest and the common start only (no creep counted from the record)
+_INVERSE_CREEP_START = ("creep lags before the first sample: 0 at rest at h0[0], 1 at rest at "
+                        "creep_start_level (a common rest, params creep_start 'common')")
 MODELS["DiagnosedInverse"] = {
     "id": 9,
     "description": "The causal feedforward of a diagnosed model: the prefilter (the dynamics' "
@@ -377,7 +382,8 @@ MODELS["DiagnosedInverse"] = {
                    "of the static part (creep, asymmetry, rate) and the post sections (the "
                    "approximate inverse of a filter before the hysteresis), its output delayed "
                    "by the latency (pimodel.diagnosis.model.DiagnosedInverse.block, dt = Ts)",
-    "vars": [*[v for v in MODELS["DiagnosedModel"]["vars"]
+    "vars": [*[v if v.name != "creep_start" else replace(v, description=_INVERSE_CREEP_START)
+               for v in MODELS["DiagnosedModel"]["vars"]
                if v.name.split("[")[0] in _INVERSE_SHARED],
              Var("reference_range", 67, "Real", "parameter", "0",
                  "range of the (prefiltered) reference, the root rule's scale: span = max(2 "

@@ -26,7 +26,12 @@ size_t pim_diag_state_size(const pim_diag *d)
 {
     return PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
            pim_diag_element_states(d) + pim_diag_delay_length(d->delay) +
-           pim_diag_prefilter_states(d);
+           pim_diag_prefilter_states(d) + pim_diag_record_states(d);
+}
+
+size_t pim_diag_record_states(const pim_diag *d)
+{
+    return d->lag_record && d->m ? 1 : 0;
 }
 
 size_t pim_diag_prefilter_states(const pim_diag *d)
@@ -39,7 +44,8 @@ void pim_diag_initial_state(const pim_diag *d, double *x, double z0)
     const size_t size = pim_diag_state_size(d), nf = pim_diag_prefilter_states(d);
     for (size_t j = 0; j < size; ++j) x[j] = 0.0;
     for (size_t i = 0; i < d->n; ++i) x[PIM_DIAG_HEADER + i] = z0;
-    for (size_t i = 0; nf && i < d->n; ++i) x[size - nf + i] = z0; /* zf */
+    const size_t nrec = pim_diag_record_states(d);
+    for (size_t i = 0; nf && i < d->n; ++i) x[size - nrec - nf + i] = z0; /* zf */
     if (d->rate_w && d->rate_family == PIM_DIAG_RATE_SCALED) /* zs */
         for (size_t i = 0; i < d->n; ++i) x[PIM_DIAG_HEADER + d->n + 1 + i] = z0;
 }
@@ -109,6 +115,8 @@ const char *pim_diag_check(const pim_diag *d)
         if (d->lag_start && !isfinite(d->lag_start[j]))
             return "a creep start level is not finite";
     }
+    if (d->lag_record != 0 && d->lag_record != 1)
+        return "the creep's record start flag lag_record must be 0 or 1";
     if (d->asym) {
         if (!isfinite(d->q) || !isfinite(d->c3) || !isfinite(d->center))
             return "an asymmetry coefficient is not finite";
@@ -175,7 +183,8 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     const size_t nbuf = pim_diag_delay_length(d->delay);
     double *z = x + PIM_DIAG_HEADER, *rate = z + n, *mem = rate + 1, *lag = rate + nr,
            *s = lag + d->m, *es = s + q, *buf = es + pim_diag_element_states(d),
-           *zf = buf + nbuf, *fs = zf + n;
+           *zf = buf + nbuf, *fs = zf + n,
+           *l0 = x + pim_diag_state_size(d) - pim_diag_record_states(d);
     const int radius = nr && d->rate_family == PIM_DIAG_RATE_RADIUS;
     const int scaled = nr && d->rate_family == PIM_DIAG_RATE_SCALED;
     const int first = x[0] == 0.0;
@@ -275,11 +284,16 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     }
     y += d->c;
     /* the effect terms, in the order of DiagnosedModel.simulate */
+    const int record = d->lag_record && d->m;
+    if (record && first) l0[0] = h0; /* the lags' start at rest, kept for the record */
     for (size_t j = 0; j < d->m; ++j) {
         const double a = d->lag_a[j];
         const double before = !first ? lag[j] : d->lag_start ? d->lag_start[j] : h0;
         lag[j] = (1.0 - a) * h0 + a * before;
-        y += d->lag_g[j] * (lag[j] - h0);
+        if (record) /* counted from the record's start: less g_j L_j[-1] */
+            y += d->lag_g[j] * (lag[j] - h0 - (d->lag_start ? d->lag_start[j] : l0[0]));
+        else
+            y += d->lag_g[j] * (lag[j] - h0);
     }
     if (d->asym) {
         const double u = (h0 - d->center) / d->half;

@@ -30,6 +30,9 @@
  *                                                    L_j[-1] = h0[0] (lag_start NULL) or
  *                                                    L_j[-1] = lag_start[j] (a common rest:
  *                                                    pimodel.diagnosis.creep)
+ *              - sum_j g_j L_j[-1]                when lag_record = 1: the creep counted from
+ *                                                 the record's start (creep_start "record"),
+ *                                                 L_j[-1] as above; y[0] holds no creep
  *            + q u^2 + c3 u^3,  u = (h0[k] - center) / half            asymmetry
  *            + sum_i g_i m_i[k]                 rate, radius family       (g_i: the gain
  *            + rho_f[k] sum_i g_i w0_i z_i[k]   or weight family           of play i's band)
@@ -53,9 +56,10 @@
  *
  * State (one flat array of pim_diag_state_size(d) doubles, so that python-control blocks and FMU
  * states hold it as is): [started, v_prev, t_start, head, z[n], rate[n_rate], L[m], s[order],
- * e[n_e], buf[nbuf], zf[n_f], f[2 nw]] (e: two states per section M_1, E_1..E_ne, n_e =
+ * e[n_e], buf[nbuf], zf[n_f], f[2 nw], L0[n_r]] (e: two states per section M_1, E_1..E_ne, n_e =
  * 2 (ne + 1), or 0 when ne = 0; zf: the plays of the filtered input and f: two states per
- * prefilter section, n_f = n, both present only when nw > 0) with rate = [rho_f[k-1], m[n]]
+ * prefilter section, n_f = n, both present only when nw > 0; L0: the lags' start h0[0], set on
+ * the first sample, n_r = 1 when lag_record = 1 and m > 0, else 0) with rate = [rho_f[k-1], m[n]]
  * (radius family), [rho_f[k-1]] (weight family), [rate[k+1], zs[n]]
  * (scaled family: the rate pim_rdpi_sat_run holds for the next sample, in input unit / s, and
  * the scaled plays) or none; all zero (except z and zf = the
@@ -80,7 +84,7 @@ extern "C" {
 #define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + 1 + PIM_DIAG_MAX_LAGS + \
                             PIM_DIAG_MAX_ORDER + 2 * (PIM_DIAG_MAX_ELEMENTS + 1) + \
                             PIM_DIAG_MAX_DELAY + PIM_DIAG_MAX_PLAYS + \
-                            2 * PIM_DIAG_MAX_ELEMENTS)
+                            2 * PIM_DIAG_MAX_ELEMENTS + 1)
 
 typedef struct {
     size_t n;              /* plays */
@@ -120,6 +124,9 @@ typedef struct {
     const double *lag_start; /* NULL: each creep lag at rest at h0[0]; else L_j[-1] =
                                 lag_start[j], the lags' common rest levels (creep_start
                                 "common" of pimodel.diagnosis.creep) [output unit] */
+    int lag_record;        /* 0: the creep term sum_j g_j (L_j[k] - h0[k]); 1: less
+                              sum_j g_j L_j[-1], the creep counted from each record's start
+                              (creep_start "record" of pimodel.diagnosis.creep) */
 } pim_diag;
 
 /* Length of the flat state of d (the layout above). */
@@ -130,6 +137,9 @@ PIM_API size_t pim_diag_element_states(const pim_diag *d);
 
 /* Length of the prefilter's state: n + 2 nw (zf and the sections), or 0 when nw = 0. */
 PIM_API size_t pim_diag_prefilter_states(const pim_diag *d);
+
+/* Length of the record start's state: 1 when lag_record = 1 and m > 0, else 0. */
+PIM_API size_t pim_diag_record_states(const pim_diag *d);
 
 /* Length of the rate state: 1 + n (radius or scaled family), 1 (weight family) or 0. */
 PIM_API size_t pim_diag_rate_size(const pim_diag *d);
@@ -143,7 +153,8 @@ PIM_API size_t pim_diag_delay_length(double delay);
  * input_range > 0 when rate_tau = 0; lags
  * 0 < a_j < 1; a[0] = 1 and sum a != 0 so that a rest state exists, for the LTI and for each
  * section of the further elements and of the prefilter; ne, nw <= PIM_DIAG_MAX_ELEMENTS;
- * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2; settle_tau >= 0; lag_start finite),
+ * 0 <= delay <= PIM_DIAG_MAX_DELAY - 2; drift_clock 0..2; settle_tau >= 0; lag_start finite;
+ * lag_record 0 or 1),
  * else a static message naming the first bad one
  * (the FMU adds the value).
  */

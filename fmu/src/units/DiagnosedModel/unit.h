@@ -1,6 +1,10 @@
 /* The DiagnosedModel unit (unit 8): the model a diagnosis chose (pim_diagnosed.h), signed play
  * weights and the effect terms in parallel; input v (in1), output y (out1).  Its hooks
  * (fmi/pim_unit.h), included after the unit struct. */
+/* creep_start 2: the lags at rest at h0[0], the creep counted from the record's start
+ * (pim_diag.lag_record; params creep_start "record" of pimodel.diagnosis.creep) */
+#define PIM_CREEP_START_MAX 2
+#define PIM_CREEP_START_MORE ", 2 at rest at h0[0] counted from the record's start"
 #include "diag_static.h"
 #include "sections.h"
 #define HAS_MODEL_DEFAULTS
@@ -39,6 +43,7 @@ static void unit_diag(const pim_unit *u, pim_diag *d)
     d->settle = u->drift_settling;
     d->settle_tau = u->drift_settling_tau;
     d->settle_t0 = u->drift_settling_start;
+    d->lag_record = u->creep_start == 2; /* less sum_j g_j h0[0] (pim_diagnosed.h) */
 }
 
 /* The DiagnosedModel parameter rules, with the variable, index and value in the message. */

@@ -4,6 +4,14 @@
 #ifndef PIM_DIAG_STATIC_H
 #define PIM_DIAG_STATIC_H
 
+/* The highest creep_start a unit takes and its words in the range message: 0 at rest at h0[0],
+ * 1 at a common rest; a unit that also counts the creep from the record's start (DiagnosedModel:
+ * 2) defines both before including this file. */
+#ifndef PIM_CREEP_START_MAX
+#define PIM_CREEP_START_MAX 1
+#define PIM_CREEP_START_MORE ""
+#endif
+
 
 /* Start values of the static part's parameters (the spec's). */
 static void unit_diag_defaults(pim_unit *u)
@@ -105,10 +113,10 @@ static int unit_check_diag_static(pim_unit *u)
                                  "finite and > 0 s)", j + 1, u->creep_tau[j]);
         u->a[j] = exp(-u->Ts / u->creep_tau[j]); /* derived; checked below */
     }
-    if (u->creep_start < 0 || u->creep_start > 1)
+    if (u->creep_start < 0 || u->creep_start > PIM_CREEP_START_MAX)
         return unit_error(u, "parameter creep_start = %d out of range: 0 at rest at h0[0], 1 at "
-                             "rest at creep_start_level", u->creep_start);
-    for (int j = 0; u->creep_start && j < u->n_lags; ++j)
+                             "rest at creep_start_level" PIM_CREEP_START_MORE, u->creep_start);
+    for (int j = 0; u->creep_start == 1 && j < u->n_lags; ++j)
         if (!isfinite(u->creep_start_level[j]))
             return unit_error(u, "creep start level creep_start_level[%d] = %g is not finite",
                               j + 1, u->creep_start_level[j]);
@@ -155,7 +163,7 @@ static int unit_check_diag_static(pim_unit *u)
         (d)->m = (u)->n_lags > 0 ? (size_t)(u)->n_lags : 0;                                     \
         (d)->lag_a = (u)->a;                                                                    \
         (d)->lag_g = (u)->creep_gain;                                                           \
-        (d)->lag_start = (u)->creep_start ? (u)->creep_start_level : NULL;                      \
+        (d)->lag_start = (u)->creep_start == 1 ? (u)->creep_start_level : NULL;                 \
         (d)->asym = (u)->asym_q != 0.0 || (u)->asym_c3 != 0.0;                                  \
         (d)->q = (u)->asym_q;                                                                   \
         (d)->c3 = (u)->asym_c3;                                                                 \
