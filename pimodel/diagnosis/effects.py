@@ -1147,10 +1147,9 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
         model.params["dynamics_structures_tried"] = lti_trace
     if positions:
         model.params["dynamics_positions_tried"] = positions
+    in_train = static["train"]
     if "drift" in effects and has_levels(p):  # a level per record
         model.params["drift_t0_train"] = float(train[0].t[0])
-    in_train = static["train"]
-    if "drift" in effects and has_levels(p):
 
         def with_level(seg, out):  # a record's own level, out of fold (not for train records)
             return out if seg in in_train else out + out_of_fold_level(seg.y - out, seg.mask)
@@ -1422,7 +1421,7 @@ def _describe(effects, model: Model, nominal: Model, n_train: int = 1) -> dict:
                 out["creep_start"] = "record"
                 # its levels of the train records after the first (their own columns)
                 i += max(n_train - 1, 0) if creep_levels(effects, model.params) else 0
-            if model.params.get("creep_start") == "common":  # g_i s_i, then the levels s_i
+            elif model.params.get("creep_start") == "common":  # g_i s_i, then the levels s_i
                 out["creep_start"] = "common"
                 out["creep_start_levels"] = _start_levels(gains, extra[i:i + len(taus)])
                 i += len(taus)
