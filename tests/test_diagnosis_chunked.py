@@ -448,3 +448,45 @@ def test_bounded_weights_reach_the_bounded_least_squares_optimum(seed):
     unbounded = ne.solve()  # least squares turns the first bounded weight negative here
     assert unbounded[1] < 0.0
     assert float(np.sum((X.T @ unbounded - y) ** 2)) < rss_ref
+
+
+def test_chunks_left_out_whole_are_skipped():
+    """A chunk with no sample (a start-up longer than ``CHUNK`` samples left out of the fit,
+    ``initial_state="unknown"``) adds nothing, first or later: LAPACK's QR refuses an empty
+    stack."""
+    X, y = _problem(3, n=500, p=4)
+    ref, res, *_ = np.linalg.lstsq(X.T, y, rcond=None)
+    qr, ne = ChunkedQR(4), NormalEquations(4)
+    empty = slice(0, 0)
+    for c in (empty, slice(0, 200), empty, slice(200, 500), empty):
+        qr.add(X[:, c], y[c])
+        ne.add(X[:, c], y[c])
+    coef, rss = qr.solve()
+    scale = np.max(np.abs(ref))
+    assert np.max(np.abs(coef - ref)) < 1e-10 * scale and abs(rss - res[0]) < 1e-8 * res[0]
+    assert np.all(qr.solve_nonneg(np.ones(4, bool)) >= 0)
+    assert qr.samples == ne.samples == 500
+
+
+def test_unknown_start_longer_than_a_chunk_is_fitted():
+    """The nominal's bounded fit (``_bounded``: a ChunkedQR streamed over play chunks) on a
+    record whose start-up region (left out with ``initial_state="unknown"``) spans more than
+    one ``CHUNK`` of samples: before, LAPACK failed on the all-masked first chunk (dgeqrf
+    info -4)."""
+    D = importlib.import_module("pimodel.diagnosis.diagnose")
+    from pimodel import Record
+    from pimodel.diagnosis.where import startup_length
+
+    n = CHUNK + 9000
+    k = np.arange(n)
+    # small loops about 0.5 for 1.2 chunks, then loops over the whole range
+    v = np.where(k < CHUNK + 3000, 0.5 + 0.1 * np.sin(2 * np.pi * k / 2000),
+                 0.5 + 0.5 * np.sin(2 * np.pi * k / 1500))
+    y = PIOperator(np.array([1.0, 0.5, 0.3]), np.array([0.0, 0.1, 0.3])).simulate(v)
+    y = y + 1e-4 * np.random.default_rng(0).normal(size=n)
+    rec = Record(k * 1e-4, v, y)
+    assert startup_length(v) > CHUNK
+    radii = np.linspace(0.0, 0.5, 6)
+    segs, ne = D._plain_fit([rec], radii, "unknown", True, factor=(qr := ChunkedQR(7)))
+    assert qr.samples == ne.samples == n - startup_length(v)
+    assert np.all(np.isfinite(qr.solve_nonneg(radii > 0)))

@@ -243,6 +243,8 @@ class ChunkedQR:
         ``y``, shape (m,) (a ValueError for shapes that do not fit), as
         :meth:`NormalEquations.add` takes them; the factor is updated in place."""
         X, y = _check_chunk(X, y, self.p)
+        if y.size == 0:  # a chunk whose samples are all masked (a long start-up left out)
+            return
         k = self.R.shape[0]
         # the stack in column-major order, factored in place by LAPACK's dgeqrf: half the time
         # of numpy.linalg.qr on the row-major stack (measured: 33 against 65 ms for 16,466 x 82)
