@@ -113,7 +113,7 @@ def test_blind_clean_stages_not_started_at_rest_are_none_by_default(name, seed):
     assert choice["chosen"] == rep.nominal["initial_state"] == "unknown"
     assert choice["post_startup_ratio"] > choice["limits"]["post_startup_ratio"] or \
         choice["startup_ratio"] > choice["limits"]["startup_ratio"]
-    assert any("do not start at rest" in h for h in hints(rep))
+    assert any("do not all start at rest" in h for h in hints(rep))
     assert rep.verdict["effects"] == ["none"]
     assert rep.verdict["gap_before"] < 1.5 * rep.verdict["noise_floor"]
 

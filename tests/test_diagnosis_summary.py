@@ -82,14 +82,14 @@ def test_an_auto_start_left_out_is_said_with_its_reason():
     post = {"asked": "auto", "chosen": "unknown", "post_startup_ratio": 4.08,
             "startup_ratio": 4.8, "limits": limits}
     said = [h for h in hints(_report(("none",), initial_state="unknown", choice=post))
-            if "do not start at rest" in h]
+            if "do not all start at rest" in h]
     assert len(said) == 1 and "4.08 times" in said[0] and "4.8 times" not in said[0]
     start = dict(post, post_startup_ratio=1.05, startup_ratio=93.4)
     said = [h for h in hints(_report(("none",), initial_state="unknown", choice=start))
-            if "do not start at rest" in h]
+            if "do not all start at rest" in h]
     assert len(said) == 1 and "93.4 times as much misfit in validate's start-up" in said[0]
     rest = dict(post, chosen="rest", post_startup_ratio=0.9, startup_ratio=1.2)
-    assert not any("do not start at rest" in h for h in hints(_report(choice=rest)))
+    assert not any("do not all start at rest" in h for h in hints(_report(choice=rest)))
 
 
 def test_alternatives_and_unexplained_lower_the_confidence():

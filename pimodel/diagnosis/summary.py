@@ -156,7 +156,7 @@ def hints(rep) -> list[str]:
                if over["post_startup_ratio"] else "",
                f"{choice['startup_ratio']:.3g} times as much misfit in validate's start-up as "
                "after it" if over["startup_ratio"] else ""]
-        out.append("the records do not start at rest: fitted from rest, the nominal left "
+        out.append("the records do not all start at rest: fitted from rest, the nominal left "
                    f"{' and '.join(w for w in why if w)}, so each record's start-up region "
                    "was left out (initial_state 'auto' chose 'unknown'); to model the start "
                    "too, record from a known rest (a hold, then a ramp from it)")
