@@ -102,7 +102,8 @@ def test_blind_clean_stages_not_started_at_rest_are_none_by_default(name, seed):
     at 1-20 kHz: a validate start-up misfit of 5-30 noise floors, or weights that fitted slow
     noise by the large plays' one move in train's start-up) are ``none`` with the default
     ``initial_state="auto"``, which chose ``"unknown"`` (the records contradict a start at
-    rest) and says so in a hint; validate within 1.5 noise floors."""
+    rest, and without the start-ups the nominal is at the noise) and says so in a hint;
+    validate within 1.5 noise floors."""
     import run48
 
     from pimodel.diagnosis.summary import hints
@@ -113,6 +114,7 @@ def test_blind_clean_stages_not_started_at_rest_are_none_by_default(name, seed):
     assert choice["chosen"] == rep.nominal["initial_state"] == "unknown"
     assert choice["post_startup_ratio"] > choice["limits"]["post_startup_ratio"] or \
         choice["startup_ratio"] > choice["limits"]["startup_ratio"]
+    assert choice["free_over_noise"] <= choice["limits"]["free_over_noise"]
     assert any("do not all start at rest" in h for h in hints(rep))
     assert rep.verdict["effects"] == ["none"]
     assert rep.verdict["gap_before"] < 1.5 * rep.verdict["noise_floor"]
