@@ -22,7 +22,7 @@ STARTUP = "start-up (until the input first spans 90 % of its range)"
 
 
 def _report(effects=("creep",), *, ratio=1.2, alternatives=(), startup=1.0, share=0.0,
-            initial_state="rest", seed=0):
+            initial_state="rest", seed=0, choice=None):
     rng = np.random.default_rng(seed)
     noise = rng.uniform(0.005, 0.02)
     before = noise * rng.uniform(5, 20)
@@ -43,7 +43,10 @@ def _report(effects=("creep",), *, ratio=1.2, alternatives=(), startup=1.0, shar
                "alternatives": list(alternatives), "unexplained": un, "model": {}}
     where = {"regions": regions, "spectrum": [{"band": "< 1 Hz", "energy_share": 0.7},
                                               {"band": "1-10 Hz", "energy_share": 0.3}]}
-    return DiagnosisReport({"initial_state": initial_state}, where, [], verdict, [], [], [])
+    nominal = {"initial_state": initial_state}
+    if choice is not None:
+        nominal["initial_state_choice"] = choice
+    return DiagnosisReport(nominal, where, [], verdict, [], [], [])
 
 
 def test_summary_states_verdict_figures_and_region():
@@ -70,6 +73,23 @@ def test_startup_hint_only_when_started_at_rest():
     assert not any("--initial-state" in h for h in hints(quiet))
     assert "start-up" in summarize(rep) and "start-up" not in summarize(quiet)
     assert not any("--initial-state" in h for h in hints(_report(startup=1.2)))
+
+
+def test_an_auto_start_left_out_is_said_with_its_reason():
+    """``initial_state="auto"`` that chose ``"unknown"``: a hint says the records do not start
+    at rest, with the ratio that decided it (only that one); one that chose rest says nothing."""
+    limits = {"post_startup_ratio": 3.0, "startup_ratio": 10.0}
+    post = {"asked": "auto", "chosen": "unknown", "post_startup_ratio": 4.08,
+            "startup_ratio": 4.8, "limits": limits}
+    said = [h for h in hints(_report(("none",), initial_state="unknown", choice=post))
+            if "do not all start at rest" in h]
+    assert len(said) == 1 and "4.08 times" in said[0] and "4.8 times" not in said[0]
+    start = dict(post, post_startup_ratio=1.05, startup_ratio=93.4)
+    said = [h for h in hints(_report(("none",), initial_state="unknown", choice=start))
+            if "do not all start at rest" in h]
+    assert len(said) == 1 and "93.4 times as much misfit in validate's start-up" in said[0]
+    rest = dict(post, chosen="rest", post_startup_ratio=0.9, startup_ratio=1.2)
+    assert not any("do not all start at rest" in h for h in hints(_report(choice=rest)))
 
 
 def test_alternatives_and_unexplained_lower_the_confidence():

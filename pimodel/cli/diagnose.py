@@ -41,9 +41,11 @@ def register(sub) -> None:
                    help="validate record (repeatable)")
     p.add_argument("--json", required=True, help="output JSON report")
     p.add_argument("--plots", default=None, metavar="DIR", help="write figures (PNG) here")
-    p.add_argument("--initial-state", choices=("rest", "unknown"), default="rest",
+    p.add_argument("--initial-state", choices=("auto", "rest", "unknown"), default="auto",
                    help="'unknown': leave each record's start-up region (until the input first "
-                   "spans 90 %% of its range) out of fitting and scoring (default: rest)")
+                   "spans 90 %% of its range) out of fitting and scoring; 'rest': fit and score "
+                   "it with the plays at rest; 'auto' (default): 'unknown' when the records "
+                   "contradict a start at rest, else 'rest'")
     p.add_argument("--export", default=None, metavar="DIR",
                    help="write the augmented and the nominal model as JSON (augmented.json, "
                    "nominal.json: pimodel.diagnosis.model.load_diagnosed_model; 'pimodel fmu "

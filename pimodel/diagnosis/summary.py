@@ -148,6 +148,18 @@ def hints(rep) -> list[str]:
     start = [r for r in rep.where.get("regions", []) if r["region"].startswith(STARTUP) and
              r["concentration"] >= DOMINANT and
              (r in top or r.get("energy_share", 0.0) >= STARTUP_MAJORITY)]
+    choice = rep.nominal.get("initial_state_choice") or {}
+    if choice.get("chosen") == "unknown":  # initial_state "auto" left the start-ups out
+        over = {k: (choice.get(k) or 0.0) > lim for k, lim in choice["limits"].items()}
+        why = [f"{choice['post_startup_ratio']:.3g} times the mean squared misfit after "
+               "validate's start-up of a nominal fitted without it"
+               if over["post_startup_ratio"] else "",
+               f"{choice['startup_ratio']:.3g} times as much misfit in validate's start-up as "
+               "after it" if over["startup_ratio"] else ""]
+        out.append("the records do not all start at rest: fitted from rest, the nominal left "
+                   f"{' and '.join(w for w in why if w)}, so each record's start-up region "
+                   "was left out (initial_state 'auto' chose 'unknown'); to model the start "
+                   "too, record from a known rest (a hold, then a ramp from it)")
     if start and rep.nominal.get("initial_state", "rest") == "rest":
         r = start[0]
         out.append(f"the start-up region dominates ({100 * r['energy_share']:.0f} % of the "
