@@ -60,7 +60,7 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.parametrize("case", ["nominal", "all", "dynamics_delay_creep", "rate_weight",
                                   "rate_weight_filtered", "rate_saturated", "rate_scaled_creep",
                                   "delay_whole", "creep_common", "dynamics_delay_creep_common",
-                                  "wiener_two_delay_creep"])
+                                  "wiener_two_delay_creep", "creep_record", "all_record"])
 def test_unit_equals_the_python_stream(fmus, fmi, case):
     effects, extra = CASES[case]
     m = model(effects, **extra)
@@ -117,8 +117,10 @@ def test_unit_with_more_than_64_plays_and_a_start_memory(fmus, fmi):
                               "a latency >= 1"),
      ({"rate_band_gain[1]": 0.1, "rate_scale": 0.0}, "parameter rate_scale = 0"),
      ({"n_lags": 1, "creep_tau[1]": 0.0}, "time constant creep_tau[1] = 0 is not positive"),
-     ({"creep_start": 2}, "parameter creep_start = 2 out of range: 0 at rest at h0[0], 1 at "
-                         "rest at creep_start_level"),
+     ({"creep_start": 3}, "parameter creep_start = 3 out of range: 0 at rest at h0[0], 1 at "
+                         "rest at creep_start_level, 2 at rest at h0[0] counted from the "
+                         "record's start"),
+     ({"creep_start": -1}, "parameter creep_start = -1 out of range"),
      ({"n_lags": 2, "creep_tau[1]": 0.1, "creep_tau[2]": 1.0, "creep_start": 1,
        "creep_start_level[2]": float("nan")},
       "creep start level creep_start_level[2] = nan is not finite")])
