@@ -262,3 +262,21 @@ def test_model_file_keeps_the_record_start(tmp_path):
     assert "creep_start" not in fmu_parameters(model(("creep",), start="rest"))[1]
     assert "creep_start" not in inverse_fmu_parameters(model(("creep",), start="rest")
                                                        .inverse())[1]
+
+
+def test_c_check_takes_only_a_record_flag_of_0_or_1_without_a_common_rest():
+    """``pim_dinv_check``: ``lag_record`` 0 or 1, and not beside ``lag_start`` (the record
+    start has its lags at rest at ``h0[0]``)."""
+    from pimodel import _native
+
+    native = NativeInverse(model(("creep",)).inverse())
+    d = native.params
+    assert d.lag_record == 1 and _native.inverse_check(d) is None
+    for bad in (2, -1):
+        d.lag_record = bad
+        assert "lag_record must be 0 or 1" in _native.inverse_check(d)
+    common = NativeInverse(model(("creep",), start="common",
+                                 creep_start_levels=[0.4, -0.3]).inverse())
+    assert common.params.lag_record == 0 and _native.inverse_check(common.params) is None
+    common.params.lag_record = 1
+    assert "no lag_start" in _native.inverse_check(common.params)

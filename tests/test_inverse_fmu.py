@@ -169,6 +169,40 @@ def test_unit_substeps_and_restores_its_state(fmus):
     assert first == again
 
 
+@pytest.mark.parametrize("case", ["wiener_two_delay_creep", "all_record"])
+def test_unit_restores_its_state_with_post_sections_and_a_record_start(fmus, case):
+    """An FMU state saved and restored mid-record continues as the unbroken run, with post
+    sections (the solver after them in the state check) and with the record start's L0
+    (the filtered rate after it)."""
+    effects, extra = CASES[case]
+    m = model(effects, **extra)
+    y_d = reference(m, n=150)
+    _, params = unit_parameters(m.inverse())
+    unit = FMUUnit(unit_path(fmus, "2.0"), params)
+    try:
+        for y in y_d[:80]:
+            unit.set({"y_d": y})
+            unit.step(DT)
+        state = unit.get_state()
+        first = []
+        for y in y_d[80:]:
+            unit.set({"y_d": y})
+            unit.step(DT)
+            first.append(unit.get(["v"])[0])
+        unit.set_state(state)
+        again = []
+        for y in y_d[80:]:
+            unit.set({"y_d": y})
+            unit.step(DT)
+            again.append(unit.get(["v"])[0])
+        unit.free_state(state)
+    finally:
+        unit.close()
+    assert first == again
+    want, _ = python_stream(m, y_d, None)
+    assert np.max(np.abs(np.array(again) - want[80:])) < 1e-9
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("fmi", ["2.0", "3.0"])
 def test_cli_builds_the_inverse_fmu_that_validates_and_runs_in_the_masters(tmp_path, fmi):
