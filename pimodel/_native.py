@@ -534,7 +534,7 @@ class InverseParams(ctypes.Structure):
                 ("rate_tau", c_double), ("rate_saturation", c_double),
                 ("rate_growth", c_double), ("reference_range", c_double), ("ns", c_size),
                 ("sos", _DP), ("latency", c_size), ("frac", c_double), ("npost", c_size),
-                ("post", _DP), ("lag_start", _DP)]
+                ("post", _DP), ("lag_start", _DP), ("lag_record", c_int)]
 
 
 _check_layout(InverseParams, "pim_dinv")

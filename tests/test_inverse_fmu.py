@@ -37,18 +37,43 @@ def unit_path(folder: Path, fmi: str) -> Path:
     return folder / f"DiagnosedInverse{'_fmi3' if fmi == '3.0' else ''}.fmu"
 
 
+def _steps(unit: FMUUnit, y_d, h: float = DT) -> list:
+    """``v`` of an open unit after each communication step ``h`` with ``y_d[k]`` held."""
+    out = []
+    for y in y_d:
+        unit.set({"y_d": y})
+        unit.step(h)
+        out.append(unit.get(["v"])[0])
+    return out
+
+
 def run_inverse_unit(path: Path, params: dict, y_d: np.ndarray, h: float) -> np.ndarray:
     """``v`` of the unit after each communication step ``h`` with ``y_d[k]`` held over it."""
     unit = FMUUnit(path, params)
-    out = []
     try:
-        for y in y_d:
-            unit.set({"y_d": y})
-            unit.step(h)
-            out.append(unit.get(["v"])[0])
+        return np.array(_steps(unit, y_d, h))
     finally:
         unit.close()
-    return np.array(out)
+
+
+def run_restored(path: Path, params: dict, y_d: np.ndarray, k: int) -> tuple[list, list]:
+    """``v`` over ``y_d[k:]`` after the first ``k`` samples, run on, then again from the FMU
+    state saved after sample ``k - 1`` (steps of ``DT``)."""
+    unit = FMUUnit(path, params)
+
+    def run(ys):
+        return _steps(unit, ys)
+
+    try:
+        run(y_d[:k])
+        state = unit.get_state()
+        first = run(y_d[k:])
+        unit.set_state(state)
+        again = run(y_d[k:])
+        unit.free_state(state)
+    finally:
+        unit.close()
+    return first, again
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +85,7 @@ def fmus(built_fmus) -> Path:
 @pytest.mark.parametrize("case", ["nominal", "all", "dynamics_delay_creep", "rate_weight",
                                   "rate_weight_filtered", "rate_saturated", "rate_scaled_creep",
                                   "delay_whole", "creep_common", "dynamics_delay_creep_common",
-                                  "wiener_two_delay_creep"])
+                                  "wiener_two_delay_creep", "creep_record", "all_record"])
 def test_unit_equals_the_python_stream(fmus, fmi, case):
     effects, extra = CASES[case]
     m = model(effects, **extra)
@@ -117,8 +142,10 @@ def test_unit_with_more_than_64_plays_and_a_start_memory(fmus, fmi):
                               "a latency >= 1"),
      ({"rate_band_gain[1]": 0.1, "rate_scale": 0.0}, "parameter rate_scale = 0"),
      ({"n_lags": 1, "creep_tau[1]": 0.0}, "time constant creep_tau[1] = 0 is not positive"),
-     ({"creep_start": 2}, "parameter creep_start = 2 out of range: 0 at rest at h0[0], 1 at "
-                         "rest at creep_start_level"),
+     ({"creep_start": 3}, "parameter creep_start = 3 out of range: 0 at rest at h0[0], 1 at "
+                         "rest at creep_start_level, 2 at rest at h0[0] counted from the "
+                         "record's start"),
+     ({"creep_start": -1}, "parameter creep_start = -1 out of range"),
      ({"n_lags": 2, "creep_tau[1]": 0.1, "creep_tau[2]": 1.0, "creep_start": 1,
        "creep_start_level[2]": float("nan")},
       "creep start level creep_start_level[2] = nan is not finite")])
@@ -144,27 +171,23 @@ def test_unit_substeps_and_restores_its_state(fmus):
     got = run_inverse_unit(path, params, y_d, 2.5 * DT)
     want, _ = python_stream(m, np.array(seq), None)
     assert np.max(np.abs(got - want[last])) < 1e-9
-    unit = FMUUnit(path, params)
-    try:
-        for y in y_d[:60]:
-            unit.set({"y_d": y})
-            unit.step(DT)
-        state = unit.get_state()
-        first = []
-        for y in y_d[60:90]:
-            unit.set({"y_d": y})
-            unit.step(DT)
-            first.append(unit.get(["v"])[0])
-        unit.set_state(state)
-        again = []
-        for y in y_d[60:90]:
-            unit.set({"y_d": y})
-            unit.step(DT)
-            again.append(unit.get(["v"])[0])
-        unit.free_state(state)
-    finally:
-        unit.close()
+    first, again = run_restored(path, params, y_d[:90], 60)
     assert first == again
+
+
+@pytest.mark.parametrize("case", ["wiener_two_delay_creep", "all_record"])
+def test_unit_restores_its_state_with_post_sections_and_a_record_start(fmus, case):
+    """An FMU state saved and restored mid-record continues as the unbroken run, with post
+    sections (the solver after them in the state check) and with the record start's L0
+    (the filtered rate after it)."""
+    effects, extra = CASES[case]
+    m = model(effects, **extra)
+    y_d = reference(m, n=150)
+    _, params = unit_parameters(m.inverse())
+    first, again = run_restored(unit_path(fmus, "2.0"), params, y_d, 80)
+    assert first == again
+    want, _ = python_stream(m, y_d, None)
+    assert np.max(np.abs(np.array(again) - want[80:])) < 1e-9
 
 
 @pytest.mark.slow

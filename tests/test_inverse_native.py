@@ -80,6 +80,12 @@ CASES = {
                                     {"creep_start": "common", "creep_start_levels": [0.4, -0.3]}),
     "all": (("dynamics", "delay", "creep", "asymmetry", "rate"), {}),
     # a filter before the hysteresis (a Wiener model): its inverse's post sections
+    # the creep counted from each record's start (module creep): less sum_j g_j h0[0], L0
+    "creep_record": (("creep",), {"creep_start": "record"}),
+    "creep_asymmetry_record": (("creep", "asymmetry"), {"creep_start": "record"}),
+    "dynamics_delay_creep_record": (("dynamics", "delay", "creep"), {"creep_start": "record"}),
+    "all_record": (("dynamics", "delay", "creep", "asymmetry", "rate"),
+                   {"creep_start": "record"}),
     "wiener_lowpass": (("dynamics",), {"dynamics_position": "before",
                                        "wiener_elements": [["lowpass", 1 / (2 * np.pi * 60)]]}),
     "wiener_lowpass_direct": (("dynamics", "creep"),
@@ -198,7 +204,8 @@ def test_folding_model_is_inverted_through_its_monotone_projection(single_roots)
     assert np.all(np.isfinite(got))
 
 
-@pytest.mark.parametrize("case", ["asymmetry", "creep", "dynamics_delay_creep"])
+@pytest.mark.parametrize("case", ["asymmetry", "creep", "dynamics_delay_creep",
+                                  "dynamics_delay_creep_record"])
 def test_unknown_start_memory_equals_simulate_unknown(case):
     """A start from the memory that puts y_d[0] on the model (initial_state="unknown")."""
     effects, extra = CASES[case]
@@ -257,7 +264,8 @@ def test_c_step_equals_python_on_diagnosed_models(generator, effect, seed, singl
         assert np.max(np.abs(got[a:] - batch[:y_d.size - a])) < 1e-9
 
 
-@pytest.mark.parametrize("case", ["nominal", "static_all", "all", "wiener_two_delay_creep"])
+@pytest.mark.parametrize("case", ["nominal", "static_all", "all", "wiener_two_delay_creep",
+                                  "all_record"])
 def test_block_on_c_equals_the_reference_block(case, single_roots):
     """``DiagnosedInverse.block()`` steps ``NativeInverse``; the NumPy reference block
     (``reference_inverse.inverse_block``) gives the same outputs, states and labels."""

@@ -94,9 +94,7 @@ class NativeInverse:
             d.m = solver.m
             if solver.starts is not None:  # the lags at a common rest (module creep)
                 keep["lag_start"] = solver.starts
-            if solver.record:  # the C feedforward has no term for it: the reference runs it
-                raise ValueError("params: creep_start 'record' (the creep counted from each "
-                                 "record's start): the C feedforward does not take it")
+            d.lag_record = solver.record  # counted from each record's start: L0 in the state
         if solver.asym:
             d.asym, d.q, d.c3 = 1, p["asymmetry_quadratic"], p["asymmetry_cubic"]
             d.center, d.half = p["center"], p["half_range"]

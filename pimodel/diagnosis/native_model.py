@@ -599,7 +599,7 @@ def _static_effect_values(d, k: dict, params: dict) -> dict:
                     **arr("creep_tau", params["creep_time_constants_s"])})
         if "lag_start" in k:  # the lags' common rest (module creep)
             out.update({"creep_start": 1, **arr("creep_start_level", k["lag_start"])})
-        if getattr(d, "lag_record", 0):  # counted from each record's start (DiagnosedModel)
+        if d.lag_record:  # counted from each record's start (both units)
             out["creep_start"] = 2
     if d.asym:
         out.update({"asymmetry_quadratic": d.q, "asymmetry_cubic": d.c3, "center": d.center,

@@ -11,7 +11,7 @@ C. The limits come from the C core (``pimodel._native.LIMITS``, ``fmu/src/core/p
 from __future__ import annotations
 
 import uuid
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from .. import _native
 from .._native import LIMITS
@@ -372,9 +372,6 @@ _INVERSE_SHARED = {"Ts", "n", "z0", "p", "r", "w0", "offset", "reference_offset"
                    "center", "half_range", "rate_band_gain", "rate_scale", "rate_family",
                    "rate_tau", "rate_saturation", "rate_growth", "input_range", "p_hi", "r_hi",
                    "w0_hi", "rate_band_gain_hi"}
-# the inverse unit takes the rest and the common start only (no creep counted from the record)
-_INVERSE_CREEP_START = ("creep lags before the first sample: 0 at rest at h0[0], 1 at rest at "
-                        "creep_start_level (a common rest, params creep_start 'common')")
 MODELS["DiagnosedInverse"] = {
     "id": 9,
     "description": "The causal feedforward of a diagnosed model: the prefilter (the dynamics' "
@@ -382,8 +379,7 @@ MODELS["DiagnosedInverse"] = {
                    "of the static part (creep, asymmetry, rate) and the post sections (the "
                    "approximate inverse of a filter before the hysteresis), its output delayed "
                    "by the latency (pimodel.diagnosis.model.DiagnosedInverse.block, dt = Ts)",
-    "vars": [*[v if v.name != "creep_start" else replace(v, description=_INVERSE_CREEP_START)
-               for v in MODELS["DiagnosedModel"]["vars"]
+    "vars": [*[v for v in MODELS["DiagnosedModel"]["vars"]
                if v.name.split("[")[0] in _INVERSE_SHARED],
              Var("reference_range", 67, "Real", "parameter", "0",
                  "range of the (prefiltered) reference, the root rule's scale: span = max(2 "

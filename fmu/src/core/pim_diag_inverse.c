@@ -28,7 +28,7 @@ static inline double dinv_saturate(const pim_dinv *d, double rho)
 
 size_t pim_dinv_solver_size(const pim_dinv *d, int rate)
 {
-    const size_t base = 3 + d->n + d->m;
+    const size_t base = 3 + d->n + d->m + (d->lag_record ? 1 : 0); /* L0 (record start) */
     if (rate && d->rate_family == PIM_DIAG_RATE_SCALED) return base + 1 + d->n; /* s, zs */
     return rate ? base + 2 + d->n + base : base;
 }
@@ -103,6 +103,11 @@ const char *pim_dinv_check(const pim_dinv *d)
         if (d->lag_start && !isfinite(d->lag_start[j]))
             return "a creep start level is not finite";
     }
+    if (d->lag_record != 0 && d->lag_record != 1)
+        return "the creep's record start flag lag_record must be 0 or 1";
+    if (d->lag_record && d->lag_start)
+        return "a creep counted from the record's start (lag_record) has its lags at rest at "
+               "h0[0] (no lag_start)";
     if (d->asym) {
         if (!isfinite(d->q) || !isfinite(d->c3) || !isfinite(d->center))
             return "an asymmetry coefficient is not finite";
@@ -155,7 +160,8 @@ void pim_dinv_initial_state(const pim_dinv *d, double *x, const double *z0)
     double *solver = x + PIM_DINV_HEAD + 2 * (d->ns + d->npost);
     for (size_t i = 0; i < n; ++i) solver[3 + i] = z0[i];
     if (d->rate_w && d->rate_family == PIM_DIAG_RATE_SCALED) {
-        for (size_t i = 0; i < n; ++i) solver[3 + n + d->m + 1 + i] = z0[i]; /* zs */
+        const size_t zs = 3 + n + d->m + (d->lag_record ? 1 : 0) + 1;
+        for (size_t i = 0; i < n; ++i) solver[zs + i] = z0[i];
     } else if (d->rate_w) {
         double *source = solver + pim_dinv_solver_size(d, 0) + 2 + n;
         for (size_t i = 0; i < n; ++i) source[3 + i] = z0[i];
@@ -167,6 +173,7 @@ typedef struct {
     const pim_dinv *d;
     const double *z, *mem;
     double lag_acc, lag_sum; /* sum g_j a_j L_j, sum g_j a_j */
+    double rec_gain, rec_start; /* lag_record: sum g_j and L0 (h0 itself on the first sample) */
     double rho_k;
     int first, rate;
     const double *zs, *rs; /* the scaled family's plays and radii at sample k (else NULL) */
@@ -195,6 +202,7 @@ static double dinv_F(const dinv_ctx *c, double v)
     y += d->c;
     h0 += d->c0;
     if (d->m && (!c->first || d->lag_start)) y += c->lag_acc - c->lag_sum * h0;
+    if (d->lag_record) y -= c->rec_gain * (c->first ? h0 : c->rec_start);
     if (d->asym) {
         const double u = (h0 - d->center) / d->half;
         y += d->q * (u * u) + d->c3 * (u * u * u);
@@ -298,8 +306,8 @@ static const double VINV[4][4] = {
 static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
 {
     const size_t n = d->n, m = d->m;
-    double *z = x + 3, *lags = z + n, *rho_f = lags + m, *mem = rho_f + 1, *v0_prev = mem + n,
-           *source = v0_prev + 1;
+    double *z = x + 3, *lags = z + n, *l0 = lags + m, *rho_f = l0 + (d->lag_record ? 1 : 0),
+           *mem = rho_f + 1, *v0_prev = mem + n, *source = v0_prev + 1;
     const int first = x[0] == 0.0;
     const double v_prev = x[1], guess = x[2];
     double wsum = 0.0;
@@ -310,7 +318,8 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
     const double step_size = PIM_DIAG_STEP_SHARE * d->input_range;
     const int scaled = rate && d->rate_family == PIM_DIAG_RATE_SCALED;
     double rs[PIM_DINV_MAX_PLAYS];
-    dinv_ctx c = {d, z, rate ? mem : NULL, 0.0, 0.0, 0.0, first, rate && !scaled, NULL, NULL};
+    dinv_ctx c = {d, z, rate ? mem : NULL, 0.0, 0.0, 0.0, 0.0, 0.0, first, rate && !scaled,
+                  NULL, NULL};
     double fresh = 0.0;
     if (scaled) { /* radii fixed by the rate before sample k (pim_rdpi_sat_run's) */
         const double beta = d->rate_growth / d->rate_scale, sat = d->rate_saturation * d->rate_scale;
@@ -333,6 +342,10 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
         const double ga = d->lag_g[j] * d->lag_a[j];
         c.lag_acc += ga * lags[j];
         c.lag_sum += ga;
+    }
+    if (d->lag_record) { /* less sum_j g_j L_j[-1], L_j[-1] = h0[0] (kept in L0) */
+        for (size_t j = 0; j < m; ++j) c.rec_gain += d->lag_g[j];
+        c.rec_start = *l0;
     }
     /* breakpoints, sorted and unique, with the bracket 10 span beyond them */
     double b[DINV_NB_MAX];
@@ -430,6 +443,7 @@ static double dinv_solve(const pim_dinv *d, double *x, double yk, int rate)
     h += d->c0;
     for (size_t j = 0; j < m; ++j)
         lags[j] = first && !d->lag_start ? h : d->lag_a[j] * lags[j] + (1.0 - d->lag_a[j]) * h;
+    if (d->lag_record && first) *l0 = h; /* the lags' start h0[0] */
     if (scaled) {
         for (size_t i = 0; i < n; ++i) mem[i] = dinv_clamp(mem[i], vk - rs[i], vk + rs[i]);
         *rho_f = a_rate * *rho_f + (1.0 - a_rate) * (first ? 0.0 : fabs(vk - v_prev) / d->dt);

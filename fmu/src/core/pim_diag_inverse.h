@@ -27,6 +27,9 @@
  *     h0(v) = sum w0_i Z_i + c0
  *     F_k(v) = h(v) + sum_j g_j a_j (L_j[k-1] - h0(v))          creep (not on the first sample;
  *                                                      with lag_start, L_j[-1] = lag_start[j])
+ *            - (sum_j g_j) (k = 0 ? h0(v) : L0)         lag_record = 1: the creep counted from
+ *                                                      the record's start (L_j[-1] = h0[0],
+ *                                                      kept in L0; pim_diagnosed.h)
  *            + q u^2 + c3 u^3,  u = (h0(v) - center) / half       asymmetry
  *            + sum_i g_i r_i (contact_i(v) ? -sign(v - Z_i) rho_k : m_i)   rate, radius family
  *            + rho_k sum_i g_i w0_i Z_i                                     rate, weight family
@@ -50,11 +53,13 @@
  * than 1 % of span, else 2 v[k] - v[k-1].  span = max(2 r_n, reference_range / max(|sum w|,
  * 1e-12), 1).  After the solve: plays, creep lags L_j = a_j L_j + (1 - a_j) h0 (L = h0 on the
  * first solve without lag_start), rate rho_f (from the solved input's rate, at most PIM_DINV_RATE_FEEDBACK_CAP
- * times fresh[k]) and the radius family's memory m_i of the plays in contact.
+ * times fresh[k]) and the radius family's memory m_i of the plays in contact; with lag_record,
+ * L0 = h0 of the first solve.
  *
  * State (pim_dinv_state_size doubles): [started, seen, v_rest, f_prev, s[2 ns], g[2 npost],
  * solver]
- * with solver = [started, v_prev, guess, z[n], L[m]] and, with a rate effect, [rho_f, m[n],
+ * with solver = [started, v_prev, guess, z[n], L[m], L0[n_r]] (n_r = 1 when lag_record = 1,
+ * else 0) and, with a rate effect, [rho_f, m[n],
  * v0_prev, source] where source is a rate-free solver's state (same layout, no rate), or for
  * the scaled family [s, zs[n]] (s in input unit / s).  The
  * layout is that of the Python stream's state (reference_inverse._InverseStream.labels).
@@ -70,8 +75,8 @@ extern "C" {
 
 #define PIM_DINV_HEAD 4
 #define PIM_DINV_RATE_FEEDBACK_CAP 2.0          /* reference_inverse.RATE_FEEDBACK_CAP */
-#define PIM_DINV_SOLVER_MAX (3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS + 2 + PIM_DINV_MAX_PLAYS + \
-                             3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS)
+#define PIM_DINV_SOLVER_MAX (3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS + 1 + 2 + PIM_DINV_MAX_PLAYS + \
+                             3 + PIM_DINV_MAX_PLAYS + PIM_DINV_MAX_LAGS + 1)
 #define PIM_DINV_STATE_MAX (PIM_DINV_HEAD + 4 * PIM_DINV_MAX_SECTIONS + PIM_DINV_SOLVER_MAX)
 
 typedef struct {
@@ -100,6 +105,9 @@ typedef struct {
     const double *post;    /* npost rows of 6, as sos */
     const double *lag_start; /* NULL: the creep lags at rest at h0[0]; else L_j[-1] =
                                 lag_start[j], a common rest (pim_diagnosed.h) */
+    int lag_record;        /* 0 or 1: the creep counted from each record's start, less
+                              sum_j g_j h0[0] (creep_start "record" of pimodel.diagnosis.creep;
+                              lag_start NULL); the solver state holds L0 */
 } pim_dinv;
 
 /* Length of the flat state (layout above). */

@@ -4,6 +4,10 @@
  * section), the post sections of a Wiener model's filter inverse (n_post_sections,
  * post_section), latency, delay_fraction and reference_range.  Its hooks (fmi/pim_unit.h),
  * included after the unit struct. */
+/* creep_start 2: the lags at rest at h0[0], the creep counted from the record's start
+ * (pim_dinv.lag_record; params creep_start "record" of pimodel.diagnosis.creep) */
+#define PIM_CREEP_START_MAX 2
+#define PIM_CREEP_START_MORE ", 2 at rest at h0[0] counted from the record's start"
 #include "diag_static.h"
 #include "sections.h"
 #define HAS_MODEL_DEFAULTS
@@ -27,6 +31,7 @@ static void unit_dinv(const pim_unit *u, pim_dinv *d)
     d->post = u->post_section;
     d->latency = u->latency > 0 ? (size_t)u->latency : 0;
     d->frac = u->delay_fraction;
+    d->lag_record = u->creep_start == 2; /* less sum_j g_j h0[0] (pim_diag_inverse.h) */
 }
 
 /* The DiagnosedInverse parameter rules, with the variable, index and value in the message. */
@@ -99,7 +104,8 @@ static int model_check_states(pim_unit *u, pim_unit *s)
     pim_dinv d;
     unit_diag_join(s);
     unit_dinv(s, &d);
-    const double *x = s->dstate, *solver = x + PIM_DINV_HEAD + 2 * d.ns;
+    const double *x = s->dstate, *solver = x + PIM_DINV_HEAD + 2 * (d.ns + d.npost);
+    const size_t rho_f = 3 + d.n + d.m + (d.lag_record ? 1 : 0); /* after L0 (record start) */
     if (!unit_all_finite(x, pim_dinv_state_size(&d)))
         return unit_error(u, "FMU state rejected: a feedforward state is not finite");
     if ((x[0] != 0.0 && x[0] != 1.0) || x[1] < 0.0 || x[1] != floor(x[1]) ||
@@ -108,8 +114,8 @@ static int model_check_states(pim_unit *u, pim_unit *s)
                              "solver started = %g (expected 0 or 1, 0 <= seen <= latency "
                              "%llu)", x[0], x[1], solver[0],
                           (unsigned long long)d.latency);
-    if (d.rate_w && solver[3 + d.n + d.m] < 0.0)
+    if (d.rate_w && solver[rho_f] < 0.0)
         return unit_error(u, "FMU state rejected: the filtered rate rho_f = %g must be "
-                             ">= 0", solver[3 + d.n + d.m]);
+                             ">= 0", solver[rho_f]);
     return 0;
 }
