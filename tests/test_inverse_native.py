@@ -359,7 +359,9 @@ def test_c_step_equals_python_on_the_real_record_models(real_record_path, single
     rec = load_record(real_record_path)
     k0 = int(np.argmax(np.abs(rec.v) > 1))
     mid = k0 + (len(rec) - k0) // 2
-    rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)])
+    # from rest: the models with signed weights and an effect (the default, "auto", leaves the
+    # validate start-up out here and finds nothing beyond a monotone nominal)
+    rep = diagnose([rec.slice(k0, mid)], [rec.slice(mid, None)], initial_state="rest")
     y_d = np.asarray(rec.y[mid:mid + 2000], float)
     for m in (rep.model(), rep.model(augmented=False)):
         single_roots.clear()
