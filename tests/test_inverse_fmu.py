@@ -25,6 +25,7 @@ from pimodel.fmu.operators import unit_parameters
 from pimodel.fmu.unit import FMUUnit
 
 sys.path.insert(0, str(Path(__file__).parent))
+from diagnosed_unit import step_through  # noqa: E402
 from test_inverse_native import CASES as NATIVE_CASES  # noqa: E402
 from test_inverse_native import DT, RADII, model, python_stream, reference  # noqa: E402
 
@@ -37,21 +38,11 @@ def unit_path(folder: Path, fmi: str) -> Path:
     return folder / f"DiagnosedInverse{'_fmi3' if fmi == '3.0' else ''}.fmu"
 
 
-def _steps(unit: FMUUnit, y_d, h: float = DT) -> list:
-    """``v`` of an open unit after each communication step ``h`` with ``y_d[k]`` held."""
-    out = []
-    for y in y_d:
-        unit.set({"y_d": y})
-        unit.step(h)
-        out.append(unit.get(["v"])[0])
-    return out
-
-
 def run_inverse_unit(path: Path, params: dict, y_d: np.ndarray, h: float) -> np.ndarray:
     """``v`` of the unit after each communication step ``h`` with ``y_d[k]`` held over it."""
     unit = FMUUnit(path, params)
     try:
-        return np.array(_steps(unit, y_d, h))
+        return np.array(step_through(unit, y_d, h, "y_d", "v"))
     finally:
         unit.close()
 
@@ -62,7 +53,7 @@ def run_restored(path: Path, params: dict, y_d: np.ndarray, k: int) -> tuple[lis
     unit = FMUUnit(path, params)
 
     def run(ys):
-        return _steps(unit, ys)
+        return step_through(unit, ys, DT, "y_d", "v")
 
     try:
         run(y_d[:k])

@@ -35,7 +35,7 @@ from pimodel.fmu.model_fmu import cosimulate_chain
 from pimodel.fmu.unit import FMUUnit
 
 sys.path.insert(0, str(Path(__file__).parent))
-from diagnosed_unit import run_unit, unit_file  # noqa: E402
+from diagnosed_unit import run_unit, step_through, unit_file  # noqa: E402
 
 DT = 1e-3
 RADII = [0.0, 0.15, 0.4, 0.7, 1.0]
@@ -207,12 +207,7 @@ def test_unit_state_round_trip_holds_the_filter(built_fmus, fmi):
     unit = FMUUnit(unit_file(built_fmus, fmi), params)
 
     def run(xs):
-        out = []
-        for x in xs:
-            unit.set({"v": x})
-            unit.step(DT)
-            out.append(unit.get(["y"])[0])
-        return out
+        return step_through(unit, xs, DT)
 
     try:
         first = run(v[:200])
