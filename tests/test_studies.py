@@ -35,8 +35,17 @@ def _run(name, tmp_path, shared=None):
     return res
 
 
-def test_paper_simulation(tmp_path):
-    res = _run("paper_simulation", tmp_path)
+@pytest.fixture(scope="module")
+def paper_simulation_run(tmp_path_factory):
+    """``paper_simulation`` at its quick size, computed once for this file (fresh folder): its
+    numbers are checked by test_paper_simulation, its rerun from the kept cases by
+    test_sweep_study_reruns_from_its_kept_cases. Returns the output folder and the result."""
+    tmp = tmp_path_factory.mktemp("paper_simulation_run")
+    return tmp / "paper_simulation", _run("paper_simulation", tmp)
+
+
+def test_paper_simulation(paper_simulation_run):
+    res = paper_simulation_run[1]
     assert res.numbers["noise_free_max_rel_error"] < 0.01
 
 
@@ -135,15 +144,16 @@ def test_augmented_feedforward(tmp_path, quick_study_cases):
 
 
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
-def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
-    """A rerun of a sweep study loads its finished cases instead of computing them."""
+def test_sweep_study_reruns_from_its_kept_cases(paper_simulation_run, monkeypatch):
+    """A rerun of a sweep study loads its finished cases instead of computing them (the first
+    run, computed in a fresh folder, is test_paper_simulation's)."""
     from pimodel.experiments.studies import load_study
 
-    first = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    out, first = paper_simulation_run
     module = load_study("paper_simulation")
     monkeypatch.setattr("pimodel.experiments.studies.load_study", lambda name: module)
     monkeypatch.setattr(module, "run_case", lambda params: pytest.fail(f"recomputed {params}"))
-    again = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    again = run_study("paper_simulation", out, quick=True, workers=0)
     assert again.to_json() == first.to_json()
 
 
