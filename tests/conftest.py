@@ -113,3 +113,53 @@ def built_fmus(tmp_path_factory, worker_id) -> Path:
             build(out)
             done.touch()
         return out
+
+
+class QuickStudyCases:
+    """The kept cases (``OUT/cases``) of the quick sweep studies, shared by the tests that run
+    the same study at the same settings in one run.
+
+    ``tests/test_studies.py`` runs ``run_study(NAME, quick=True, workers=0)`` and the
+    docs/studies.md snippet runs ``pimodel study NAME --quick --workers 0``: the same cases
+    (each case seeds its own generators), computed twice. Whichever runs first publishes its
+    finished cases here; the other copies them into its own output folder before it runs, so
+    the study loads them (the rerun path of ``pimodel.experiments.sweeps.run_cases``) and still
+    aggregates, writes its tables and figures and is checked as before. Nothing waits: a test
+    that finds no published cases computes them itself, as it did before. A folder is published
+    whole (a temporary folder renamed), so a reader never sees half of it.
+    """
+
+    def __init__(self, root: Path):
+        self.root = root
+
+    def seed(self, name: str, cases: Path) -> bool:
+        """Copy the published cases of study ``name`` into ``cases``; False when none yet."""
+        import shutil
+
+        src = self.root / name
+        if not src.is_dir():
+            return False
+        shutil.copytree(src, cases, dirs_exist_ok=True)
+        return True
+
+    def publish(self, name: str, cases: Path) -> None:
+        """Publish the finished cases in ``cases`` of study ``name`` (the first one stays)."""
+        import shutil
+
+        dest = self.root / name
+        if dest.exists() or not cases.is_dir():
+            return
+        self.root.mkdir(parents=True, exist_ok=True)
+        tmp = self.root / f".{name}.{os.getpid()}"
+        shutil.copytree(cases, tmp)
+        try:
+            os.rename(tmp, dest)
+        except OSError:  # another worker published first
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def quick_study_cases(tmp_path_factory, worker_id) -> QuickStudyCases:
+    """The quick sweep studies' cases of this run, common to the pytest-xdist workers."""
+    base = tmp_path_factory.getbasetemp()
+    return QuickStudyCases((base if worker_id == "master" else base.parent) / "quick_study_cases")

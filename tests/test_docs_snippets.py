@@ -7,6 +7,13 @@ this interpreter's ``bin/`` first on PATH, so ``pimodel ...`` is the installed c
 A block is skipped only when the line before its fence is ``<!-- no-run: REASON -->``; the
 reason is shown in the page (raw Markdown) and checked to be present here.
 Other fences (```text, ```json, ...) are not run.
+
+A quick sweep study a page runs (``pimodel study NAME --quick ... --out DIR``, e.g. in
+docs/studies.md) is the one ``tests/test_studies.py`` runs at the same settings: the finished
+cases of whichever ran first in this run are copied into ``DIR/cases`` before the page runs
+(``quick_study_cases`` in conftest.py), so the command loads them instead of computing them a
+second time; it still aggregates and writes its results and figures, and with no cases yet it
+computes them itself and publishes them.
 """
 
 from __future__ import annotations
@@ -110,6 +117,23 @@ def test_relative_links_resolve():
     assert not broken, broken
 
 
+QUICK_STUDY = re.compile(r"^\s*pimodel study (\w+)\b[^\n#]*?--quick\b[^\n#]*?--out (\S+)", re.M)
+
+
+def quick_studies(blocks: list[Block]) -> list[tuple[str, str]]:
+    """``(NAME, DIR)`` of every ``pimodel study NAME --quick ... --out DIR`` the blocks run."""
+    return [m.groups() for b in blocks if b.lang == "bash" and b.no_run is None
+            for m in QUICK_STUDY.finditer(b.code)]
+
+
+def test_quick_studies_are_found():
+    # guards the sharing of the studies' cases: the page's quick sweeps are recognised
+    found = dict(quick_studies(runnable(DOCS / "studies.md")))
+    assert found.get("convergence_map") == "out/convergence_map"
+    assert found.get("augmented_feedforward") == "out/augmented_feedforward"
+    assert "all" not in found  # the no-run block's `pimodel study all --quick` is not run
+
+
 def _run_bash(block: Block, cwd: Path) -> None:
     env = dict(os.environ, MPLBACKEND="Agg")
     env["PATH"] = str(Path(sys.executable).parent) + os.pathsep + env.get("PATH", "")
@@ -122,11 +146,14 @@ def _run_bash(block: Block, cwd: Path) -> None:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("page", doc_pages(), ids=lambda p: str(p.relative_to(ROOT)))
-def test_page_code_runs(page, tmp_path, monkeypatch):
+def test_page_code_runs(page, tmp_path, monkeypatch, quick_study_cases):
     import matplotlib
 
     matplotlib.use("Agg")
     monkeypatch.chdir(tmp_path)
+    studies = quick_studies(runnable(page))
+    for name, out in studies:
+        quick_study_cases.seed(name, tmp_path / out / "cases")
     namespace: dict = {"__name__": "__docs__"}
     for block in runnable(page):
         if block.no_run is not None:
@@ -137,3 +164,5 @@ def test_page_code_runs(page, tmp_path, monkeypatch):
             exec(compile(code, str(block.page), "exec"), namespace)  # noqa: S102
         else:
             _run_bash(block, tmp_path)
+    for name, out in studies:
+        quick_study_cases.publish(name, tmp_path / out / "cases")

@@ -19,17 +19,33 @@ def test_all_studies_are_listed():
                                         "convergence_map", "augmented_feedforward"}
 
 
-def _run(name, tmp_path):
-    res = run_study(name, tmp_path / name, quick=True, workers=0)
+def _run(name, tmp_path, shared=None):
+    """Run study ``name`` quick and serially into ``tmp_path/name``. With ``shared`` (the
+    ``quick_study_cases`` fixture) the cases another test of this run computed at the same
+    settings are loaded instead of computed again, and ours are published for the others."""
     out = tmp_path / name
+    if shared is not None:
+        shared.seed(name, out / "cases")
+    res = run_study(name, out, quick=True, workers=0)
+    if shared is not None:
+        shared.publish(name, out / "cases")
     assert (out / "results.md").exists() and (out / "results.json").exists()
     for fig in res.figures:
         assert fig.exists() and fig.stat().st_size > 10_000  # a real PNG, not an empty canvas
     return res
 
 
-def test_paper_simulation(tmp_path):
-    res = _run("paper_simulation", tmp_path)
+@pytest.fixture(scope="module")
+def paper_simulation_run(tmp_path_factory):
+    """``paper_simulation`` at its quick size, computed once for this file (fresh folder): its
+    numbers are checked by test_paper_simulation, its rerun from the kept cases by
+    test_sweep_study_reruns_from_its_kept_cases. Returns the output folder and the result."""
+    tmp = tmp_path_factory.mktemp("paper_simulation_run")
+    return tmp / "paper_simulation", _run("paper_simulation", tmp)
+
+
+def test_paper_simulation(paper_simulation_run):
+    res = paper_simulation_run[1]
     assert res.numbers["noise_free_max_rel_error"] < 0.01
 
 
@@ -97,14 +113,14 @@ def test_sim_to_real(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_augmented_feedforward(tmp_path):
+def test_augmented_feedforward(tmp_path, quick_study_cases):
     """Quick size: every case gives a complete table row with finite errors, the figure is
     written, and on ``pimodel.stages.pi_stage`` the augmented inverse tracks better than the nominal
     one
     (open loop) wherever the verdict names asymmetry or creep."""
     from pimodel.experiments.studies import load_study
 
-    res = _run("augmented_feedforward", tmp_path)
+    res = _run("augmented_feedforward", tmp_path, quick_study_cases)
     out = tmp_path / "augmented_feedforward"
     assert (out / "augmented_feedforward.png").exists()
     stage_cases = [c for c in load_study("augmented_feedforward").cases(True)
@@ -128,15 +144,16 @@ def test_augmented_feedforward(tmp_path):
 
 
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
-def test_sweep_study_reruns_from_its_kept_cases(tmp_path, monkeypatch):
-    """A rerun of a sweep study loads its finished cases instead of computing them."""
+def test_sweep_study_reruns_from_its_kept_cases(paper_simulation_run, monkeypatch):
+    """A rerun of a sweep study loads its finished cases instead of computing them (the first
+    run, computed in a fresh folder, is test_paper_simulation's)."""
     from pimodel.experiments.studies import load_study
 
-    first = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    out, first = paper_simulation_run
     module = load_study("paper_simulation")
     monkeypatch.setattr("pimodel.experiments.studies.load_study", lambda name: module)
     monkeypatch.setattr(module, "run_case", lambda params: pytest.fail(f"recomputed {params}"))
-    again = run_study("paper_simulation", tmp_path, quick=True, workers=0)
+    again = run_study("paper_simulation", out, quick=True, workers=0)
     assert again.to_json() == first.to_json()
 
 
@@ -198,10 +215,10 @@ def test_limit_cycle(tmp_path):
 
 
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
-def test_convergence_map(tmp_path):
+def test_convergence_map(tmp_path, quick_study_cases):
     """Quick grid (1 kHz, 60 s): every clean cell, from every start (up to 6x the truth, all
     zero, all equal) and on every input, is within 10 % after 60 s (the full size, 150 s,
     reaches 0.06 %)."""
-    res = _run("convergence_map", tmp_path)
+    res = _run("convergence_map", tmp_path, quick_study_cases)
     assert res.numbers["cases"] == 7 * 4 * 4
     assert res.numbers["clean_worst"] < 0.10
