@@ -411,9 +411,15 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
     # the pool lent to this thread too: its passes over long records read their next chunk of
     # play outputs on an idle thread (module threads)
+    progress = progress or (lambda message: None)
     with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
-        return _diagnose(train, validate, max_effects, initial_state,
-                         progress or (lambda message: None), pool)
+        rep = _diagnose(train, validate, max_effects, initial_state, progress, pool)
+        choice = rep.nominal.get("initial_state_choice")
+        if choice is None or not choice["in_question"] or choice["chosen"] != "rest":
+            return rep
+        progress("the start in question: the diagnosis without the start-ups")
+        return _final_start(rep, _diagnose(train, validate, max_effects, "unknown", progress,
+                                           pool), validate)
 
 
 def _mask(r: Record, initial_state: str) -> np.ndarray | None:
@@ -605,7 +611,9 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
               "limits": {"post_startup_ratio": START_POST_GAIN, "startup_ratio": START_EXCESS,
                          "free_over_noise": NOISE_STOP}}
     state = "rest"
-    if post_rest > START_POST_GAIN * post_free or su_rest > START_EXCESS * post_rest:
+    choice["in_question"] = bool(post_rest > START_POST_GAIN * post_free or
+                                 su_rest > START_EXCESS * post_rest)
+    if choice["in_question"]:
         noise = measure_noise_floor([(s.v, s.y) for sc in screens for s in sc],
                                     [o for out in outputs["unknown"] for o in out])["value"]
         choice["free_over_noise"] = float(np.sqrt(post_free)) / noise if noise > 0 else None
@@ -613,6 +621,32 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
             state = "unknown"
     choice["chosen"] = state
     return state, choice, picks[state]
+
+
+def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
+                 validate: list[Record]) -> DiagnosisReport:
+    """``initial_state="auto"`` with the start in question but not explained by the nominal
+    alone (:func:`_auto_start`): an effect may leave the nominal without the start-ups above
+    the noise while the start still spoils the fit from rest. Both diagnoses are made; the
+    one without the start-ups is kept when the model the rest diagnosis chose predicts
+    validate after its start-up regions (the samples both score) with more than
+    ``START_POST_GAIN`` times the mean squared misfit of the model chosen without them. A
+    stage started at rest gives both chosen models alike there (the ratio near 1)."""
+    post = []
+    for rep in (rest, unknown):
+        res = [s.y - o for s, o in zip(rep.validate, rep.after, strict=True)]
+        k = [min(startup_length(r.v), e.size) for r, e in zip(validate, res, strict=True)]
+        tail = np.concatenate([e[j:] for e, j in zip(res, k, strict=True)])
+        post.append(float(np.mean(np.square(tail))) if tail.size else 0.0)
+    choice = rest.nominal["initial_state_choice"]
+    ratio = post[0] / post[1] if post[1] > 0 else None
+    choice["final_post_startup_ratio"] = ratio
+    choice["limits"]["final_post_startup_ratio"] = START_POST_GAIN
+    if ratio is None or ratio <= START_POST_GAIN:
+        return rest
+    choice["chosen"] = "unknown"
+    unknown.nominal["initial_state_choice"] = choice
+    return unknown
 
 
 def _one_above(train, validate, initial_state: str, half, extended, n_train: int):
