@@ -124,6 +124,9 @@ START_POST_GAIN = 3.0  # "auto": unknown when the start-up fitted as at rest mak
 # mispredict validate after its start-up this many times worse (mean square) than without it,
 START_EXCESS = 10.0  # ... or leaves validate's start-up with this many times the mean squared
 # misfit of the rest of the record (_auto_start)
+START_LIKE = ("creep", "drift", "unexplained")  # "auto": verdicts from rest that a wrong start
+# can give (a start-up misfit taken for slow motion, or left unexplained): the diagnosis without
+# the start-ups is made too and compared (_final_start)
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
@@ -415,7 +418,8 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
         rep = _diagnose(train, validate, max_effects, initial_state, progress, pool)
         choice = rep.nominal.get("initial_state_choice")
-        if choice is None or not choice["in_question"] or choice["chosen"] != "rest":
+        if choice is None or choice["chosen"] != "rest" or not (
+                choice["in_question"] or set(rep.verdict["effects"]).intersection(START_LIKE)):
             return rep
         progress("the start in question: the diagnosis without the start-ups")
         return _final_start(rep, _diagnose(train, validate, max_effects, "unknown", progress,
@@ -625,26 +629,43 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
 
 def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
                  validate: list[Record]) -> DiagnosisReport:
-    """``initial_state="auto"`` with the start in question but not explained by the nominal
-    alone (:func:`_auto_start`): an effect may leave the nominal without the start-ups above
-    the noise while the start still spoils the fit from rest. Both diagnoses are made; the
-    one without the start-ups is kept when the model the rest diagnosis chose predicts
-    validate after its start-up regions (the samples both score) with more than
-    ``START_POST_GAIN`` times the mean squared misfit of the model chosen without them. A
-    stage started at rest gives both chosen models alike there (the ratio near 1)."""
+    """``initial_state="auto"``, the second look: with the start in question but not explained
+    by the nominal alone (:func:`_auto_start`: an effect keeps the nominal without the
+    start-ups above the noise), or with a verdict from rest among ``START_LIKE`` (a misfit in
+    the start-ups that a wrong start gives, taken for creep or drift or left unexplained), the
+    diagnosis without the start-ups (``"unknown"``) has been made too. Both chosen models
+    predict validate after its start-up regions (the samples both score; mean squared misfits
+    ``post``). The diagnosis without the start-ups is kept when
+
+    - the rest one's ``post`` exceeds ``START_POST_GAIN`` times its ``post`` (the start spoiled
+      the fit from rest beyond what the effects mend), or
+    - it names fewer effects (its effects, ``"unexplained"`` included, a strict subset of the
+      rest verdict's) and the rest one's extra effects do not cut the RMS after the start-ups
+      by ``MIN_RMS_CUT`` (``post`` ratio above ``(1 - MIN_RMS_CUT)**2``): they fitted the
+      start-ups alone.
+
+    Else the rest diagnosis is kept: a stage started at rest gives both chosen models alike
+    after the start-ups, and effects that show there are kept from rest. The figures are in
+    ``nominal["initial_state_choice"]["second_look"]``."""
     post = []
     for rep in (rest, unknown):
         res = [s.y - o for s, o in zip(rep.validate, rep.after, strict=True)]
         k = [min(startup_length(r.v), e.size) for r, e in zip(validate, res, strict=True)]
         tail = np.concatenate([e[j:] for e, j in zip(res, k, strict=True)])
         post.append(float(np.mean(np.square(tail))) if tail.size else 0.0)
-    choice = rest.nominal["initial_state_choice"]
+    named = [set(rep.verdict["effects"]) - {"none"} for rep in (rest, unknown)]
     ratio = post[0] / post[1] if post[1] > 0 else None
-    choice["final_post_startup_ratio"] = ratio
-    choice["limits"]["final_post_startup_ratio"] = START_POST_GAIN
-    if ratio is None or ratio <= START_POST_GAIN:
+    fewer = named[1] < named[0]
+    choice = rest.nominal["initial_state_choice"]
+    choice["second_look"] = {"unknown_effects": list(unknown.verdict["effects"]),
+                             "post_startup_ratio": ratio, "fewer_effects": fewer,
+                             "limits": {"post_startup_ratio": START_POST_GAIN,
+                                        "fewer_effects_ratio": (1 - MIN_RMS_CUT) ** 2}}
+    if ratio is None or not (ratio > START_POST_GAIN or
+                             (fewer and ratio > (1 - MIN_RMS_CUT) ** 2)):
         return rest
     choice["chosen"] = "unknown"
+    choice["second_look"]["rest_effects"] = list(rest.verdict["effects"])
     unknown.nominal["initial_state_choice"] = choice
     return unknown
 
