@@ -166,8 +166,9 @@ def hints(rep) -> list[str]:
                       "start-ups" if ratio > second["limits"]["post_startup_ratio"] else
                       "no better than the one without the start-ups, which names fewer "
                       "effects")]
-        out.append("the records do not all start at rest: fitted from rest, "
-                   f"{'the nominal left ' if second is None else ''}{' and '.join(why)}, so "
+        out.append("the records do not all start at rest: "
+                   f"{'fitted from rest, the nominal left ' if second is None else ''}"
+                   f"{' and '.join(why)}, so "
                    "each record's start-up region was left out (initial_state 'auto' chose "
                    "'unknown'); to model the start too, record from a known rest (a hold, then "
                    "a ramp from it)")
