@@ -124,9 +124,10 @@ START_POST_GAIN = 3.0  # "auto": unknown when the start-up fitted as at rest mak
 # mispredict validate after its start-up this many times worse (mean square) than without it,
 START_EXCESS = 10.0  # ... or leaves validate's start-up with this many times the mean squared
 # misfit of the rest of the record (_auto_start)
-START_LIKE = ("creep", "drift", "unexplained")  # "auto": verdicts from rest that a wrong start
-# can give (a start-up misfit taken for slow motion, or left unexplained): the diagnosis without
-# the start-ups is made too and compared (_final_start)
+START_SLOW = ("creep", "drift")  # "auto": effects that a wrong start's misfit in the start-ups
+# can be taken for; with one of them named from rest and the start-ups misfitted more densely
+# than the rest of validate, or with a gap left unexplained, the diagnosis without the start-ups
+# is made too and compared (_second_look, _final_start)
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
@@ -356,9 +357,13 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         is unknown; the start-up region (until the input first spans 90 % of the record's
         range) is left out of fitting and scoring. ``"auto"`` (default): ``"unknown"`` when the
         data contradict a start at rest (:func:`_auto_start`: the nominal fitted with the
-        start-up mispredicts the rest of validate, or validate's own start-up, by far), else
-        ``"rest"``; the choice and its figures are in ``report.nominal["initial_state"]`` and
-        ``["initial_state_choice"]``.
+        start-up mispredicts the rest of validate, or validate's own start-up, by far, and
+        without the start-ups it is at the noise), else ``"rest"``; where a start at rest
+        stays in doubt (the start in question, a gap left unexplained, or creep or drift
+        named with the start-ups misfitted most), both diagnoses are made and the one
+        without the start-ups kept when it predicts validate after them far better, or as well
+        with fewer effects (:func:`_final_start`). The choice and its figures are in
+        ``report.nominal["initial_state"]`` and ``["initial_state_choice"]``.
     progress : callable or None
         Called with a short message (``"candidate creep (1/6)"``) as each stage of the
         diagnosis starts (for a progress line on long records); None: silent.
@@ -418,8 +423,8 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
         rep = _diagnose(train, validate, max_effects, initial_state, progress, pool)
         choice = rep.nominal.get("initial_state_choice")
-        if choice is None or choice["chosen"] != "rest" or not (
-                choice["in_question"] or set(rep.verdict["effects"]).intersection(START_LIKE)):
+        if choice is None or choice["chosen"] != "rest" or not _second_look(choice,
+                                                                              rep.verdict):
             return rep
         progress("the start in question: the diagnosis without the start-ups")
         return _final_start(rep, _diagnose(train, validate, max_effects, "unknown", progress,
@@ -627,12 +632,22 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
     return state, choice, picks[state]
 
 
+def _second_look(choice: dict, verdict: dict) -> bool:
+    """Whether ``"auto"``, having kept ``"rest"``, makes the diagnosis without the start-ups
+    too (:func:`_final_start`): the start in question (:func:`_auto_start`), a gap left
+    unexplained, or an effect of ``START_SLOW`` named while the rest nominal misfits
+    validate's start-ups more densely (mean square) than the rest of validate."""
+    slow = set(verdict["effects"]).intersection(START_SLOW)
+    return bool(choice["in_question"] or "unexplained" in verdict["effects"] or
+                (slow and (choice["startup_ratio"] or 0.0) > 1.0))
+
+
 def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
                  validate: list[Record]) -> DiagnosisReport:
-    """``initial_state="auto"``, the second look: with the start in question but not explained
-    by the nominal alone (:func:`_auto_start`: an effect keeps the nominal without the
-    start-ups above the noise), or with a verdict from rest among ``START_LIKE`` (a misfit in
-    the start-ups that a wrong start gives, taken for creep or drift or left unexplained), the
+    """``initial_state="auto"``, the second look (:func:`_second_look`): with the start in
+    question but not explained by the nominal alone (:func:`_auto_start`: an effect keeps the
+    nominal without the start-ups above the noise), or with a verdict from rest that a misfit
+    of a wrong start in the start-ups can give (creep or drift, or a gap left unexplained), the
     diagnosis without the start-ups (``"unknown"``) has been made too. Both chosen models
     predict validate after its start-up regions (the samples both score; mean squared misfits
     ``post``). The diagnosis without the start-ups is kept when
