@@ -125,9 +125,8 @@ START_POST_GAIN = 3.0  # "auto": unknown when the start-up fitted as at rest mak
 START_EXCESS = 10.0  # ... or leaves validate's start-up with this many times the mean squared
 # misfit of the rest of the record (_auto_start)
 START_SLOW = ("creep", "drift")  # "auto": effects that a wrong start's misfit in the start-ups
-# can be taken for; with one of them named from rest and the start-ups misfitted more densely
-# than the rest of validate, or with a gap left unexplained, the diagnosis without the start-ups
-# is made too and compared (_second_look, _final_start)
+# can be taken for: named from rest, the diagnosis without the start-ups may be made too and
+# compared (_second_look, _final_start)
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
@@ -423,12 +422,13 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
         rep = _diagnose(train, validate, max_effects, initial_state, progress, pool)
         choice = rep.nominal.get("initial_state_choice")
-        if choice is None or choice["chosen"] != "rest" or not _second_look(choice,
-                                                                              rep.verdict):
+        look = 0 if choice is None or choice["chosen"] != "rest" else \
+            _second_look(choice, rep.verdict, max_effects)
+        if not look:
             return rep
-        progress("the start in question: the diagnosis without the start-ups")
-        return _final_start(rep, _diagnose(train, validate, max_effects, "unknown", progress,
-                                           pool), validate)
+        progress("a start at rest in doubt: the diagnosis without the start-ups")
+        return _final_start(rep, _diagnose(train, validate, look, "unknown", progress, pool),
+                            validate)
 
 
 def _mask(r: Record, initial_state: str) -> np.ndarray | None:
@@ -632,14 +632,22 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
     return state, choice, picks[state]
 
 
-def _second_look(choice: dict, verdict: dict) -> bool:
+def _second_look(choice: dict, verdict: dict, max_effects: int) -> int:
     """Whether ``"auto"``, having kept ``"rest"``, makes the diagnosis without the start-ups
-    too (:func:`_final_start`): the start in question (:func:`_auto_start`), a gap left
-    unexplained, or an effect of ``START_SLOW`` named while the rest nominal misfits
-    validate's start-ups more densely (mean square) than the rest of validate."""
-    slow = set(verdict["effects"]).intersection(START_SLOW)
-    return bool(choice["in_question"] or "unexplained" in verdict["effects"] or
-                (slow and (choice["startup_ratio"] or 0.0) > 1.0))
+    too (:func:`_final_start`), and with how many effects at most (0: not made).
+
+    ``max_effects`` when the start is in question (:func:`_auto_start`), a gap is left
+    unexplained, or an effect of ``START_SLOW`` is named while the rest nominal misfits
+    validate's start-ups more densely (mean square) than the rest of validate; one effect
+    fewer than the rest verdict named when it names one of ``START_SLOW`` beside others (can
+    fewer effects do without the start-ups? a wrong start's misfit in them is taken for creep
+    beside the true effect on stages that are not at rest, the Preisach generator's); else 0."""
+    named = [e for e in verdict["effects"] if e != "none"]
+    slow = set(named).intersection(START_SLOW)
+    if choice["in_question"] or "unexplained" in named or (
+            slow and (choice["startup_ratio"] or 0.0) > 1.0):
+        return max_effects
+    return len(named) - 1 if slow and len(named) > 1 else 0
 
 
 def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
@@ -648,7 +656,8 @@ def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
     question but not explained by the nominal alone (:func:`_auto_start`: an effect keeps the
     nominal without the start-ups above the noise), or with a verdict from rest that a misfit
     of a wrong start in the start-ups can give (creep or drift, or a gap left unexplained), the
-    diagnosis without the start-ups (``"unknown"``) has been made too. Both chosen models
+    diagnosis without the start-ups (``"unknown"``, with at most the effects
+    :func:`_second_look` allows) has been made too. Both chosen models
     predict validate after its start-up regions (the samples both score; mean squared misfits
     ``post``). The diagnosis without the start-ups is kept when
 
