@@ -422,9 +422,9 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
     with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
         rep = _diagnose(train, validate, max_effects, initial_state, progress, pool)
         choice = rep.nominal.get("initial_state_choice")
-        look = 0 if choice is None or choice["chosen"] != "rest" else \
+        look = None if choice is None or choice["chosen"] != "rest" else \
             _second_look(choice, rep.verdict, max_effects)
-        if not look:
+        if look is None:
             return rep
         progress("a start at rest in doubt: the diagnosis without the start-ups")
         return _final_start(rep, _diagnose(train, validate, look, "unknown", progress, pool),
@@ -632,22 +632,26 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
     return state, choice, picks[state]
 
 
-def _second_look(choice: dict, verdict: dict, max_effects: int) -> int:
+def _second_look(choice: dict, verdict: dict, max_effects: int) -> int | None:
     """Whether ``"auto"``, having kept ``"rest"``, makes the diagnosis without the start-ups
-    too (:func:`_final_start`), and with how many effects at most (0: not made).
+    too (:func:`_final_start`), and with how many effects at most (None: not made).
 
-    ``max_effects`` when the start is in question (:func:`_auto_start`), a gap is left
-    unexplained, or an effect of ``START_SLOW`` is named while the rest nominal misfits
-    validate's start-ups more densely (mean square) than the rest of validate; one effect
-    fewer than the rest verdict named when it names one of ``START_SLOW`` beside others (can
-    fewer effects do without the start-ups? a wrong start's misfit in them is taken for creep
-    beside the true effect on stages that are not at rest, the Preisach generator's); else 0."""
-    named = [e for e in verdict["effects"] if e != "none"]
+    - ``max_effects`` when the start is in question (:func:`_auto_start`) or an effect of
+      ``START_SLOW`` is named while the rest nominal misfits validate's start-ups more densely
+      (mean square) than the rest of validate;
+    - as many effects as the rest verdict named when it left a gap ``unexplained`` (can they
+      do without the start-ups?);
+    - one fewer when it names one of ``START_SLOW`` beside others (on stages that are not at
+      rest, the Preisach generator's, a wrong start's misfit in the start-ups is taken for
+      creep beside the true effect);
+    - else None. The caps keep the second diagnosis to what could replace the first."""
+    named = [e for e in verdict["effects"] if e not in ("none", "unexplained")]
     slow = set(named).intersection(START_SLOW)
-    if choice["in_question"] or "unexplained" in named or (
-            slow and (choice["startup_ratio"] or 0.0) > 1.0):
+    if choice["in_question"] or (slow and (choice["startup_ratio"] or 0.0) > 1.0):
         return max_effects
-    return len(named) - 1 if slow and len(named) > 1 else 0
+    if "unexplained" in verdict["effects"]:
+        return len(named)
+    return len(named) - 1 if slow and len(named) > 1 else None
 
 
 def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
