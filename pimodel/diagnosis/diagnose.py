@@ -666,7 +666,8 @@ def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
     ``post``). The diagnosis without the start-ups is kept when
 
     - the rest one's ``post`` exceeds ``START_POST_GAIN`` times its ``post`` (the start spoiled
-      the fit from rest beyond what the effects mend), or
+      the fit from rest beyond what the effects mend) and it names no more effects (else the
+      gain may be its extra effects', not the start's), or
     - it names fewer effects (its effects, ``"unexplained"`` included, a strict subset of the
       rest verdict's) and the rest one's extra effects do not cut the RMS after the start-ups
       by ``MIN_RMS_CUT`` (``post`` ratio above ``(1 - MIN_RMS_CUT)**2``): they fitted the
@@ -684,12 +685,14 @@ def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
     named = [set(rep.verdict["effects"]) - {"none"} for rep in (rest, unknown)]
     ratio = post[0] / post[1] if post[1] > 0 else None
     fewer = named[1] < named[0]
+    more = len(named[1] - {"unexplained"}) > len(named[0] - {"unexplained"})
     choice = rest.nominal["initial_state_choice"]
     choice["second_look"] = {"unknown_effects": list(unknown.verdict["effects"]),
                              "post_startup_ratio": ratio, "fewer_effects": fewer,
+                             "more_effects": more,
                              "limits": {"post_startup_ratio": START_POST_GAIN,
                                         "fewer_effects_ratio": (1 - MIN_RMS_CUT) ** 2}}
-    if ratio is None or not (ratio > START_POST_GAIN or
+    if ratio is None or not ((ratio > START_POST_GAIN and not more) or
                              (fewer and ratio > (1 - MIN_RMS_CUT) ** 2)):
         return rest
     choice["chosen"] = "unknown"
