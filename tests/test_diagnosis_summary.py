@@ -92,6 +92,27 @@ def test_an_auto_start_left_out_is_said_with_its_reason():
     assert not any("do not all start at rest" in h for h in hints(_report(choice=rest)))
 
 
+def test_start_hint_after_the_second_look_says_which_rule_chose():
+    """``initial_state="auto"`` decided by the two diagnoses (diagnose._final_start): the hint
+    names the rest verdict and whether its model mispredicted after the start-ups or named
+    more effects for no gain there."""
+    limits = {"post_startup_ratio": 3.0, "startup_ratio": 10.0}
+    look = {"unknown_effects": ["delay"], "rest_effects": ["delay", "unexplained"],
+            "post_startup_ratio": 4.08, "fewer_effects": True,
+            "limits": {"post_startup_ratio": 3.0, "fewer_effects_ratio": 0.64}}
+    choice = {"asked": "auto", "chosen": "unknown", "post_startup_ratio": 1.03,
+              "startup_ratio": 3.4, "limits": limits, "second_look": look}
+    said = [h for h in hints(_report(("delay",), initial_state="unknown", choice=choice))
+            if "do not all start at rest" in h]
+    assert len(said) == 1 and "(delay, unexplained)" in said[0] and "4.08 times worse" in said[0]
+    assert "the nominal left" not in said[0]
+    fewer = dict(choice, second_look=dict(look, post_startup_ratio=1.02))
+    said = [h for h in hints(_report(("delay",), initial_state="unknown", choice=fewer))
+            if "do not all start at rest" in h]
+    assert len(said) == 1 and "no better than the one without the start-ups" in said[0]
+    assert "times worse" not in said[0]
+
+
 def test_alternatives_and_unexplained_lower_the_confidence():
     alt = _report(("delay",), alternatives=("rate",))
     level, why = confidence(alt)

@@ -124,6 +124,9 @@ START_POST_GAIN = 3.0  # "auto": unknown when the start-up fitted as at rest mak
 # mispredict validate after its start-up this many times worse (mean square) than without it,
 START_EXCESS = 10.0  # ... or leaves validate's start-up with this many times the mean squared
 # misfit of the rest of the record (_auto_start)
+START_SLOW = ("creep", "drift")  # "auto": effects that a wrong start's misfit in the start-ups
+# can be taken for: named from rest, the diagnosis without the start-ups may be made too and
+# compared (_second_look, _final_start)
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
@@ -353,9 +356,13 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
         is unknown; the start-up region (until the input first spans 90 % of the record's
         range) is left out of fitting and scoring. ``"auto"`` (default): ``"unknown"`` when the
         data contradict a start at rest (:func:`_auto_start`: the nominal fitted with the
-        start-up mispredicts the rest of validate, or validate's own start-up, by far), else
-        ``"rest"``; the choice and its figures are in ``report.nominal["initial_state"]`` and
-        ``["initial_state_choice"]``.
+        start-up mispredicts the rest of validate, or validate's own start-up, by far, and
+        without the start-ups it is at the noise), else ``"rest"``; where a start at rest
+        stays in doubt (the start in question, a gap left unexplained, or creep or drift
+        named with the start-ups misfitted most), both diagnoses are made and the one
+        without the start-ups kept when it predicts validate after them far better, or as well
+        with fewer effects (:func:`_final_start`). The choice and its figures are in
+        ``report.nominal["initial_state"]`` and ``["initial_state_choice"]``.
     progress : callable or None
         Called with a short message (``"candidate creep (1/6)"``) as each stage of the
         diagnosis starts (for a progress line on long records); None: silent.
@@ -411,9 +418,17 @@ def diagnose(train: list[Record], validate: list[Record], *, max_effects: int = 
                       "gap is a training fit, not a test", UserWarning, stacklevel=2)
     # the pool lent to this thread too: its passes over long records read their next chunk of
     # play outputs on an idle thread (module threads)
+    progress = progress or (lambda message: None)
     with threadpool_limits(1, user_api="blas"), Pool(int(workers)) as pool, lend(pool):
-        return _diagnose(train, validate, max_effects, initial_state,
-                         progress or (lambda message: None), pool)
+        rep = _diagnose(train, validate, max_effects, initial_state, progress, pool)
+        choice = rep.nominal.get("initial_state_choice")
+        look = None if choice is None or choice["chosen"] != "rest" else \
+            _second_look(choice, rep.verdict, max_effects)
+        if look is None:
+            return rep
+        progress("a start at rest in doubt: the diagnosis without the start-ups")
+        return _final_start(rep, _diagnose(train, validate, look, "unknown", progress, pool),
+                            validate)
 
 
 def _mask(r: Record, initial_state: str) -> np.ndarray | None:
@@ -605,7 +620,9 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
               "limits": {"post_startup_ratio": START_POST_GAIN, "startup_ratio": START_EXCESS,
                          "free_over_noise": NOISE_STOP}}
     state = "rest"
-    if post_rest > START_POST_GAIN * post_free or su_rest > START_EXCESS * post_rest:
+    choice["in_question"] = bool(post_rest > START_POST_GAIN * post_free or
+                                 su_rest > START_EXCESS * post_rest)
+    if choice["in_question"]:
         noise = measure_noise_floor([(s.v, s.y) for sc in screens for s in sc],
                                     [o for out in outputs["unknown"] for o in out])["value"]
         choice["free_over_noise"] = float(np.sqrt(post_free)) / noise if noise > 0 else None
@@ -613,6 +630,75 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
             state = "unknown"
     choice["chosen"] = state
     return state, choice, picks[state]
+
+
+def _second_look(choice: dict, verdict: dict, max_effects: int) -> int | None:
+    """Whether ``"auto"``, having kept ``"rest"``, makes the diagnosis without the start-ups
+    too (:func:`_final_start`), and with how many effects at most (None: not made).
+
+    - ``max_effects`` when the start is in question (:func:`_auto_start`) or an effect of
+      ``START_SLOW`` is named while the rest nominal misfits validate's start-ups more densely
+      (mean square) than the rest of validate;
+    - as many effects as the rest verdict named when it left a gap ``unexplained`` (can they
+      do without the start-ups?);
+    - one fewer when it names one of ``START_SLOW`` beside others (on stages that are not at
+      rest, the Preisach generator's, a wrong start's misfit in the start-ups is taken for
+      creep beside the true effect);
+    - else None. The caps keep the second diagnosis to what could replace the first."""
+    named = [e for e in verdict["effects"] if e not in ("none", "unexplained")]
+    slow = set(named).intersection(START_SLOW)
+    if choice["in_question"] or (slow and (choice["startup_ratio"] or 0.0) > 1.0):
+        return max_effects
+    if "unexplained" in verdict["effects"]:
+        return len(named)
+    return len(named) - 1 if slow and len(named) > 1 else None
+
+
+def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
+                 validate: list[Record]) -> DiagnosisReport:
+    """``initial_state="auto"``, the second look (:func:`_second_look`): with the start in
+    question but not explained by the nominal alone (:func:`_auto_start`: an effect keeps the
+    nominal without the start-ups above the noise), or with a verdict from rest that a misfit
+    of a wrong start in the start-ups can give (creep or drift, or a gap left unexplained), the
+    diagnosis without the start-ups (``"unknown"``, with at most the effects
+    :func:`_second_look` allows) has been made too. Both chosen models
+    predict validate after its start-up regions (the samples both score; mean squared misfits
+    ``post``). The diagnosis without the start-ups is kept when
+
+    - the rest one's ``post`` exceeds ``START_POST_GAIN`` times its ``post`` (the start spoiled
+      the fit from rest beyond what the effects mend) and it names no more effects (else the
+      gain may be its extra effects', not the start's), or
+    - it names fewer effects (its effects, ``"unexplained"`` included, a strict subset of the
+      rest verdict's) and the rest one's extra effects do not cut the RMS after the start-ups
+      by ``MIN_RMS_CUT`` (``post`` ratio above ``(1 - MIN_RMS_CUT)**2``): they fitted the
+      start-ups alone.
+
+    Else the rest diagnosis is kept: a stage started at rest gives both chosen models alike
+    after the start-ups, and effects that show there are kept from rest. The figures are in
+    ``nominal["initial_state_choice"]["second_look"]``."""
+    post = []
+    for rep in (rest, unknown):
+        res = [s.y - o for s, o in zip(rep.validate, rep.after, strict=True)]
+        k = [min(startup_length(r.v), e.size) for r, e in zip(validate, res, strict=True)]
+        tail = np.concatenate([e[j:] for e, j in zip(res, k, strict=True)])
+        post.append(float(np.mean(np.square(tail))) if tail.size else 0.0)
+    named = [set(rep.verdict["effects"]) - {"none"} for rep in (rest, unknown)]
+    ratio = post[0] / post[1] if post[1] > 0 else None
+    fewer = named[1] < named[0]
+    more = len(named[1] - {"unexplained"}) > len(named[0] - {"unexplained"})
+    choice = rest.nominal["initial_state_choice"]
+    choice["second_look"] = {"unknown_effects": list(unknown.verdict["effects"]),
+                             "post_startup_ratio": ratio, "fewer_effects": fewer,
+                             "more_effects": more,
+                             "limits": {"post_startup_ratio": START_POST_GAIN,
+                                        "fewer_effects_ratio": (1 - MIN_RMS_CUT) ** 2}}
+    if ratio is None or not ((ratio > START_POST_GAIN and not more) or
+                             (fewer and ratio > (1 - MIN_RMS_CUT) ** 2)):
+        return rest
+    choice["chosen"] = "unknown"
+    choice["second_look"]["rest_effects"] = list(rest.verdict["effects"])
+    unknown.nominal["initial_state_choice"] = choice
+    return unknown
 
 
 def _one_above(train, validate, initial_state: str, half, extended, n_train: int):

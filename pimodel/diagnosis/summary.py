@@ -156,10 +156,22 @@ def hints(rep) -> list[str]:
                if over["post_startup_ratio"] else "",
                f"{choice['startup_ratio']:.3g} times as much misfit in validate's start-up as "
                "after it" if over["startup_ratio"] else ""]
-        out.append("the records do not all start at rest: fitted from rest, the nominal left "
-                   f"{' and '.join(w for w in why if w)}, so each record's start-up region "
-                   "was left out (initial_state 'auto' chose 'unknown'); to model the start "
-                   "too, record from a known rest (a hold, then a ramp from it)")
+        why = [w for w in why if w]
+        second = choice.get("second_look")
+        if second is not None:  # decided by the two diagnoses (diagnose._final_start)
+            rest = ", ".join(second.get("rest_effects", []))
+            ratio = second["post_startup_ratio"]
+            why = [f"the diagnosis from rest ({rest}) predicts validate after its start-up "
+                   + (f"{ratio:.3g} times worse (mean square) than the one without the "
+                      "start-ups" if ratio > second["limits"]["post_startup_ratio"] else
+                      "no better than the one without the start-ups, which names fewer "
+                      "effects")]
+        out.append("the records do not all start at rest: "
+                   f"{'fitted from rest, the nominal left ' if second is None else ''}"
+                   f"{' and '.join(why)}, so "
+                   "each record's start-up region was left out (initial_state 'auto' chose "
+                   "'unknown'); to model the start too, record from a known rest (a hold, then "
+                   "a ramp from it)")
     if start and rep.nominal.get("initial_state", "rest") == "rest":
         r = start[0]
         out.append(f"the start-up region dominates ({100 * r['energy_share']:.0f} % of the "
