@@ -221,7 +221,7 @@ def test_a_whole_diagnosis_is_the_same_with_the_streamed_refit(effects, seed, mo
         return got
 
     monkeypatch.setattr(dg, "_whole_fit", both)
-    rep = dg.diagnose(train, validate, workers=1)
+    rep = dg.diagnose(train, validate, workers=1, initial_state="rest")  # one diagnosis
     assert "screen" in rep.verdict
     assert refits, "the diagnosis made no whole-record refit"
     for (m, out), (m_full, out_full) in refits:
