@@ -78,6 +78,7 @@ from .effects import (
     Segment,
     base_features,
     fit_effect,
+    fitted_in,
     make_segment,
     nominal_params,
     play_chunks,
@@ -465,7 +466,8 @@ def _plain_fit(records: list[Record], radii, initial_state: str,
     sinks = (ne,) if factor is None else (ne, factor)
     for s in segs:
         for c, rows in play_chunks(s.v, radii, at_rest=at_rest):
-            X, y = (rows, s.y[c]) if s.mask is None else (rows[:, s.mask[c]], s.y[c][s.mask[c]])
+            m = slice(None) if s.mask is None else fitted_in(s.mask, c)
+            X, y = rows[:, m], s.y[c][m]
             for sink in sinks:
                 sink.add(X, y)
     return segs, ne
@@ -600,7 +602,6 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
     reach the noise then, and the effect is searched from rest as before (issue 28: the four
     clean blind cases that were wrong from rest, stages parked before each record)."""
     screens = [_bare(records, "rest", SCREEN_SAMPLES) for records in (train, validate)]
-    k = [min(startup_length(r.v), len(s.v)) for r, s in zip(validate, screens[1], strict=True)]
     stats, outputs = {}, {}
     picks = {"rest": rest_pick, "unknown": _nominal(train, validate, "unknown")}
     for state, (radii, _, at_rest) in picks.items():
@@ -609,10 +610,8 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
         ne = _plain_fit(train, radii, state, at_rest, SCREEN_SAMPLES, factor=qr)[1]
         coef = ne.solve() if qr is None else qr.solve_nonneg(nonneg)
         outputs[state] = [_plain_outputs(sc, radii, coef, at_rest) for sc in screens]
-        res = [s.y - o for s, o in zip(screens[1], outputs[state][1], strict=True)]
-        parts = [np.concatenate([e[:j] for e, j in zip(res, k, strict=True)]),
-                 np.concatenate([e[j:] for e, j in zip(res, k, strict=True)])]
-        stats[state] = [float(np.mean(np.square(p))) if p.size else 0.0 for p in parts]
+        stats[state] = _startup_split(validate, [s.y - o for s, o in zip(
+            screens[1], outputs[state][1], strict=True)])
     (su_rest, post_rest), post_free = stats["rest"], stats["unknown"][1]
     choice = {"asked": "auto",
               "post_startup_ratio": post_rest / post_free if post_free > 0 else None,
@@ -630,6 +629,16 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
             state = "unknown"
     choice["chosen"] = state
     return state, choice, picks[state]
+
+
+def _startup_split(validate: list[Record], residuals: list[np.ndarray]) -> list[float]:
+    """The mean squared ``residuals`` of the ``validate`` records (each possibly cut short)
+    within their start-up regions (:func:`.where.startup_length`) and after them (0.0 where
+    there are no samples)."""
+    k = [min(startup_length(r.v), e.size) for r, e in zip(validate, residuals, strict=True)]
+    parts = [np.concatenate([e[:j] for e, j in zip(residuals, k, strict=True)]),
+             np.concatenate([e[j:] for e, j in zip(residuals, k, strict=True)])]
+    return [float(np.mean(np.square(p))) if p.size else 0.0 for p in parts]
 
 
 def _second_look(choice: dict, verdict: dict, max_effects: int) -> int | None:
@@ -676,12 +685,9 @@ def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
     Else the rest diagnosis is kept: a stage started at rest gives both chosen models alike
     after the start-ups, and effects that show there are kept from rest. The figures are in
     ``nominal["initial_state_choice"]["second_look"]``."""
-    post = []
-    for rep in (rest, unknown):
-        res = [s.y - o for s, o in zip(rep.validate, rep.after, strict=True)]
-        k = [min(startup_length(r.v), e.size) for r, e in zip(validate, res, strict=True)]
-        tail = np.concatenate([e[j:] for e, j in zip(res, k, strict=True)])
-        post.append(float(np.mean(np.square(tail))) if tail.size else 0.0)
+    post = [_startup_split(validate, [s.y - o for s, o in zip(rep.validate, rep.after,
+                                                               strict=True)])[1]
+            for rep in (rest, unknown)]
     named = [set(rep.verdict["effects"]) - {"none"} for rep in (rest, unknown)]
     ratio = post[0] / post[1] if post[1] > 0 else None
     fewer = named[1] < named[0]
@@ -884,7 +890,8 @@ def _projected_fit(segs: list[Segment], radii, V: np.ndarray, at_rest: bool
     then the residuals)."""
     def projected_chunks(s):
         for c, rows in _play_row_chunks(s, radii, V, at_rest):
-            yield (rows, s.y[c]) if s.mask is None else (rows[:, s.mask[c]], s.y[c][s.mask[c]])
+            m = slice(None) if s.mask is None else fitted_in(s.mask, c)
+            yield rows[:, m], s.y[c][m]
 
     ne = NormalEquations(V.shape[1] + 1)
     for s in segs:
@@ -935,7 +942,7 @@ def _slow_rss(segs: list[Segment], radii, at_rest: bool, V: np.ndarray) -> tuple
             rows = [P[:-1], np.eye(len(segs))[j][:, None] * np.ones(x.size),
                     np.polynomial.legendre.legvander(x, SLOW_DEGREE)[:, 1:].T, s.y[c][None]]
             M = np.vstack(rows).T
-            M = M if s.mask is None else M[s.mask[c]]
+            M = M if s.mask is None else M[fitted_in(s.mask, c)]
             R = np.linalg.qr(M if R is None else np.vstack((R, M)), mode="r")
     n, rest = V.shape[0], R.shape[1] - V.shape[0]
     T = np.zeros((R.shape[1], V.shape[1] + rest))

@@ -60,6 +60,7 @@ __all__ = [
     "base_features",
     "delay_grid",
     "fit_effect",
+    "fitted_in",
     "fit_nominal",
     "head_segment",
     "lag",
@@ -520,8 +521,20 @@ def _used_chunk(Pc: tuple, s: Segment, c: slice) -> tuple[tuple, np.ndarray]:
     the fitted samples only."""
     if s.mask is None:
         return Pc, s.y[c]
-    m = s.mask[c]
+    m = fitted_in(s.mask, c)
     return tuple(X[:, m] for X in Pc), s.y[c][m]
+
+
+def fitted_in(mask: np.ndarray, c: slice) -> slice | np.ndarray:
+    """The fitted samples of chunk ``c`` under ``mask`` (:class:`Segment`), as an index into
+    the chunk: a slice when they are one run (a start-up region left out: the blocks of rows
+    are then sliced as views, not copied at each fit), else the chunk's boolean mask."""
+    m = mask[c]
+    first = int(np.argmax(m))
+    if not m[first]:
+        return slice(0, 0)
+    stop = m.size - int(np.argmax(m[::-1]))
+    return slice(first, stop) if stop - first == int(np.count_nonzero(m)) else m
 
 
 def _row_parts(features, s: Segment) -> tuple:
