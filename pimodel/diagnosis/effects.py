@@ -89,6 +89,8 @@ SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the fi
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
 LTI_MEMO = 16  # columns of the linear part's elements memoised per record (the last base mode)
 _ORDER_LOCK = threading.Lock()  # guards the memos of _order_memo (module threads)
+GRAM_STORE_BYTES = 32 << 20  # per segment: the play rows' terms kept by what they are
+# (_stored_grams; 80 plays on 4 chunks of a screen: 0.2 MB a key)
 DELAYED_GRAM_MAX = 1024  # samples: a longer whole delay's Gram formed anew (_delayed_grams)
 SCREEN_CONFIRM = 3  # grid points of the screen confirmed on the whole records
 MAX_DELAY_S = 20e-3  # s: real measurement chains (amplifier, sensor filter) lag by ms
@@ -421,7 +423,8 @@ def _fit(name, k, features, train, params=None) -> tuple[Model, float]:
     blocks = [None if is_streamed(s) else _row_parts(features, s) for s in train]
     ne = None
     for P, s in zip(blocks, train, strict=True):
-        first = None if P is None else _first_grams(P[0], s, getattr(P, "delayed", None))
+        first = None if P is None else _first_grams(P[0], s, getattr(P, "delayed", None),
+                                                    getattr(P, "first_key", None))
         for terms in _per_chunk(features, P, s, lambda j, c, Pc, s=s, first=first:
                                 _normal_terms(Pc, s, c, None if first is None else first[j])):
             if ne is None:
@@ -548,7 +551,8 @@ def _row_parts(features, s: Segment) -> tuple:
     return (features(s).T,)
 
 
-def _first_grams(Z: np.ndarray, s: Segment, delayed: tuple | None = None) -> list | None:
+def _first_grams(Z: np.ndarray, s: Segment, delayed: tuple | None = None,
+                 key: tuple | None = None) -> list | None:
     """``(Z_c Z_c^T, Z_c y_c)`` of the first block of rows ``Z`` (the play rows) on each chunk
     ``c`` of ``s`` (its fitted samples), kept on the segment for the latest ``Z`` while ``Z`` is a
     screen's (at most ``SCREEN_SAMPLES`` samples): the fits of a search that holds the play
@@ -560,7 +564,13 @@ def _first_grams(Z: np.ndarray, s: Segment, delayed: tuple | None = None) -> lis
     of ``Z0`` on ``[a - d, b - d)``: ``Z0``'s on ``[a, b)`` (kept for the latest ``Z0``,
     :func:`_delayed_grams`) less its ``d`` last samples' outer products plus those of the ``d``
     samples before ``a``, so a delay search forms one Gram of the play rows per ``Z0``, not
-    one per delay (the same sums in another order: equal to rounding)."""
+    one per delay (the same sums in another order: equal to rounding).
+
+    ``key``: what ``Z`` is (:func:`_combo_features`: the play rows and the transforms made of
+    them, such as a mode's filter at ``(fn, zeta)``), or None. With a key the terms are kept on
+    the segment by it (:func:`_stored_grams`), not only for the latest ``Z``: a search builds
+    the same rows anew for each combination and drift variant around one mode, and gets the
+    terms it made before, to the bit."""
     if Z.shape[1] > SCREEN_SAMPLES:
         return None
     cuts = list(chunks(s.y.size))
@@ -573,7 +583,34 @@ def _first_grams(Z: np.ndarray, s: Segment, delayed: tuple | None = None) -> lis
             grams = helped_map(lambda c: _first_terms(*_used_chunk((Z[:, c],), s, c)), cuts)
         return grams
 
+    if key is not None:
+        return _stored_grams(s, (key, len(cuts)), make)
     return _rows_memo(s, "_first_grams", Z, cuts, make)
+
+
+_GRAM_LOCK = threading.Lock()  # guards the stores of _stored_grams (module threads)
+
+
+def _stored_grams(s: Segment, key: tuple, make: Callable) -> list:
+    """``make()`` (a list of ``(G, zy)`` arrays) kept on the segment ``s`` by ``key``, the least
+    recently used dropped beyond ``GRAM_STORE_BYTES`` per segment. Two threads that miss one
+    key both make it (the same values) and the later one is kept."""
+    with _GRAM_LOCK:
+        store = s.__dict__.setdefault("_gram_store", {})  # insertion order: least recent first
+        kept = store.pop(key, None)
+        if kept is not None:
+            store[key] = kept
+            return kept[1]
+    grams = make()
+    size = sum(g.nbytes + zy.nbytes for g, zy in grams)
+    with _GRAM_LOCK:
+        old = store.pop(key, None)
+        store[key] = (size, grams)
+        total = s.__dict__.get("_gram_bytes", 0) + size - (0 if old is None else old[0])
+        while total > GRAM_STORE_BYTES and len(store) > 1:
+            total -= store.pop(next(iter(store)))[0]
+        s.__dict__["_gram_bytes"] = total
+    return grams
 
 
 def _rows_memo(s: Segment, name: str, Z: np.ndarray, cuts: list, make: Callable) -> list:
@@ -1282,9 +1319,11 @@ def _combo_k(effects, nominal: Model) -> int:
 
 class _Parts(tuple):
     """Blocks of rows (:func:`_row_parts`); ``delayed``: ``(Z0, d)`` when the first block is
-    ``Z0`` delayed by ``d`` samples (:func:`_first_grams`), else None."""
+    ``Z0`` delayed by ``d`` samples (:func:`_first_grams`), else None; ``first_key``: what the
+    first block is (the key of its terms in :func:`_first_grams`), or None."""
 
     delayed = None
+    first_key = None
 
 
 def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None = None):
@@ -1325,20 +1364,25 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
 
     def rows(s: Segment) -> tuple[np.ndarray, np.ndarray]:  # the play rows, then the others
         Z = s.play_rows(ncols)
+        what: tuple = ("plays", ncols)  # what Z is: the key of its Gram (_first_grams)
         scaled = "rate" in effects and p["rate_family"] == SCALED
         if scaled:  # the exact shape's plays in place of the nominal ones (module rate)
             Z = s.rate_basis.scaled_rows(p["rate_tau"], p["rate_saturation"], p["rate_growth"])
+            what = ("scaled", p["rate_tau"], p["rate_saturation"], p["rate_growth"])
         if p.get("wiener"):  # the linear part before the hysteresis (module wiener)
             Z = s.wiener_basis.columns(p["wiener"], ncols).T  # rows, kept C-contiguous
+            what = ("wiener", p["wiener"], ncols)
         elif "dynamics" in effects:  # filter the play rows
             last = static.get(("mode", id(s), ncols))  # the last mode filtered, for a delay
             if last is None or last[0] != (p["fn"], p["zeta"]):  # search at a fixed mode
                 last = ((p["fn"], p["zeta"]), mode_rows(Z, p["fn"], p["zeta"], s.dt), s)
                 static[("mode", id(s), ncols)] = last
             Z = last[1]
+            what = (*what, "mode", p["fn"], p["zeta"])
         delayed = None
         if "delay" in effects:
             delayed, Z = (None if static.get("held") else (Z, p["d"])), shift(Z, p["d"], axis=-1)
+            what = (*what, "held" if delayed is None else "delayed", p["d"])
         parts = [Z, static_rows(s)]
         if p.get("lti"):  # the extra elements of the linear part
             parts.append(_lti_block(s, p, nominal, static).T)
@@ -1356,6 +1400,7 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
         # a mode or delay search then copies nothing of them per point)
         out = _Parts((Z, parts[1] if len(parts) == 2 else _stack_rows(parts[1:])))
         out.delayed = delayed  # the play rows before the delay (their Gram: _first_grams)
+        out.first_key = _exact(what)
         return out
 
     def feats(s: Segment) -> np.ndarray:
