@@ -105,3 +105,24 @@ def test_a_parked_stage_with_a_delay_is_diagnosed_without_the_start_ups(seed):
     assert rep.verdict["gap_after"] < 3.0 * rep.verdict["noise_floor"]
     assert any("do not all start at rest" in h and "diagnosis from rest" in h
                for h in hints(rep))
+
+
+def test_the_second_look_is_capped_to_what_could_replace_the_first():
+    """``diagnose._second_look``: a full search only with the start in question or creep or
+    drift named while the start-ups are misfitted far more densely than the rest; a ratio
+    near 1 (residuals spread evenly) is no evidence, and the caps apply."""
+    import importlib
+
+    d = importlib.import_module("pimodel.diagnosis.diagnose")
+    far, even = 1.5 * d.START_SLOW_EXCESS, 1.0 + 1e-3
+
+    def look(effects, ratio, in_question=False):
+        return d._second_look({"in_question": in_question, "startup_ratio": ratio},
+                              {"effects": effects}, 3)
+
+    assert look(["dynamics"], far, in_question=True) == 3
+    assert look(["creep"], far) == 3 and look(["drift", "dynamics"], far) == 3
+    assert look(["creep"], even) is None and look(["creep"], None) is None
+    assert look(["dynamics", "creep"], even) == 1
+    assert look(["drift", "unexplained"], even) == 1 and look(["unexplained"], even) == 0
+    assert look(["dynamics"], far) is None and look(["none"], even) is None

@@ -128,6 +128,10 @@ START_EXCESS = 10.0  # ... or leaves validate's start-up with this many times th
 START_SLOW = ("creep", "drift")  # "auto": effects that a wrong start's misfit in the start-ups
 # can be taken for: named from rest, the diagnosis without the start-ups may be made too and
 # compared (_second_look, _final_start)
+START_SLOW_EXCESS = 2.0  # ... by a full search when the rest nominal misfits validate's start-ups
+# at least this many times as densely (mean square) as the rest of validate (a ratio near 1,
+# as residuals spread evenly give, is no evidence either way; blind gain change s1 at 1.006: the
+# full search without the start-ups took 182 s CPU, capped 9 s, the same verdict as from rest)
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
@@ -646,8 +650,8 @@ def _second_look(choice: dict, verdict: dict, max_effects: int) -> int | None:
     too (:func:`_final_start`), and with how many effects at most (None: not made).
 
     - ``max_effects`` when the start is in question (:func:`_auto_start`) or an effect of
-      ``START_SLOW`` is named while the rest nominal misfits validate's start-ups more densely
-      (mean square) than the rest of validate;
+      ``START_SLOW`` is named while the rest nominal misfits validate's start-ups at least
+      ``START_SLOW_EXCESS`` times as densely (mean square) as the rest of validate;
     - as many effects as the rest verdict named when it left a gap ``unexplained`` (can they
       do without the start-ups?);
     - one fewer when it names one of ``START_SLOW`` beside others (on stages that are not at
@@ -656,7 +660,7 @@ def _second_look(choice: dict, verdict: dict, max_effects: int) -> int | None:
     - else None. The caps keep the second diagnosis to what could replace the first."""
     named = [e for e in verdict["effects"] if e not in ("none", "unexplained")]
     slow = set(named).intersection(START_SLOW)
-    if choice["in_question"] or (slow and (choice["startup_ratio"] or 0.0) > 1.0):
+    if choice["in_question"] or (slow and (choice["startup_ratio"] or 0.0) > START_SLOW_EXCESS):
         return max_effects
     if "unexplained" in verdict["effects"]:
         return len(named)
