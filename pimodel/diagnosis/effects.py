@@ -530,8 +530,27 @@ def _used_chunk(Pc: tuple, s: Segment, c: slice) -> tuple[tuple, np.ndarray]:
 
 def fitted_in(mask: np.ndarray, c: slice) -> slice | np.ndarray:
     """The fitted samples of chunk ``c`` under ``mask`` (:class:`Segment`), as an index into
-    the chunk: a slice when they are one run (a start-up region left out: the blocks of rows
-    are then sliced as views, not copied at each fit), else the chunk's boolean mask."""
+    the chunk.
+
+    Parameters
+    ----------
+    mask : numpy.ndarray
+        Boolean, the fitted samples of the whole record.
+    c : slice
+        The chunk's samples ``a:b`` (:func:`~.chunked.chunks`).
+
+    Returns
+    -------
+    slice or numpy.ndarray
+        A slice when the chunk's fitted samples are one run (a start-up region left out: the
+        blocks of rows are then sliced as views, not copied at each fit; ``slice(0, 0)`` when
+        none is fitted), else the chunk's boolean mask.
+
+    Examples
+    --------
+    >>> fitted_in(np.arange(10) >= 3, slice(0, 5)), fitted_in(np.arange(10) >= 3, slice(5, 10))
+    (slice(3, 5, None), slice(0, 5, None))
+    """
     m = mask[c]
     first = int(np.argmax(m))
     if not m[first]:
