@@ -126,3 +126,54 @@ def test_the_second_look_is_capped_to_what_could_replace_the_first():
     assert look(["dynamics", "creep"], even) == 1
     assert look(["drift", "unexplained"], even) == 1 and look(["unexplained"], even) == 0
     assert look(["dynamics"], far) is None and look(["none"], even) is None
+
+
+def _staircase(n_levels: int, fs: float, hold: float, t0: float) -> tuple[np.ndarray, np.ndarray]:
+    """Stairs up from -1 V to 1 V and down again, ``hold`` seconds a level, a 1 ms ramp
+    between levels: after its start-up region one descending branch."""
+    levels = np.concatenate([np.linspace(-1, 1, n_levels), np.linspace(1, -1, n_levels)[1:]])
+    per, ramp = int(round(hold * fs)), max(int(round(1e-3 * fs)), 2)
+    v = np.repeat(levels, per)
+    v = np.convolve(np.concatenate([np.full(ramp, v[0]), v]), np.ones(ramp) / ramp, "valid")
+    v = v[:levels.size * per]
+    return t0 + np.arange(v.size) / fs, v
+
+
+def test_one_branch_after_the_start_up_is_no_test_of_the_start():
+    """``diagnose._one_branch``: stairs up and down (one reversal after the start-up) are one
+    branch, also with moves back below ``BRANCH_TRAVEL``; a second reversal above it, a
+    triangle or a multisine's small reversals are not; one record that reverses is enough."""
+    import importlib
+
+    d = importlib.import_module("pimodel.diagnosis.diagnose")
+    rec = lambda v: Record(np.arange(v.size) / 5e3, v, np.zeros(v.size))  # noqa: E731
+    stairs = _staircase(12, 5e3, 0.05, 0.0)[1]
+    assert d._one_branch([rec(stairs)])
+    small = 0.5 * d.BRANCH_TRAVEL * 2.0  # half the travel on a 2 V range
+    dip = np.concatenate([stairs, stairs[-1] + small * np.hanning(200)])
+    assert d._one_branch([rec(dip)])
+    back = np.concatenate([stairs, stairs[-1] + 3 * small * np.hanning(200)])
+    assert not d._one_branch([rec(back)])
+    t = np.arange(20_000) / 5e3
+    tri = 2 / np.pi * np.arcsin(np.sin(2 * np.pi * 1.3 * t))
+    assert not d._one_branch([rec(tri)]) and not d._one_branch([rec(stairs), rec(tri)])
+    rng = np.random.default_rng(7)
+    multi = sum(np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+                for f in rng.uniform(0.5, 40, 8))
+    assert not d._one_branch([rec(multi)])
+
+
+@pytest.mark.slow
+def test_stairs_from_rest_keep_the_start_up_and_name_the_effect():
+    """A stage with an asymmetric output map at rest, driven by stairs up and down at 5 kHz:
+    the start-up region is nearly half of each record and one branch follows, which a
+    nominal without the start-ups fits to the noise whatever the stage. ``auto`` does not put
+    the start in question (``one_branch``) and keeps ``"rest"``, which names the asymmetry."""
+    truth = random_truth(["asymmetry"], PARK_SEEDS[0] + 5)
+    train = [truth.record(*_staircase(14, 5e3, 0.1, 0.0), PARK_SEEDS[0] + 6)]
+    validate = [truth.record(*_staircase(9, 5e3, 0.13, 10.0), PARK_SEEDS[0] + 7)]
+    rep = diagnose(train, validate, workers=1)
+    choice = rep.nominal["initial_state_choice"]
+    assert choice["one_branch"] and not choice["in_question"]
+    assert choice["chosen"] == rep.nominal["initial_state"] == "rest"
+    assert "asymmetry" in rep.verdict["effects"]

@@ -65,6 +65,7 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from ..identification.branches import find_reversals
 from ..records import Record
 from .chunked import ChunkedQR, NormalEquations
 from .coverage import coverage, informed_radii, span_and_reach
@@ -125,6 +126,9 @@ START_POST_GAIN = 3.0  # "auto": unknown when the start-up fitted as at rest mak
 # mispredict validate after its start-up this many times worse (mean square) than without it,
 START_EXCESS = 10.0  # ... or leaves validate's start-up with this many times the mean squared
 # misfit of the rest of the record (_auto_start)
+BRANCH_TRAVEL = 0.05  # "auto": a reversal after the start-up counts when the input moves back
+# this share of the record's input range; with at most one in every train record, what follows
+# the start-up is one branch, which a PI fits whatever the stage: no test of the start
 START_SLOW = ("creep", "drift")  # "auto": effects that a wrong start's misfit in the start-ups
 # can be taken for: named from rest, the diagnosis without the start-ups may be made too and
 # compared (_second_look, _final_start)
@@ -600,14 +604,21 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
     ``post`` (validate's own start is not at rest). ``"unknown"`` is chosen when it is in
     question and the nominal without the start-ups predicts validate after them within
     ``NOISE_STOP`` times its noise floor (:func:`.noise.measure_noise_floor`): the start
-    explains the gap. Else ``"rest"``: a stage started at rest gives both nominals alike, and an
+    explains the gap. The start is not put in question when every train record's input
+    reverses at most once after its start-up (:func:`_one_branch`): one branch, fitted by a PI
+    whatever the stage, tests no start (issue 28: blind staircases, the start-up 43-47 % of each
+    record, read ``none`` without the start-ups although an effect of 79-93 noise floors was
+    there). Else ``"rest"``: a stage started at rest gives both nominals alike, and an
     effect strongest early in the records (a settling drift, creep after the first step) can
     spoil the weights as a wrong start does, but the nominal without the start-ups does not
     reach the noise then, and the effect is searched from rest as before (issue 28: the four
     clean blind cases that were wrong from rest, stages parked before each record)."""
     screens = [_bare(records, "rest", SCREEN_SAMPLES) for records in (train, validate)]
+    one_branch = _one_branch(train)
     stats, outputs = {}, {}
-    picks = {"rest": rest_pick, "unknown": _nominal(train, validate, "unknown")}
+    picks = {"rest": rest_pick}
+    if not one_branch:
+        picks["unknown"] = _nominal(train, validate, "unknown")
     for state, (radii, _, at_rest) in picks.items():
         nonneg = _bounded(train, validate, radii, state, at_rest)
         qr = None if nonneg is None else ChunkedQR(radii.size + 1)
@@ -616,15 +627,17 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
         outputs[state] = [_plain_outputs(sc, radii, coef, at_rest) for sc in screens]
         stats[state] = _startup_split(validate, [s.y - o for s, o in zip(
             screens[1], outputs[state][1], strict=True)])
-    (su_rest, post_rest), post_free = stats["rest"], stats["unknown"][1]
-    choice = {"asked": "auto",
-              "post_startup_ratio": post_rest / post_free if post_free > 0 else None,
+    su_rest, post_rest = stats["rest"]
+    post_free = stats["unknown"][1] if "unknown" in stats else None
+    choice = {"asked": "auto", "one_branch": one_branch,
+              "post_startup_ratio": post_rest / post_free if post_free else None,
               "startup_ratio": su_rest / post_rest if post_rest > 0 else None,
               "limits": {"post_startup_ratio": START_POST_GAIN, "startup_ratio": START_EXCESS,
+                         "branch_travel": BRANCH_TRAVEL,
                          "free_over_noise": NOISE_STOP}}
     state = "rest"
-    choice["in_question"] = bool(post_rest > START_POST_GAIN * post_free or
-                                 su_rest > START_EXCESS * post_rest)
+    choice["in_question"] = bool(not one_branch and (
+        post_rest > START_POST_GAIN * post_free or su_rest > START_EXCESS * post_rest))
     if choice["in_question"]:
         noise = measure_noise_floor([(s.v, s.y) for sc in screens for s in sc],
                                     [o for out in outputs["unknown"] for o in out])["value"]
@@ -633,6 +646,18 @@ def _auto_start(train, validate, rest_pick) -> tuple[str, dict, tuple]:
             state = "unknown"
     choice["chosen"] = state
     return state, choice, picks[state]
+
+
+def _one_branch(train: list[Record]) -> bool:
+    """Whether the input of every ``train`` record reverses at most once after its start-up
+    region (:func:`.where.startup_length`), a reversal counted when the input moves back
+    ``BRANCH_TRAVEL`` of the record's range (:func:`.identification.branches.find_reversals`)."""
+    for r in train:
+        v = np.asarray(r.v, float)
+        k = startup_length(v)
+        if len(find_reversals(v[k:], BRANCH_TRAVEL * float(np.ptp(v)))) > 1:
+            return False
+    return True
 
 
 def _startup_split(validate: list[Record], residuals: list[np.ndarray]) -> list[float]:
