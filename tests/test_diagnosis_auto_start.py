@@ -126,6 +126,8 @@ def test_the_second_look_is_capped_to_what_could_replace_the_first():
     assert look(["dynamics", "creep"], even) == 1
     assert look(["drift", "unexplained"], even) == 1 and look(["unexplained"], even) == 0
     assert look(["dynamics"], far) is None and look(["none"], even) is None
+    one = {"in_question": False, "startup_ratio": far, "one_branch": True}
+    assert d._second_look(one, {"effects": ["creep", "unexplained"]}, 3) is None
 
 
 def _staircase(n_levels: int, fs: float, hold: float, t0: float) -> tuple[np.ndarray, np.ndarray]:

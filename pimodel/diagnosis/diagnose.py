@@ -682,7 +682,12 @@ def _second_look(choice: dict, verdict: dict, max_effects: int) -> int | None:
     - one fewer when it names one of ``START_SLOW`` beside others (on stages that are not at
       rest, the Preisach generator's, a wrong start's misfit in the start-ups is taken for
       creep beside the true effect);
-    - else None. The caps keep the second diagnosis to what could replace the first."""
+    - else None. The caps keep the second diagnosis to what could replace the first.
+
+    None too when every train record is one branch after its start-up (``one_branch``,
+    :func:`_one_branch`): without the start-ups a PI fits that branch whatever the stage."""
+    if choice.get("one_branch"):
+        return None
     named = [e for e in verdict["effects"] if e not in ("none", "unexplained")]
     slow = set(named).intersection(START_SLOW)
     if choice["in_question"] or (slow and (choice["startup_ratio"] or 0.0) > START_SLOW_EXCESS):
