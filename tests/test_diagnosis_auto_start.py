@@ -179,3 +179,40 @@ def test_stairs_from_rest_keep_the_start_up_and_name_the_effect():
     assert choice["one_branch"] and not choice["in_question"]
     assert choice["chosen"] == rep.nominal["initial_state"] == "rest"
     assert "asymmetry" in rep.verdict["effects"]
+
+
+def test_the_second_look_keeps_other_effects_only_when_they_predict_clearly_better():
+    """``diagnose._final_start`` with two verdicts of as many effects, other names: the
+    diagnosis without the start-ups is kept when the rest one misfits validate after the
+    start-ups more than ``START_SWAP`` times as much (mean square), not below it, and not when
+    it names more effects; the choice and its figures are in the report."""
+    import importlib
+
+    d = importlib.import_module("pimodel.diagnosis.diagnose")
+    rng = np.random.default_rng(11)
+    t = np.arange(4000) / 1e3
+    v = np.sin(2 * np.pi * 3 * t)  # spans its range in the first period: a short start-up
+    e = rng.normal(size=t.size)
+    rec = Record(t, v, e.copy())
+
+    def report(effects, scale):  # its residual on validate: scale * e
+        choice = {"chosen": "rest", "post_startup_ratio": 1.0, "startup_ratio": 1.0,
+                  "limits": {"post_startup_ratio": d.START_POST_GAIN,
+                             "startup_ratio": d.START_EXCESS}}
+        return d.DiagnosisReport({"initial_state_choice": choice}, {}, [],
+                                 {"effects": effects}, [rec], [], [e - scale * e])
+
+    for factor, swapped in ((1.5 * d.START_SWAP, True), (0.8 * d.START_SWAP, False)):
+        rest, unknown = report(["creep"], np.sqrt(factor)), report(["drift"], 1.0)
+        chosen = d._final_start(rest, unknown, [rec])
+        second = chosen.nominal["initial_state_choice"]["second_look"]
+        assert (chosen is unknown) == swapped and second["other_effects"]
+        assert second["post_startup_ratio"] == pytest.approx(factor)
+        if swapped:  # the hint says which rule chose
+            from pimodel.diagnosis.summary import hints
+
+            assert any("(creep) predicts validate after its start-up" in h and
+                       "names other effects" in h for h in hints(chosen))
+    rest, more = report(["creep"], np.sqrt(1.5 * d.START_SWAP)), \
+        report(["drift", "asymmetry"], 1.0)
+    assert d._final_start(rest, more, [rec]) is rest

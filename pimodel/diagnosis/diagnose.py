@@ -136,6 +136,9 @@ START_SLOW_EXCESS = 2.0  # ... by a full search when the rest nominal misfits va
 # at least this many times as densely (mean square) as the rest of validate (a ratio near 1,
 # as residuals spread evenly give, is no evidence either way; blind gain change s1 at 1.006: the
 # full search without the start-ups took 182 s CPU, capped 9 s, the same verdict as from rest)
+START_SWAP = 1.25  # ... kept too when it names other effects, no more of them (unexplained
+# counted), and the rest one's mean squared misfit after the start-ups exceeds this many times
+# its own (_final_start: preisach_stage drift on each record's clock read as creep from rest)
 EFFECT_SIGNATURES = {
     "creep": ("hold after a step (after 50 ms)", "< 1 Hz"),
     "drift": ("late in the record (last third)", "< 1 Hz"),
@@ -714,7 +717,11 @@ def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
     - it names fewer effects (its effects, ``"unexplained"`` included, a strict subset of the
       rest verdict's) and the rest one's extra effects do not cut the RMS after the start-ups
       by ``MIN_RMS_CUT`` (``post`` ratio above ``(1 - MIN_RMS_CUT)**2``): they fitted the
-      start-ups alone.
+      start-ups alone, or
+    - it names other effects, no more of them (``"unexplained"`` counted), and the rest one's
+      ``post`` exceeds ``START_SWAP`` times its ``post``: two explanations as large, the one
+      that needs the start-ups predicting the rest of validate worse (a drift on each record's
+      clock, of a stage not at rest, read as creep from rest).
 
     Else the rest diagnosis is kept: a stage started at rest gives both chosen models alike
     after the start-ups, and effects that show there are kept from rest. The figures are in
@@ -726,14 +733,17 @@ def _final_start(rest: DiagnosisReport, unknown: DiagnosisReport,
     ratio = post[0] / post[1] if post[1] > 0 else None
     fewer = named[1] < named[0]
     more = len(named[1] - {"unexplained"}) > len(named[0] - {"unexplained"})
+    other = named[1] != named[0] and not fewer and len(named[1]) <= len(named[0])
     choice = rest.nominal["initial_state_choice"]
     choice["second_look"] = {"unknown_effects": list(unknown.verdict["effects"]),
                              "post_startup_ratio": ratio, "fewer_effects": fewer,
-                             "more_effects": more,
+                             "more_effects": more, "other_effects": other,
                              "limits": {"post_startup_ratio": START_POST_GAIN,
-                                        "fewer_effects_ratio": (1 - MIN_RMS_CUT) ** 2}}
+                                        "fewer_effects_ratio": (1 - MIN_RMS_CUT) ** 2,
+                                        "other_effects_ratio": START_SWAP}}
     if ratio is None or not ((ratio > START_POST_GAIN and not more) or
-                             (fewer and ratio > (1 - MIN_RMS_CUT) ** 2)):
+                             (fewer and ratio > (1 - MIN_RMS_CUT) ** 2) or
+                             (other and ratio > START_SWAP)):
         return rest
     choice["chosen"] = "unknown"
     choice["second_look"]["rest_effects"] = list(rest.verdict["effects"])

@@ -161,11 +161,14 @@ def hints(rep) -> list[str]:
         if second is not None:  # decided by the two diagnoses (diagnose._final_start)
             rest = ", ".join(second.get("rest_effects", []))
             ratio = second["post_startup_ratio"]
+            if ratio > second["limits"]["post_startup_ratio"] or second.get("other_effects"):
+                than = (f"{ratio:.3g} times worse (mean square) than the one without the "
+                        "start-ups" + ("" if not second.get("other_effects") else
+                                       ", which names other effects, no more of them"))
+            else:
+                than = "no better than the one without the start-ups, which names fewer effects"
             why = [f"the diagnosis from rest ({rest}) predicts validate after its start-up "
-                   + (f"{ratio:.3g} times worse (mean square) than the one without the "
-                      "start-ups" if ratio > second["limits"]["post_startup_ratio"] else
-                      "no better than the one without the start-ups, which names fewer "
-                      "effects")]
+                   + than]
         out.append("the records do not all start at rest: "
                    f"{'fitted from rest, the nominal left ' if second is None else ''}"
                    f"{' and '.join(why)}, so "
