@@ -163,8 +163,8 @@ def hints(rep) -> list[str]:
             ratio = second["post_startup_ratio"]
             if ratio > second["limits"]["post_startup_ratio"] or second.get("other_effects"):
                 than = (f"{ratio:.3g} times worse (mean square) than the one without the "
-                        "start-ups" + ("" if not second.get("other_effects") else
-                                       ", which names other effects, no more of them"))
+                        "start-ups" + (", which names other effects, no more of them"
+                                       if second.get("other_effects") else ""))
             else:
                 than = "no better than the one without the start-ups, which names fewer effects"
             why = [f"the diagnosis from rest ({rest}) predicts validate after its start-up "
