@@ -70,3 +70,50 @@ def test_amplifier_bandwidth_sampled_at_the_end_of_the_hold_is_dynamics(fc, seed
     m = v["model"]
     assert m["dynamics_position"] == "before"
     assert abs(m["lowpass_hz"] / fc - 1) < 0.2
+
+
+def _trapezoids(rng, n: int, fs: float) -> np.ndarray:
+    """Ramps of 0.05-0.4 s between random levels within +-0.9 V, each held 0.02-0.3 s."""
+    parts, x = [], rng.uniform(-0.9, 0.9)
+    while sum(p.size for p in parts) < n:
+        y = rng.uniform(-0.9, 0.9)
+        parts += [np.linspace(x, y, int(rng.uniform(0.05, 0.4) * fs)),
+                  np.full(int(rng.uniform(0.02, 0.3) * fs), y)]
+        x = y
+    return np.concatenate(parts)[:n]
+
+
+def _ramps_and_holds(seed: int):
+    """A random PI stage behind an amplifier of a random 40-150 Hz bandwidth, driven by ramps
+    and holds at 2, 5 or 10 kHz (drawn): train 3 s, validate 2.5 s later on one clock."""
+    rng = np.random.default_rng([28, 69, seed])
+    fs = float(rng.choice([2000.0, 5000.0, 10000.0]))
+    fc = rng.uniform(40.0, 150.0)
+    truth = random_truth([], 500 + seed)
+    records, t0 = [], 0.0
+    for i, dur in enumerate((3.0, 2.5)):
+        v = _trapezoids(rng, int(dur * fs), fs)
+        t = t0 + np.arange(v.size) / fs
+        y = truth.simulate(t, _amplifier(v, fc, 1.0 / fs), np.random.default_rng([seed, i]))
+        records.append([Record(t, v, y, source=("train", "validate")[i])])
+        t0 = t[-1] + 1.0
+    return fc, records
+
+
+@pytest.mark.slow
+def test_amplifier_bandwidth_on_ramps_and_holds_is_found_before_the_hysteresis():
+    # the filter's search with the leading 12 play columns alone found a 48 Hz low-pass as a
+    # critically damped 50 Hz mode, lost to a mode and a low-pass after the hysteresis on
+    # train, and the dynamics candidate then fitted validate worse than the nominal: `delay`
+    # or `creep` named in 6 of 7 such stages. Measured with every column: the corner within
+    # 4 % on all six stages here, `dynamics` alone in five (the sixth, 137 Hz at 2 kHz, a
+    # corner near a sample's delay, named `delay`)
+    named = 0
+    for seed in range(6):
+        fc, (train, validate) = _ramps_and_holds(seed)
+        report = diagnose(train, validate, workers=1)
+        dyn = next(c for c in report.candidates if c["effect"] == "dynamics")["params"]
+        assert dyn["dynamics_position"] == "before", seed
+        assert abs(dyn["lowpass_hz"] / fc - 1) < 0.1, (seed, dyn["lowpass_hz"], fc)
+        named += report.verdict["effects"] == ["dynamics"]
+    assert named >= 4

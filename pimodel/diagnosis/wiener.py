@@ -22,8 +22,10 @@ search runs the plays again (:class:`WienerBasis`).
 
 Selection (:func:`search_filter`): every kind on a coarse grid (the low-passes' corners
 ``LOWPASS_SLOW_HZ`` from ``LOWPASS_MIN_HZ``, then ``LOWPASS_HZ`` points from ``MIN_HZ``;
-``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual,
-and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the candidate then
+``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual
+(every fit with every play column: the leading ones alone leave a misfit of the hysteresis that
+hides the filter), and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the
+candidate then
 keeps this Wiener variant when its train BIC is lower than that of the Hammerstein variant
 (:mod:`.lti`), with
 ``k`` counted the same way (2 for the base mode plus 3 per further mode there; 1 or 2 here).
@@ -61,7 +63,7 @@ MODE_DAMPING = (0.1, 0.4, 1.0)
 GATE = 8.0  # refine a kind only when its grid comes within this factor of the RSS to beat
 DAMPING_RANGE = (0.02, 2.0)  # bounds of the refined damping
 REFINE_EVALUATIONS = {"lowpass": 12, "lowpass_direct": 12, "mode": 60}  # Nelder-Mead budget per
-# kind (leading columns)
+# kind (every play column: the leading 12 alone hid a low-pass behind the hysteresis' misfit)
 POLISH_EVALUATIONS = {"lowpass": 10, "lowpass_direct": 10, "mode": 20}  # then with every
 # column, when it is kept
 KEPT_COLUMNS = 4  # play-output matrices a WienerBasis keeps (the latest)
@@ -350,10 +352,9 @@ def _refine(rss_of: Callable, el0: tuple, rss0: float, fmax: float, maxfev: int,
 
 def polish_filter(rss_of: Callable, elements: tuple, rss: float,
                   fmax: float) -> tuple[tuple, float]:
-    """A short Nelder-Mead polish of a filter found by :func:`search_filter` (which scores
-    with the leading play columns only) on the fit with every column; a low-pass is also
-    polished in its other sampling (``"lowpass"``, ``"lowpass_direct"``) from the same corner,
-    the lower RSS kept.
+    """A short Nelder-Mead polish of a filter found by :func:`search_filter`, with smaller
+    steps; a low-pass is also polished in its other sampling (``"lowpass"``,
+    ``"lowpass_direct"``) from the same corner, the lower RSS kept.
 
     Parameters
     ----------
@@ -384,10 +385,10 @@ def polish_filter(rss_of: Callable, elements: tuple, rss: float,
     el, rss = _refine(rss_of, tuple(elements[0]), rss, fmax,
                       POLISH_EVALUATIONS[elements[0][0]], (0.03, 0.1))
     if el[0] in LOWPASS_KINDS:
-        # the other sampling of the low-pass from the same corner: on the leading columns of
-        # the search the two differ little (a sample of lag against a slightly faster
-        # corner), with every column the right one fits to the noise (bw49: a 108 Hz
-        # amplifier sampled at the end of the hold kept as a 124 Hz ZOH low-pass)
+        # the other sampling of the low-pass from the same corner: the two differ little on
+        # a coarse search (a sample of lag against a slightly faster corner), the right one
+        # fits to the noise (bw49: a 108 Hz amplifier sampled at the end of the hold kept as
+        # a 124 Hz ZOH low-pass)
         other = (LOWPASS_KINDS[el[0] == "lowpass"], el[1])
         el2, rss2 = _refine(rss_of, other, rss_of((other,)), fmax,
                             POLISH_EVALUATIONS[other[0]], (0.03, 0.1))
