@@ -94,7 +94,7 @@ from .rate import RATE_KEYS, RateBasis, rate_shapes
 from .streamed import attach_plays, streamable
 from .threads import OnceCache, Pool, default_workers, lend
 from .where import residual_breakdown, startup_length
-from .wiener import WienerBasis, position_hint
+from .wiener import WienerBasis, position_hint, position_variants
 
 __all__ = [
     "diagnose",
@@ -1120,6 +1120,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         shapes = [{**r, **c} for r in rate_shapes((*combo, name), fixed_ or {})
                   for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"),
                                         len(va))]
+        # the dynamics alone: after and before the hysteresis, both scored (module wiener)
+        shapes = [{**r, **q} for r in shapes for q in position_variants((*combo, name),
+                                                                        fixed_ or {})]
         out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):
