@@ -29,8 +29,9 @@ candidate then
 keeps this Wiener variant when its train BIC is lower than that of the Hammerstein variant
 (:mod:`.lti`), with
 ``k`` counted the same way (2 for the base mode plus 3 per further mode there; 1 or 2 here).
-The position is decided on the ``dynamics`` candidate alone and held when it is fitted beside
-other effects (:func:`position_hint`).
+The diagnosis scores both positions on validate instead (:func:`position_variants`): alone,
+each searched; beside other effects, the linear part after the hysteresis searched there and the
+filter found alone held.
 
 The feedforward inverse (:func:`inverse_prefilter`) is approximate: the hysteresis is inverted
 for the filter's output, then ``F(s)^-1 (s / wf + 1)^-r`` (``r`` the order of ``F``, ``wf``
@@ -51,7 +52,7 @@ from .lti import INVERSE_FILTER, element_coefficients, nelder_mead
 from .threads import drop_threads, per_thread
 
 __all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "inverse_sections",
-           "polish_filter", "position_hint", "position_variants", "prefilter", "search_filter",
+           "polish_filter", "position_variants", "prefilter", "search_filter",
            "wiener_k"]
 
 MIN_HZ = 50.0  # slowest mode [Hz] (a slower filter moves every loop of the record)
@@ -399,13 +400,17 @@ def polish_filter(rss_of: Callable, elements: tuple, rss: float,
     return (el,), rss
 
 
-def position_variants(effects: tuple, fixed: dict) -> list[dict]:
-    """The variants of a fit the diagnosis scores on validate for the position of the
-    dynamics: ``{"position": p}`` for each of ``POSITIONS`` when ``dynamics`` is fitted alone
-    and searched, else one variant, ``{}``. On train, a linear part after the hysteresis with a
-    mode and a low-pass can beat the filter before it that made the records and then fit
-    validate worse than the nominal (a blind 70 Hz amplifier bandwidth on ramps and holds:
-    validate RMS 0.043 um after, 0.011 um before, the nominal 0.027 um).
+def position_variants(effects: tuple, fixed: dict, before: tuple | None = None) -> list[dict]:
+    """The variants of a fit that the diagnosis scores on validate for the position of the
+    dynamics. Alone: ``{"position": p}`` for each of ``POSITIONS`` (the linear part after the
+    hysteresis, :mod:`.lti`, and the filter before it, both searched). Beside other effects:
+    ``{}`` (after, searched there) and ``{"wiener": before}``, the filter the dynamics alone
+    found before the hysteresis, held. One variant, ``{}``, without ``dynamics`` or with its
+    grid held in ``fixed``. On train, a mode and a low-pass after the hysteresis can beat the
+    filter before it that made the records and then fit validate worse than the nominal (a
+    blind 70 Hz amplifier bandwidth on ramps and holds: validate RMS 0.043 um after, 0.011 um
+    before, the nominal 0.027 um); and beside a second effect the other position can fit
+    where the one chosen alone does not (density_stage's mode and pole beside an asymmetry).
 
     Parameters
     ----------
@@ -413,6 +418,9 @@ def position_variants(effects: tuple, fixed: dict) -> list[dict]:
         The effects fitted jointly.
     fixed : dict
         Their held grid parameters.
+    before : tuple or None
+        The filter elements of the dynamics fitted alone before the hysteresis (its
+        ``Model.grid["wiener"]``); None: none found.
 
     Returns
     -------
@@ -422,35 +430,17 @@ def position_variants(effects: tuple, fixed: dict) -> list[dict]:
     --------
     >>> position_variants(("dynamics",), {})
     [{'position': 'after'}, {'position': 'before'}]
+    >>> position_variants(("creep", "dynamics"), {}, (("lowpass", 1e-3),))
+    [{}, {'wiener': (('lowpass', 0.001),)}]
     >>> position_variants(("dynamics",), {"fn": 900.0, "zeta": 0.1}), position_variants(
     ...     ("creep", "dynamics"), {})
     ([{}], [{}])
     """
-    if tuple(effects) != ("dynamics",) or {"fn", "wiener", "held"} & set(fixed):
+    if "dynamics" not in effects or {"fn", "wiener", "held"} & set(fixed):
         return [{}]
-    return [{"position": p} for p in POSITIONS]
-
-
-def position_hint(alone_grid: dict) -> dict:
-    """The grid parameters that hold the Wiener variant when ``dynamics`` is fitted beside
-    other effects: those of the ``dynamics`` candidate alone when it chose it, else none.
-
-    Parameters
-    ----------
-    alone_grid : dict
-        The grid parameters of the ``dynamics`` candidate fitted alone (``Model.grid``).
-
-    Returns
-    -------
-    dict
-        ``{"wiener": elements}`` or ``{}``.
-
-    Examples
-    --------
-    >>> position_hint({"wiener": (("lowpass", 1e-3),)}), position_hint({"fn": 900.0})
-    ({'wiener': (('lowpass', 0.001),)}, {})
-    """
-    return {k: alone_grid[k] for k in KEYS if k in alone_grid}
+    if tuple(effects) == ("dynamics",):
+        return [{"position": p} for p in POSITIONS]
+    return [{}] if before is None else [{}, {"wiener": tuple(before)}]
 
 
 def inverse_sections(elements: Sequence, dt: float) -> np.ndarray | None:
