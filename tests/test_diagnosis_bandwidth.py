@@ -105,9 +105,9 @@ def test_amplifier_bandwidth_on_ramps_and_holds_is_found_before_the_hysteresis()
     # the filter's search with the leading 12 play columns alone found a 48 Hz low-pass as a
     # critically damped 50 Hz mode, lost to a mode and a low-pass after the hysteresis on
     # train, and the dynamics candidate then fitted validate worse than the nominal: `delay`
-    # or `creep` named in 6 of 7 such stages. Measured with every column: the corner within
-    # 4 % on all six stages here, `dynamics` alone in five (the sixth, 137 Hz at 2 kHz, a
-    # corner near a sample's delay, named `delay`)
+    # (4) or `creep, asymmetry` (1) named on 5 of 7 such stages at 5 kHz. Measured with every
+    # column: the corner within 4 % on all six stages here, `dynamics` alone in five (the
+    # sixth, 137 Hz at 2 kHz, a corner near a sample's delay, named `delay`)
     named = 0
     for seed in range(6):
         fc, (train, validate) = _ramps_and_holds(seed)
