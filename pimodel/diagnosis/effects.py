@@ -1194,6 +1194,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     if effects == ("dynamics",) and not dyn_fixed and position != "after" and \
             all(s.wiener_basis is not None for s in train):
         # the linear part before the hysteresis (module wiener), kept on a lower train BIC
+        # or when asked for (position "before")
         n = sum(s.y[s.used].size for s in train)
         # every play column: with the leading ones alone the hysteresis' own misfit hides the
         # filter (a 48 Hz low-pass before the plays, on ramps and holds, was found as a

@@ -70,7 +70,6 @@ POLISH_EVALUATIONS = {"lowpass": 10, "lowpass_direct": 10, "mode": 20}  # then w
 # column, when it is kept
 KEPT_COLUMNS = 4  # play-output matrices a WienerBasis keeps (the latest)
 ELEMENT_K = {"lowpass": 1, "lowpass_direct": 1, "mode": 2}
-KEYS = ("wiener",)  # the grid key of the Wiener variant (its filter elements)
 POSITIONS = ("after", "before")  # of the dynamics alone: both fitted, chosen on validate
 
 
