@@ -94,7 +94,7 @@ from .rate import RATE_KEYS, RateBasis, rate_shapes
 from .streamed import attach_plays, streamable
 from .threads import OnceCache, Pool, default_workers, lend
 from .where import residual_breakdown, startup_length
-from .wiener import WienerBasis, position_variants
+from .wiener import WienerBasis, position_hint
 
 __all__ = [
     "diagnose",
@@ -1112,19 +1112,14 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
     def variants(name, combo=(), fixed_=None) -> list[tuple]:
         """The single fits ``fit(name, combo, fixed_)`` scores, in its order: ``(key, fx)``
         (a drift's clocks, a rate's shapes; one for most effects)."""
-        before = None  # the filter the dynamics alone found before the hysteresis
-        if combo and "dynamics" in (*combo, name) and \
-                not {"fn", "wiener", "held"} & set(fixed_ or {}):
-            key, fx = next(kf for kf in variants("dynamics") if kf[1].get("position") == "before")
-            before = single(key, fx)[0].grid.get("wiener")
+        if combo and "dynamics" in (*combo, name) and not {"fn", "wiener"} & set(fixed_ or {}):
+            # the position of the dynamics (before or after the hysteresis) as chosen alone
+            fixed_ = {**position_hint(fit("dynamics")[0].grid), **(fixed_ or {})} or None
         # a creep's start: each scored where the creep enters (alone, a pair, the creep
         # added or swapped in); held where ``fixed_`` carries the chosen creep's (_hold)
         shapes = [{**r, **c} for r in rate_shapes((*combo, name), fixed_ or {})
                   for c in creep_starts((*combo, name), (fixed_ or {}).get("creep_start"),
                                         len(va))]
-        # the dynamics after and before the hysteresis, both scored (module wiener)
-        shapes = [{**r, **q} for r in shapes
-                  for q in position_variants((*combo, name), fixed_ or {}, before)]
         out = []
         for var, shape in ((d, r) for d in drift_variants((*combo, name), len(va))
                            for r in shapes):

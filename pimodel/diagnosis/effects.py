@@ -878,10 +878,7 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         ``lti`` kept as given (a refit on other records). ``"search_all": True``: the mode
         search with every play column, not the leading ``SEARCH_COLUMNS`` (slower; the
         diagnosis' re-search of a lag beside a later effect,
-        :func:`pimodel.diagnosis.diagnose._research_lag`). ``"position": "after"`` or
-        ``"before"`` (``dynamics`` alone, searched): the linear part after the hysteresis
-        (:mod:`.lti`) or the filter before it (:mod:`.wiener`), whatever the train BIC says
-        (the diagnosis scores both on validate); without it, the lower train BIC.
+        :func:`pimodel.diagnosis.diagnose._research_lag`).
     nominal : Model or None
         The nominal model (:func:`fit_nominal` of ``train`` when None).
 
@@ -916,9 +913,9 @@ def _order_memo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) ->
     (``memo["order"]``). A copy of the model is returned (its ``params`` and ``grid`` its own)."""
     if "dynamics" not in effects or {"fn", "wiener", "held"} & set(fixed):
         return _fit_combo(effects, train, fixed, nominal)
-    lti_min, position = fixed.get("lti_min", 0), fixed.get("position")
-    key = (effects, tuple(id(s) for s in train),  # both positions share the searches
-           repr(sorted((k_, v) for k_, v in fixed.items() if k_ not in ("lti_min", "position"))))
+    lti_min = fixed.get("lti_min", 0)
+    key = (effects, tuple(id(s) for s in train),
+           repr(sorted((k_, v) for k_, v in fixed.items() if k_ != "lti_min")))
     with _ORDER_LOCK:  # one memo per key, filled by one thread at a time (module threads)
         memo = nominal.__dict__.setdefault("_order_memo", {})
         known = memo.setdefault(key, {"runs": [], "lock": threading.Lock()})
@@ -928,13 +925,12 @@ def _order_memo(effects: tuple[str, ...], train, fixed: dict, nominal: Model) ->
             known = memo[key] = {"runs": [], "train": [weakref.ref(s) for s in train],
                                  "lock": threading.Lock()}
     with known["lock"]:
-        for m0, chose, pos, model in known["runs"]:
-            if pos == position and m0 <= lti_min <= chose:
+        for m0, chose, model in known["runs"]:
+            if m0 <= lti_min <= chose:
                 return _copy_model(model)
         known.pop("elements", None)
         model = _fit_combo(effects, train, dict(fixed), nominal, known)
-        known["runs"].append((lti_min, known.pop("elements", -1), position,
-                              _copy_model(model)))
+        known["runs"].append((lti_min, known.pop("elements", -1), _copy_model(model)))
     return model
 
 
@@ -982,9 +978,6 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     lti_min = fixed.pop("lti_min", 0)
     held = fixed.pop("held", False)  # every grid parameter as given: no search at all
     search_all = fixed.pop("search_all", False)
-    # the dynamics alone at one position (module wiener: "after" or "before" the hysteresis),
-    # the diagnosis' two variants chosen on validate; None: the lower train BIC
-    position = fixed.pop("position", None)
     if fixed.pop("refine", None) == "creep" and "creep" in effects:
         taus = tuple(nominal.params["creep_taus"])
         nominal = replace(nominal, params={**nominal.params,
@@ -1191,23 +1184,18 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
     if p.get("wiener"):  # a filter's parameters instead of the base mode's two
         k_all += wiener_k(p["wiener"]) - _combo_k(("dynamics",), nominal)
     model, rss = _fit(name, k_all, _combo_features(effects, p, nominal, static), train, p)
-    if effects == ("dynamics",) and not dyn_fixed and position != "after" and \
-            all(s.wiener_basis is not None for s in train):
+    if effects == ("dynamics",) and not dyn_fixed and all(s.wiener_basis is not None
+                                                          for s in train):
         # the linear part before the hysteresis (module wiener), kept on a lower train BIC
-        # or when asked for (position "before")
         n = sum(s.y[s.used].size for s in train)
-        # every play column: with the leading ones alone the hysteresis' own misfit hides the
-        # filter (a 48 Hz low-pass before the plays, on ramps and holds, was found as a
-        # critically damped 50 Hz mode and lost to the Hammerstein on train)
-        els, _, kw = search_filter(lambda e: _fit(name, k, _combo_features(
-            effects, {"wiener": e}, nominal, static), train)[1], fmax, n,
-            rss_to_beat=rss)  # the Hammerstein's, every column too
+        els, _, kw = search_filter(lambda e: search([{"wiener": e}])[1], fmax, n,
+                                   rss_to_beat=best[1])  # the Hammerstein's, same columns
         wmodel, wrss = _fit(name, kw, _combo_features(effects, {"wiener": els}, nominal,
                                                       static), train, {"wiener": els})
         delta = n * np.log(max(wrss, 1e-300) / max(rss, 1e-300)) + (kw - k_all) * np.log(n)
         positions = [{"position": "after", "train_bic": 0.0},
                      {"position": "before", "structure": [els[0][0]], "train_bic": float(delta)}]
-        if delta < 0 or position == "before":  # kept: polished with every play column
+        if delta < 0:  # kept: polished with every play column
             els, _ = polish_filter(lambda e: _fit(name, kw, _combo_features(
                 effects, {"wiener": e}, nominal, static), train)[1], els, wrss, fmax)
             p, k_all, lti_trace = {"wiener": els}, kw, []

@@ -22,16 +22,13 @@ search runs the plays again (:class:`WienerBasis`).
 
 Selection (:func:`search_filter`): every kind on a coarse grid (the low-passes' corners
 ``LOWPASS_SLOW_HZ`` from ``LOWPASS_MIN_HZ``, then ``LOWPASS_HZ`` points from ``MIN_HZ``;
-``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual
-(every fit with every play column: the leading ones alone leave a misfit of the hysteresis that
-hides the filter), and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the
-candidate then
+``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual,
+and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the candidate then
 keeps this Wiener variant when its train BIC is lower than that of the Hammerstein variant
 (:mod:`.lti`), with
 ``k`` counted the same way (2 for the base mode plus 3 per further mode there; 1 or 2 here).
-The diagnosis scores both positions on validate instead (:func:`position_variants`): alone,
-each searched; beside other effects, the linear part after the hysteresis searched there and the
-filter found alone held.
+The position is decided on the ``dynamics`` candidate alone and held when it is fitted beside
+other effects (:func:`position_hint`).
 
 The feedforward inverse (:func:`inverse_prefilter`) is approximate: the hysteresis is inverted
 for the filter's output, then ``F(s)^-1 (s / wf + 1)^-r`` (``r`` the order of ``F``, ``wf``
@@ -52,8 +49,7 @@ from .lti import INVERSE_FILTER, element_coefficients, nelder_mead
 from .threads import drop_threads, per_thread
 
 __all__ = ["WienerBasis", "describe_wiener", "inverse_prefilter", "inverse_sections",
-           "polish_filter", "position_variants", "prefilter", "search_filter",
-           "wiener_k"]
+           "polish_filter", "position_hint", "prefilter", "search_filter", "wiener_k"]
 
 MIN_HZ = 50.0  # slowest mode [Hz] (a slower filter moves every loop of the record)
 LOWPASS_MIN_HZ = 15.0  # slowest low-pass corner [Hz]: an amplifier's bandwidth of 20-50 Hz
@@ -65,12 +61,12 @@ MODE_DAMPING = (0.1, 0.4, 1.0)
 GATE = 8.0  # refine a kind only when its grid comes within this factor of the RSS to beat
 DAMPING_RANGE = (0.02, 2.0)  # bounds of the refined damping
 REFINE_EVALUATIONS = {"lowpass": 12, "lowpass_direct": 12, "mode": 60}  # Nelder-Mead budget per
-# kind (every play column: the leading 12 alone hid a low-pass behind the hysteresis' misfit)
+# kind (leading columns)
 POLISH_EVALUATIONS = {"lowpass": 10, "lowpass_direct": 10, "mode": 20}  # then with every
 # column, when it is kept
 KEPT_COLUMNS = 4  # play-output matrices a WienerBasis keeps (the latest)
 ELEMENT_K = {"lowpass": 1, "lowpass_direct": 1, "mode": 2}
-POSITIONS = ("after", "before")  # of the dynamics alone: both fitted, chosen on validate
+KEYS = ("wiener",)  # the grid key of the Wiener variant (its filter elements)
 
 
 def _check(element) -> str:
@@ -354,9 +350,10 @@ def _refine(rss_of: Callable, el0: tuple, rss0: float, fmax: float, maxfev: int,
 
 def polish_filter(rss_of: Callable, elements: tuple, rss: float,
                   fmax: float) -> tuple[tuple, float]:
-    """A short Nelder-Mead polish of a filter found by :func:`search_filter`, with smaller
-    steps; a low-pass is also polished in its other sampling (``"lowpass"``,
-    ``"lowpass_direct"``) from the same corner, the lower RSS kept.
+    """A short Nelder-Mead polish of a filter found by :func:`search_filter` (which scores
+    with the leading play columns only) on the fit with every column; a low-pass is also
+    polished in its other sampling (``"lowpass"``, ``"lowpass_direct"``) from the same corner,
+    the lower RSS kept.
 
     Parameters
     ----------
@@ -387,10 +384,10 @@ def polish_filter(rss_of: Callable, elements: tuple, rss: float,
     el, rss = _refine(rss_of, tuple(elements[0]), rss, fmax,
                       POLISH_EVALUATIONS[elements[0][0]], (0.03, 0.1))
     if el[0] in LOWPASS_KINDS:
-        # the other sampling of the low-pass from the same corner: the two differ little on
-        # a coarse search (a sample of lag against a slightly faster corner), the right one
-        # fits to the noise (bw49: a 108 Hz amplifier sampled at the end of the hold kept as
-        # a 124 Hz ZOH low-pass)
+        # the other sampling of the low-pass from the same corner: on the leading columns of
+        # the search the two differ little (a sample of lag against a slightly faster
+        # corner), with every column the right one fits to the noise (bw49: a 108 Hz
+        # amplifier sampled at the end of the hold kept as a 124 Hz ZOH low-pass)
         other = (LOWPASS_KINDS[el[0] == "lowpass"], el[1])
         el2, rss2 = _refine(rss_of, other, rss_of((other,)), fmax,
                             POLISH_EVALUATIONS[other[0]], (0.03, 0.1))
@@ -399,47 +396,26 @@ def polish_filter(rss_of: Callable, elements: tuple, rss: float,
     return (el,), rss
 
 
-def position_variants(effects: tuple, fixed: dict, before: tuple | None = None) -> list[dict]:
-    """The variants of a fit that the diagnosis scores on validate for the position of the
-    dynamics. Alone: ``{"position": p}`` for each of ``POSITIONS`` (the linear part after the
-    hysteresis, :mod:`.lti`, and the filter before it, both searched). Beside other effects:
-    ``{}`` (after, searched there) and ``{"wiener": before}``, the filter the dynamics alone
-    found before the hysteresis, held. One variant, ``{}``, without ``dynamics`` or with its
-    grid held in ``fixed``. On train, a mode and a low-pass after the hysteresis can beat the
-    filter before it that made the records and then fit validate worse than the nominal (a
-    blind 70 Hz amplifier bandwidth on ramps and holds: validate RMS 0.043 um after, 0.011 um
-    before, the nominal 0.027 um); and beside a second effect the other position can fit
-    where the one chosen alone does not (density_stage's mode and pole beside an asymmetry).
+def position_hint(alone_grid: dict) -> dict:
+    """The grid parameters that hold the Wiener variant when ``dynamics`` is fitted beside
+    other effects: those of the ``dynamics`` candidate alone when it chose it, else none.
 
     Parameters
     ----------
-    effects : tuple of str
-        The effects fitted jointly.
-    fixed : dict
-        Their held grid parameters.
-    before : tuple or None
-        The filter elements of the dynamics fitted alone before the hysteresis (its
-        ``Model.grid["wiener"]``); None: none found.
+    alone_grid : dict
+        The grid parameters of the ``dynamics`` candidate fitted alone (``Model.grid``).
 
     Returns
     -------
-    list of dict
+    dict
+        ``{"wiener": elements}`` or ``{}``.
 
     Examples
     --------
-    >>> position_variants(("dynamics",), {})
-    [{'position': 'after'}, {'position': 'before'}]
-    >>> position_variants(("creep", "dynamics"), {}, (("lowpass", 1e-3),))
-    [{}, {'wiener': (('lowpass', 0.001),)}]
-    >>> position_variants(("dynamics",), {"fn": 900.0, "zeta": 0.1}), position_variants(
-    ...     ("creep", "dynamics"), {})
-    ([{}], [{}])
+    >>> position_hint({"wiener": (("lowpass", 1e-3),)}), position_hint({"fn": 900.0})
+    ({'wiener': (('lowpass', 0.001),)}, {})
     """
-    if "dynamics" not in effects or {"fn", "wiener", "held"} & set(fixed):
-        return [{}]
-    if tuple(effects) == ("dynamics",):
-        return [{"position": p} for p in POSITIONS]
-    return [{}] if before is None else [{}, {"wiener": tuple(before)}]
+    return {k: alone_grid[k] for k in KEYS if k in alone_grid}
 
 
 def inverse_sections(elements: Sequence, dt: float) -> np.ndarray | None:
