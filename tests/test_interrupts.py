@@ -117,3 +117,18 @@ def test_interrupted_message_names_the_counts_and_the_folder():
     assert isinstance(exc, KeyboardInterrupt)
     assert str(exc) == ("interrupted: 2 of 7 cases kept in somewhere; rerun the same command "
                         "to resume")
+
+
+def test_first_sigint_in_the_dask_loop_only_sets_the_flag_second_raises():
+    # a KeyboardInterrupt raised inside Dask's threading.Condition wait can leave its lock
+    # half released (RuntimeError instead of a clean stop): the loop polls a flag instead
+    from pimodel.experiments.sweeps import _deferred_sigint
+
+    before = signal.getsignal(signal.SIGINT)
+    with _deferred_sigint() as stop:
+        os.kill(os.getpid(), signal.SIGINT)
+        _wait_for(stop.is_set, timeout=5)
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+    assert signal.getsignal(signal.SIGINT) is before

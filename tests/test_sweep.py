@@ -262,7 +262,8 @@ def scheduler():
 
     cloudpickle.register_pickle_by_value(sys.modules[__name__])  # tests/ is not importable there
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster:
+                      dashboard_address=None, silence_logs=logging.ERROR,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster:
         yield cluster.scheduler_address
 
 

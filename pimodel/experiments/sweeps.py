@@ -29,8 +29,10 @@ import hashlib
 import json
 import os
 import random
-from collections.abc import Callable, Iterable, Mapping, Sequence
-from contextlib import nullcontext
+import threading
+import time
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager, nullcontext
 from functools import partial
 from itertools import product
 from pathlib import Path
@@ -408,8 +410,11 @@ def _start_local_cluster(workers: int, memory_limit):
     handler = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:  # the nannies and workers inherit the ignored SIGINT
         with dask.config.set({"distributed.nanny.pre-spawn-environ": spawn_env}):
+            # no dashboard; the scheduler's own HTTP server (health, metrics) on a free
+            # local port, not 8787: a second sweep at once would warn "Port 8787 is in use"
             return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                 memory_limit=memory_limit, dashboard_address=None,
+                                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                 silence_logs=logging.ERROR)
     finally:
         if main:
@@ -448,7 +453,7 @@ def _quiet_close(client, cluster, interrupted: bool) -> None:
 
 def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory_limit,
               counts) -> None:
-    from dask.distributed import Client, as_completed
+    from dask.distributed import Client
 
     cluster = _start_local_cluster(workers, memory_limit) if scheduler is None else None
     client = Client(cluster if cluster is not None else scheduler)
@@ -459,22 +464,66 @@ def _run_dask(func, cases, todo, results, cache, bar, workers, scheduler, memory
         futures = client.map(run, [cases[i] for i in todo], key=keys, pure=False)
         index = dict(zip(keys, todo, strict=True))
         done = len(cases) - len(todo)
-        for fut in as_completed(futures):
-            i = index[fut.key]
-            try:
-                results[i] = fut.result()
-            except Exception as exc:
-                client.cancel(futures)
-                raise _failure(i, cases[i], len(cases), exc, cache, done) from exc
-            cache.store(cases[i], results[i])
-            counts["computed"] += 1
-            done += 1
-            bar.update()
+        with _deferred_sigint() as stop:
+            for fut in _completed(futures, stop):
+                i = index[fut.key]
+                try:
+                    results[i] = fut.result()
+                except Exception as exc:
+                    client.cancel(futures)
+                    raise _failure(i, cases[i], len(cases), exc, cache, done) from exc
+                cache.store(cases[i], results[i])
+                counts["computed"] += 1
+                done += 1
+                bar.update()
     except KeyboardInterrupt:
         interrupted = True
         raise
     finally:
         _quiet_close(client, cluster, interrupted)
+
+
+@contextmanager
+def _deferred_sigint() -> Iterator[threading.Event]:
+    """On the main thread, the first SIGINT only sets the event yielded (a second one gets the
+    previous handler, which by default raises at once); elsewhere, or with SIGINT ignored or
+    not handled in Python, an event never set.
+
+    A ``KeyboardInterrupt`` raised inside Dask's own wait (a ``threading.Condition``) can leave
+    its lock half released (``RuntimeError: cannot release un-acquired lock``), so the Dask loop
+    polls this event between waits instead."""
+    import signal
+
+    stop = threading.Event()
+    previous = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or not callable(previous):
+        yield stop
+        return
+
+    def on_sigint(signum, frame):
+        stop.set()
+        signal.signal(signal.SIGINT, previous)
+
+    signal.signal(signal.SIGINT, on_sigint)
+    try:
+        yield stop
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _completed(futures: list, stop: threading.Event) -> Iterator:
+    """The futures as they finish, polled every 50 ms; ``KeyboardInterrupt`` once ``stop`` is
+    set."""
+    from dask.distributed import as_completed
+
+    pending = as_completed(futures)
+    while not pending.is_empty():
+        if stop.is_set():
+            raise KeyboardInterrupt
+        batch = pending.next_batch(block=False)
+        if not batch:
+            time.sleep(0.05)  # not stop.wait: a second SIGINT may raise inside it
+        yield from batch
 
 
 def grid(**axes: Sequence) -> list[dict]:
