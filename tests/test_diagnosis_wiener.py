@@ -191,3 +191,47 @@ def test_first_order_driver_on_other_seeds(seed):
 def test_second_order_driver_before_preisach_is_dynamics(seed):
     v = diagnose(*alt_driver_records(seed), initial_state="unknown").verdict
     assert v["effects"] == ["dynamics"] and v["shrink"] >= 0.5
+
+
+def ramp_hold(rng: np.random.Generator, fs: float, duration: float) -> np.ndarray:
+    """Ramps of 0.05-0.4 s between random levels in [-1, 1] V, each held 0.02-0.3 s, from a
+    50 ms rest at 0 V (a user's positioning moves)."""
+    parts, level = [np.zeros(int(0.05 * fs))], 0.0
+    while sum(p.size for p in parts) < duration * fs:
+        new = rng.uniform(-1.0, 1.0)
+        parts.append(np.linspace(level, new, int(rng.uniform(0.05, 0.4) * fs), endpoint=False))
+        parts.append(np.full(int(rng.uniform(0.02, 0.3) * fs), new))
+        level = new
+    return np.concatenate(parts)[: int(duration * fs)]
+
+
+def amplifier_ramp_records(seed: int):
+    """A PI stage behind an amplifier of a 40-150 Hz bandwidth, ``u[k] = a u[k-1] + (1 - a)
+    v[k]`` (not the ZOH form of the candidate), ramps to held levels at 5 kHz."""
+    fs = 5000.0
+    rng = np.random.default_rng(7000 + seed)
+    fc = rng.uniform(40.0, 150.0)
+    a = np.exp(-2 * np.pi * fc / fs)
+    truth = random_truth([], seed)
+    recs = []
+    for j, duration in enumerate((3.0, 2.5)):
+        v = ramp_hold(rng, fs, duration)
+        t = np.arange(v.size) / fs
+        u = lfilter([1 - a], [1.0, -a], v, zi=[a * v[0]])[0]
+        y = truth.simulate(t, u, np.random.default_rng(100 * seed + j))
+        recs.append(Record(t, v, y, source=("train", "validate")[j]))
+    return [recs[0]], [recs[1]], fc
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [int(s) for s in np.random.default_rng(70).integers(0, 1000, 2)])
+def test_amplifier_bandwidth_under_ramps_and_holds_is_a_lowpass_before(seed):
+    """The filter before the hysteresis is searched with every play column: with the leading
+    12 (principal directions of the unfiltered plays) the hysteresis itself misfit by some 200
+    times the noise and such stages read ``delay`` (0 of 7 measured)."""
+    train, validate, fc = amplifier_ramp_records(seed)
+    v = diagnose(train, validate, workers=1).verdict
+    assert v["effects"] == ["dynamics"]
+    assert v["model"]["dynamics_position"] == "before"
+    assert abs(v["model"]["lowpass_hz"] / fc - 1) < 0.2
+    assert v["gap_after"] < 1.5 * v["noise_floor"] < 0.5 * v["gap_before"]

@@ -86,6 +86,7 @@ MODE_HEAVY = (tuple(np.geomspace(100.0, 5000.0, 9)), 0.7)
 MODE_DAMPING_RANGE = (0.005, 0.9)  # bounds of the refined damping
 MAX_MODE_NYQUIST = 0.8  # the mode frequency stays below this fraction of the Nyquist frequency
 SEARCH_COLUMNS = 12  # play columns (leading first) in the grid searches; the final fit uses all
+# (and the search of a filter before the hysteresis: module wiener)
 SCREEN_SAMPLES = 1 << 16  # a longer train record: searches on its first samples (_screen)
 LTI_MEMO = 16  # columns of the linear part's elements memoised per record (the last base mode)
 _ORDER_LOCK = threading.Lock()  # guards the memos of _order_memo (module threads)
@@ -1188,8 +1189,11 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
                                                           for s in train):
         # the linear part before the hysteresis (module wiener), kept on a lower train BIC
         n = sum(s.y[s.used].size for s in train)
-        els, _, kw = search_filter(lambda e: search([{"wiener": e}])[1], fmax, n,
-                                   rss_to_beat=best[1])  # the Hammerstein's, same columns
+        def rss_of(e):  # with every play column: the leading ones (principal directions of
+            # the unfiltered plays) misfit a filtered input's hysteresis ~200x the noise
+            return _fit(name, k, _combo_features(effects, {"wiener": e}, nominal, static),
+                        train, {"wiener": e})[1]
+        els, _, kw = search_filter(rss_of, fmax, n, rss_to_beat=rss)  # the Hammerstein's
         wmodel, wrss = _fit(name, kw, _combo_features(effects, {"wiener": els}, nominal,
                                                       static), train, {"wiener": els})
         delta = n * np.log(max(wrss, 1e-300) / max(rss, 1e-300)) + (kw - k_all) * np.log(n)

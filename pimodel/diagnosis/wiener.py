@@ -23,10 +23,13 @@ search runs the plays again (:class:`WienerBasis`).
 Selection (:func:`search_filter`): every kind on a coarse grid (the low-passes' corners
 ``LOWPASS_SLOW_HZ`` from ``LOWPASS_MIN_HZ``, then ``LOWPASS_HZ`` points from ``MIN_HZ``;
 ``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual,
-and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the candidate then
-keeps this Wiener variant when its train BIC is lower than that of the Hammerstein variant
-(:mod:`.lti`), with
-``k`` counted the same way (2 for the base mode plus 3 per further mode there; 1 or 2 here).
+every point scored with every play column (the leading columns of the mode searches in
+:mod:`.effects`, principal directions of the unfiltered plays, misfit the hysteresis of a
+filtered input by some 200 times the noise: ramps and holds behind a 40-150 Hz amplifier then
+read ``delay``), and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the
+candidate then keeps this Wiener variant when its train BIC is lower than that of the
+Hammerstein variant (:mod:`.lti`, refitted with every column), with ``k`` counted the same way
+(2 for the base mode plus 3 per further mode there; 1 or 2 here).
 The position is decided on the ``dynamics`` candidate alone and held when it is fitted beside
 other effects (:func:`position_hint`).
 
@@ -61,9 +64,9 @@ MODE_DAMPING = (0.1, 0.4, 1.0)
 GATE = 8.0  # refine a kind only when its grid comes within this factor of the RSS to beat
 DAMPING_RANGE = (0.02, 2.0)  # bounds of the refined damping
 REFINE_EVALUATIONS = {"lowpass": 12, "lowpass_direct": 12, "mode": 60}  # Nelder-Mead budget per
-# kind (leading columns)
-POLISH_EVALUATIONS = {"lowpass": 10, "lowpass_direct": 10, "mode": 20}  # then with every
-# column, when it is kept
+# kind
+POLISH_EVALUATIONS = {"lowpass": 10, "lowpass_direct": 10, "mode": 20}  # then the polish, when
+# it is kept
 KEPT_COLUMNS = 4  # play-output matrices a WienerBasis keeps (the latest)
 ELEMENT_K = {"lowpass": 1, "lowpass_direct": 1, "mode": 2}
 KEYS = ("wiener",)  # the grid key of the Wiener variant (its filter elements)
@@ -350,10 +353,9 @@ def _refine(rss_of: Callable, el0: tuple, rss0: float, fmax: float, maxfev: int,
 
 def polish_filter(rss_of: Callable, elements: tuple, rss: float,
                   fmax: float) -> tuple[tuple, float]:
-    """A short Nelder-Mead polish of a filter found by :func:`search_filter` (which scores
-    with the leading play columns only) on the fit with every column; a low-pass is also
-    polished in its other sampling (``"lowpass"``, ``"lowpass_direct"``) from the same corner,
-    the lower RSS kept.
+    """A short Nelder-Mead polish of a filter found by :func:`search_filter` on the fit with
+    every column; a low-pass is also polished in its other sampling (``"lowpass"``,
+    ``"lowpass_direct"``) from the same corner, the lower RSS kept.
 
     Parameters
     ----------
