@@ -30,8 +30,9 @@ read ``delay``), and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N
 candidate then keeps this Wiener variant when its train BIC is lower than that of the
 Hammerstein variant (:mod:`.lti`, refitted with every column), with ``k`` counted the same way
 (2 for the base mode plus 3 per further mode there; 1 or 2 here).
-The position is decided on the ``dynamics`` candidate alone and held when it is fitted beside
-other effects (:func:`position_hint`).
+The position is decided on the ``dynamics`` candidate alone; beside other effects, where it
+chose the filter, the filter held (:func:`position_hint`) and the linear part after the
+hysteresis searched there are both fitted, and the lower validate BIC kept.
 
 The feedforward inverse (:func:`inverse_prefilter`) is approximate: the hysteresis is inverted
 for the filter's output, then ``F(s)^-1 (s / wf + 1)^-r`` (``r`` the order of ``F``, ``wf``
@@ -400,7 +401,8 @@ def polish_filter(rss_of: Callable, elements: tuple, rss: float,
 
 def position_hint(alone_grid: dict) -> dict:
     """The grid parameters that hold the Wiener variant when ``dynamics`` is fitted beside
-    other effects: those of the ``dynamics`` candidate alone when it chose it, else none.
+    other effects (one of the two variants scored there): those of the ``dynamics`` candidate
+    alone when it chose it, else none.
 
     Parameters
     ----------
