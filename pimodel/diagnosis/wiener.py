@@ -274,8 +274,8 @@ def _grid(fmax: float) -> dict:
     return out
 
 
-def search_filter(rss_of: Callable, fmax: float, n: int,
-                  rss_to_beat: float | None = None) -> tuple[tuple, float, int]:
+def search_filter(rss_of: Callable, fmax: float, n: int, rss_to_beat: float | None = None,
+                  kinds: Sequence[str] | None = None) -> tuple[tuple, float, int]:
     """The filter with the lowest train BIC (module docstring).
 
     Parameters
@@ -291,6 +291,8 @@ def search_filter(rss_of: Callable, fmax: float, n: int,
         kind whose best grid point is more than ``GATE`` times above it is not refined (it
         cannot win; this spares the refinement on a stage whose dynamics follow the
         hysteresis).
+    kinds : sequence of str, optional
+        The kinds searched (``"lowpass"``, ``"lowpass_direct"``, ``"mode"``); None: all.
 
     Returns
     -------
@@ -322,6 +324,8 @@ def search_filter(rss_of: Callable, fmax: float, n: int,
         raise ValueError(f"fmax: expected >= {MIN_HZ} Hz, got {fmax!r}")
     best = None
     for kind, grid in _grid(fmax).items():
+        if kinds is not None and kind not in kinds:
+            continue
         scored = [(el, rss_of((el,))) for el in grid if _admissible(el, fmax)]
         el, rss = min(scored, key=lambda o: o[1])
         if rss_to_beat is None or rss < GATE * rss_to_beat:
