@@ -22,11 +22,12 @@ search runs the plays again (:class:`WienerBasis`).
 
 Selection (:func:`search_filter`): every kind on a coarse grid (the low-passes' corners
 ``LOWPASS_SLOW_HZ`` from ``LOWPASS_MIN_HZ``, then ``LOWPASS_HZ`` points from ``MIN_HZ``;
-``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual,
-every point scored with every play column (the leading columns of the mode searches in
-:mod:`.effects`, principal directions of the unfiltered plays, misfit the hysteresis of a
-filtered input by some 200 times the noise: ramps and holds behind a 40-150 Hz amplifier then
-read ``delay``), and the kind with the lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the
+``MODE_HZ`` x ``MODE_DAMPING``), the best of each refined by Nelder-Mead on the train residual
+(:mod:`.effects` scores the low-passes with every play column: the leading columns of its mode
+searches, principal directions of the unfiltered plays, misfit the hysteresis of a filtered
+input by some 200 times the noise, and ramps and holds behind a 40-150 Hz amplifier then read
+``delay``; the mode with the leading columns, then with every column), and the kind with the
+lowest train BIC ``N ln(RSS / N) + k ln N`` kept; the
 candidate then keeps this Wiener variant when its train BIC is lower than that of the
 Hammerstein variant (:mod:`.lti`, refitted with every column), with ``k`` counted the same way
 (2 for the base mode plus 3 per further mode there; 1 or 2 here).
