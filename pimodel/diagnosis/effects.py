@@ -1208,8 +1208,7 @@ def _fit_combo(effects: tuple[str, ...], train, fixed: dict, nominal: Model,
         positions = [{"position": "after", "train_bic": 0.0},
                      {"position": "before", "structure": [els[0][0]], "train_bic": float(delta)}]
         if delta < 0:  # kept: polished with every play column
-            els, _ = polish_filter(lambda e: _fit(name, kw, _combo_features(
-                effects, {"wiener": e}, nominal, static), train)[1], els, wrss, fmax)
+            els, _ = polish_filter(rss_of, els, wrss, fmax)  # the RSS does not depend on k
             p, k_all, lti_trace = {"wiener": els}, kw, []
             model = _fit(name, kw, _combo_features(effects, p, nominal, static), train, p)[0]
     if "asymmetry" in effects:
