@@ -235,3 +235,9 @@ def test_amplifier_bandwidth_under_ramps_and_holds_is_a_lowpass_before(seed):
     assert v["model"]["dynamics_position"] == "before"
     assert abs(v["model"]["lowpass_hz"] / fc - 1) < 0.2
     assert v["gap_after"] < 1.5 * v["noise_floor"] < 0.5 * v["gap_before"]
+
+
+@pytest.mark.parametrize("kinds", [(), ("lowpass", "notch")])
+def test_search_filter_names_a_bad_kind(kinds):
+    with pytest.raises(ValueError, match=r"^kinds: expected some of \['lowpass'"):
+        search_filter(lambda els: 1.0, 2000.0, 100, kinds=kinds)

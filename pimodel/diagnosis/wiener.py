@@ -307,7 +307,7 @@ def search_filter(rss_of: Callable, fmax: float, n: int, rss_to_beat: float | No
     Raises
     ------
     ValueError
-        ``fmax`` below ``MIN_HZ``.
+        ``fmax`` below ``MIN_HZ``; ``kinds`` empty or naming an unknown kind.
 
     Examples
     --------
@@ -323,6 +323,8 @@ def search_filter(rss_of: Callable, fmax: float, n: int, rss_to_beat: float | No
     """
     if not fmax >= MIN_HZ:
         raise ValueError(f"fmax: expected >= {MIN_HZ} Hz, got {fmax!r}")
+    if kinds is not None and (not kinds or set(kinds) - set(ELEMENT_K)):
+        raise ValueError(f"kinds: expected some of {sorted(ELEMENT_K)}, got {kinds!r}")
     best = None
     for kind, grid in _grid(fmax).items():
         if kinds is not None and kind not in kinds:
