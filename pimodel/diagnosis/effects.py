@@ -889,7 +889,10 @@ def fit_effect(name: str, train, combo: tuple[str, ...] = (), fixed: dict | None
         Named by the effects joined by ``+``, with ``k`` added parameters, the grid optimum in
         ``grid`` and the fitted physical parameters in ``params``. With an asymmetry, the
         effect columns are built from the hysteresis part of the joint fit, refitted
-        ``ASYMMETRY_ITERATIONS`` times, and ``reference`` holds it.
+        ``ASYMMETRY_ITERATIONS`` times, and ``reference`` holds it. With a delay, the columns
+        built from that reference ``h0`` (creep, asymmetry, the linear part's elements) are
+        delayed with the play rows: the delay acts on the input of everything the plays
+        drive (:mod:`.model`).
 
     Examples
     --------
@@ -1369,9 +1372,13 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
     def static_rows(s: Segment) -> np.ndarray:
         key = (start, creep_levels(effects, p), id(s)) if start in ("common", "record") \
             else id(s)
-        if key not in static:
+        # a delay delays the input of everything the hysteresis drives: h0 too (the rows of
+        # the latest delay kept per segment: a delay search tries many)
+        d = p["d"] if "delay" in effects else 0
+        kept = static.get(key)
+        if kept is None or kept[2] != d:
             out = [np.ones(s.t.size)]
-            h0 = nominal.predict(s)
+            h0 = shift(_reference(s, nominal, static), d) if d else nominal.predict(s)
             taus = nominal.params["creep_taus"] if "creep" in effects else ()
             if common:  # lags at rest at levels shared by the records (module creep)
                 out += [lag(h0, tau, s.dt, 0.0) - h0 for tau in taus]
@@ -1389,8 +1396,8 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             if "asymmetry" in effects:
                 u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
                 out += [u**2, u**3]
-            static[key] = (s, np.vstack(out))  # keep s alive so its id stays unique
-        return static[key][1]
+            kept = static[key] = (s, np.vstack(out), d)  # s alive: its id stays unique
+        return kept[1]
 
     def rows(s: Segment) -> tuple[np.ndarray, np.ndarray]:  # the play rows, then the others
         Z = s.play_rows(ncols)
@@ -1455,13 +1462,19 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
 _LTI_LOCK = threading.Lock()  # the element columns' memo of _lti_block
 
 
-def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
-    """The columns ``(E_j - M_1)[h0]`` of the elements ``p["lti"]`` (delayed by ``p["d"]`` when
-    the delay is fitted too); ``h0`` is memoised per segment in ``static``."""
+def _reference(s: Segment, nominal: Model, static: dict) -> np.ndarray:
+    """``h0``, the reference hysteresis output ``nominal.predict(s)``, memoised per segment in
+    ``static``."""
     key = ("h0", id(s))
     if key not in static:
         static[key] = (s, nominal.predict(s))
-    h0 = static[key][1]
+    return static[key][1]
+
+
+def _lti_block(s: Segment, p: dict, nominal: Model, static: dict) -> np.ndarray:
+    """The columns ``(E_j - M_1)[h0]`` of the elements ``p["lti"]`` (delayed by ``p["d"]`` when
+    the delay is fitted too); ``h0`` is memoised per segment in ``static``."""
+    h0 = _reference(s, nominal, static)
     base = static.get(("M1[h0]", id(s)))  # the base mode's response, for the last mode only
     if base is None or base[0] != (p["fn"], p["zeta"]):
         base = ((p["fn"], p["zeta"]), mode(h0, p["fn"], p["zeta"], s.dt))

@@ -18,7 +18,9 @@ The diagnosis fits every candidate *jointly* with the hysteresis weights, in a p
 
 where ``D`` is the identity, the unit-gain base mode ``M_1`` (ZOH, ``(D Z)[k]`` depends on
 ``Z[0..k-1]``) and/or a delay of ``d`` samples (fractional: linear interpolation); ``D'`` the
-delay alone. ``E_j`` are the further modes, low-pass and direct term of the linear part
+delay alone. A delay acts on the input of everything the plays drive: with it, ``h0`` in the
+creep and asymmetry terms is ``h0`` delayed by ``d`` samples too (held at ``h0[0]`` before the
+start). ``E_j`` are the further modes, low-pass and direct term of the linear part
 (:mod:`.lti`). ``L_i`` is the exact
 first-order lag at rest around ``h0[0]``: ``L[k] = a L[k-1] + (1 - a) h0[k]``,
 ``a = exp(-dt / tau)``; with ``creep_start == "common"`` (a stage parked between records,
@@ -321,6 +323,8 @@ class DiagnosedModel:
             if "delay" in e:
                 cols = shift(cols, p["delay_samples"])
             y = y + cols @ np.asarray(p["lti_gains"], float)
+        if "delay" in e:  # the delay acts on the input: the effect terms' h0 delayed too
+            h0 = shift(h0, p["delay_samples"])
         y_meas = None if measured is None else checked_signal(measured, "measured")
         if y_meas is not None and y_meas.shape != v.shape:
             raise ValueError(f"measured: expected {v.size} samples like v, got {y_meas.shape}")

@@ -464,7 +464,8 @@ def state_labels(model) -> list[str]:
         ``m[1..n]`` (the radius family's terms held from each play's last contact),
         ``L[1..m]`` (creep lags),
         ``s[1..q]`` (LTI states), ``e[1..2 (ne + 1)]`` (the sections of the linear part's
-        further elements and of its base mode on ``h0``), ``x_delay[1..nbuf]`` (delay line),
+        further elements and of its base mode on ``h0``), ``x_delay[1..nbuf]`` and
+        ``h0_delay[1..nbuf]`` (delay lines of the hysteresis term and of ``h0``),
         and for a Wiener model ``zf[1..n]`` (plays of the filtered input) and ``f[1..2 nw]``
         (two states per section of the filter before the hysteresis), and ``L0`` (the lags'
         start ``h0[0]``, kept for a creep counted from each record's start, ``creep_start``
@@ -486,7 +487,7 @@ def state_labels(model) -> list[str]:
     return (["started", "v_prev", "t_start", "head"] + signal_labels("z", n)
             + rate + signal_labels("L", d.m)
             + signal_labels("s", d.order) + signal_labels("e", 2 * (d.ne + 1) if d.ne else 0)
-            + signal_labels("x_delay", nbuf)
+            + signal_labels("x_delay", nbuf) + signal_labels("h0_delay", nbuf)
             + (signal_labels("zf", n) + signal_labels("f", 2 * d.nw) if d.nw else [])
             + (["L0"] if d.lag_record and d.m else []))
 

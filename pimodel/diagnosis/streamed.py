@@ -147,6 +147,7 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
     mode_f = _Biquad(*mode_coefficients(p["fn"], p["zeta"], dt)) if "dynamics" in effects \
         else None
     delayed = _Shift(p["d"]) if "delay" in effects else None
+    h0_delayed = _Shift(p["d"]) if "delay" in effects else None  # the effect rows' h0
     lti = p.get("lti") or ()
     if lti:
         base = _Biquad(*mode_coefficients(p["fn"], p["zeta"], dt))
@@ -163,14 +164,15 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
         if delayed is not None:
             Z = delayed(Z)
         h0 = combine((rows,), nominal.coef)
+        hd = h0 if h0_delayed is None else h0_delayed(h0[None, :])[0]  # delayed as the plays
         out = [np.ones(h0.size)]
-        out += [lag(h0) - h0 - (lag.rest if record else 0.0) for lag in lags]
+        out += [lag(hd) - hd - (lag.rest if record else 0.0) for lag in lags]
         if levels:  # a creep counted from each start: a level per train record after the first
             out += list(level_rows(train_record, n_train, h0.size))
         if common:
             out += list(start_columns(np.arange(c.start, c.stop), dt, taus))
         if "asymmetry" in effects:
-            u = (h0 - nominal.params["center"]) / nominal.params["half_range"]
+            u = (hd - nominal.params["center"]) / nominal.params["half_range"]
             out += [u**2, u**3]
         parts = [Z, np.vstack(out)]
         if lti:

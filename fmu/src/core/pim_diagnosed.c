@@ -25,7 +25,7 @@ size_t pim_diag_rate_size(const pim_diag *d)
 size_t pim_diag_state_size(const pim_diag *d)
 {
     return PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
-           pim_diag_element_states(d) + pim_diag_delay_length(d->delay) +
+           pim_diag_element_states(d) + 2 * pim_diag_delay_length(d->delay) +
            pim_diag_prefilter_states(d) + pim_diag_record_states(d);
 }
 
@@ -177,13 +177,24 @@ const char *pim_diag_check(const pim_diag *d)
     return NULL;
 }
 
+/* The value `delay` samples before the newest, buf[head], of the ring buf[nbuf] (a fractional
+ * part interpolates linearly, as pimodel.diagnosis.filters.shift). */
+static double delayed(const double *buf, size_t nbuf, size_t head, double delay)
+{
+    const size_t d0 = (size_t)floor(delay);
+    const double f = delay - (double)d0;
+    const double x0 = buf[(head + nbuf - d0) % nbuf];
+    if (f > 1e-12) return (1.0 - f) * x0 + f * buf[(head + nbuf - d0 - 1) % nbuf];
+    return x0;
+}
+
 double pim_diag_step(const pim_diag *d, double *x, double v, double t)
 {
     const size_t n = d->n, nr = pim_diag_rate_size(d), q = d->order;
     const size_t nbuf = pim_diag_delay_length(d->delay);
     double *z = x + PIM_DIAG_HEADER, *rate = z + n, *mem = rate + 1, *lag = rate + nr,
            *s = lag + d->m, *es = s + q, *buf = es + pim_diag_element_states(d),
-           *zf = buf + nbuf, *fs = zf + n,
+           *hbuf = buf + nbuf, *zf = hbuf + nbuf, *fs = zf + n,
            *l0 = x + pim_diag_state_size(d) - pim_diag_record_states(d);
     const int radius = nr && d->rate_family == PIM_DIAG_RATE_RADIUS;
     const int scaled = nr && d->rate_family == PIM_DIAG_RATE_SCALED;
@@ -264,23 +275,21 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
                    (lti_step(d->el_b + m * j, d->el_a + m * j, o, es + o * j, h0, first) - base);
         xk += acc;
     }
-    /* delay line: buf[head] holds x[k] after the write */
+    /* delay lines: buf[head] holds x[k], hbuf[head] h0[k] after the write; the delay acts on
+     * the input of everything the plays drive, so the effect terms below take h0 delayed */
     double y = xk;
     if (nbuf) {
         size_t head = first ? 0 : ((size_t)x[3] + 1) % nbuf;
         if (first)
-            for (size_t j = 0; j < nbuf; ++j) buf[j] = xk;
+            for (size_t j = 0; j < nbuf; ++j) {
+                buf[j] = xk;
+                hbuf[j] = h0;
+            }
         buf[head] = xk;
+        hbuf[head] = h0;
         x[3] = (double)head;
-        const size_t d0 = (size_t)floor(d->delay);
-        const double f = d->delay - (double)d0;
-        const double x0 = buf[(head + nbuf - d0) % nbuf];
-        if (f > 1e-12) {
-            const double x1 = buf[(head + nbuf - d0 - 1) % nbuf];
-            y = (1.0 - f) * x0 + f * x1;
-        } else {
-            y = x0;
-        }
+        y = delayed(buf, nbuf, head, d->delay);
+        h0 = delayed(hbuf, nbuf, head, d->delay);
     }
     y += d->c;
     /* the effect terms, in the order of DiagnosedModel.simulate */
@@ -318,6 +327,20 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     x[0] = 1.0;
     x[1] = v;
     return y;
+}
+
+int pim_diag_pending_finite(const pim_diag *d, const double *x)
+{
+    const size_t nbuf = pim_diag_delay_length(d->delay);
+    if (!nbuf || x[0] == 0.0) return 1;
+    const double *buf = x + PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
+                        pim_diag_element_states(d);
+    const size_t head = (size_t)x[3];
+    const double xk = buf[head], h0 = buf[nbuf + head];
+    if (!isfinite(xk) || !isfinite(h0)) return 0;
+    if (!d->asym) return 1;
+    const double u = (h0 - d->center) / d->half;
+    return isfinite(d->q * (u * u) + d->c3 * (u * u * u));
 }
 
 void pim_diag_run(const pim_diag *d, double *x, size_t N, const double *v, const double *t,

@@ -26,6 +26,8 @@
  *                                     a_0 = 1), at rest around h0[0] (pimodel.diagnosis.lti)
  *     y[k]   = (1 - f) x[k - d0] + f x[k - d0 - 1] + c               delay d = d0 + f samples,
  *                                                                    x[j < 0] = x[0]
+ * and in the effect terms below h0[k] stands for h0 delayed alike, (1 - f) h0[k - d0] +
+ * f h0[k - d0 - 1] (h0[j < 0] = h0[0]; the delay acts on the input of all the plays drive):
  *            + sum_j g_j (L_j[k] - h0[k])     creep: L_j[k] = a_j L_j[k-1] + (1 - a_j) h0[k],
  *                                                    L_j[-1] = h0[0] (lag_start NULL) or
  *                                                    L_j[-1] = lag_start[j] (a common rest:
@@ -56,7 +58,7 @@
  *
  * State (one flat array of pim_diag_state_size(d) doubles, so that python-control blocks and FMU
  * states hold it as is): [started, v_prev, t_start, head, z[n], rate[n_rate], L[m], s[order],
- * e[n_e], buf[nbuf], zf[n_f], f[2 nw], L0[n_r]] (e: two states per section M_1, E_1..E_ne, n_e =
+ * e[n_e], buf[nbuf], hbuf[nbuf], zf[n_f], f[2 nw], L0[n_r]] (e: two states per section M_1, E_1..E_ne, n_e =
  * 2 (ne + 1), or 0 when ne = 0; zf: the plays of the filtered input and f: two states per
  * prefilter section, n_f = n, both present only when nw > 0; L0: the lags' start h0[0], set on
  * the first sample, n_r = 1 when lag_record = 1 and m > 0, else 0) with rate = [rho_f[k-1], m[n]]
@@ -64,7 +66,8 @@
  * (scaled family: the rate pim_rdpi_sat_run holds for the next sample, in input unit / s, and
  * the scaled plays) or none; all zero (except z and zf = the
  * initial play states, pim_diag_initial_state) before the first sample.  `head` is the
- * ring position of x[k-1] in buf (nbuf = floor(d) + 2 when d > 0, else 0).  Units: v and r
+ * ring position of x[k-1] in buf and of h0[k-1] in hbuf (nbuf = floor(d) + 2 when d > 0, else
+ * 0).  Units: v and r
  * in the input unit, y, c, c0, center, half in the output unit, t in s, s in output unit / s.
  */
 #ifndef PIM_DIAGNOSED_H
@@ -83,7 +86,7 @@ extern "C" {
 #define PIM_DIAG_HEADER 4            /* started, v_prev, t_start, head */
 #define PIM_DIAG_STATE_MAX (PIM_DIAG_HEADER + 2 * PIM_DIAG_MAX_PLAYS + 1 + PIM_DIAG_MAX_LAGS + \
                             PIM_DIAG_MAX_ORDER + 2 * (PIM_DIAG_MAX_ELEMENTS + 1) + \
-                            PIM_DIAG_MAX_DELAY + PIM_DIAG_MAX_PLAYS + \
+                            2 * PIM_DIAG_MAX_DELAY + PIM_DIAG_MAX_PLAYS + \
                             2 * PIM_DIAG_MAX_ELEMENTS + 1)
 
 typedef struct {
@@ -167,6 +170,11 @@ PIM_API void pim_diag_initial_state(const pim_diag *d, double *x, double z0);
 
 /* One sample: y[k] for v[k] at time t[k]; the state x advances to after sample k. */
 PIM_API double pim_diag_step(const pim_diag *d, double *x, double v, double t);
+
+/* After a step, with a delay: whether what the step wrote into the delay lines (the hysteresis
+ * term x[k], h0[k] and the asymmetry of h0[k]) is finite: it reaches the output d samples
+ * later, so a unit refuses the step that overflows, not a later one.  1 without a delay. */
+PIM_API int pim_diag_pending_finite(const pim_diag *d, const double *x);
 
 /* N samples (t may be NULL: t[k] = k dt); x advances. */
 PIM_API void pim_diag_run(const pim_diag *d, double *x, size_t N, const double *v,

@@ -9,6 +9,7 @@
 #include "sections.h"
 #define HAS_MODEL_DEFAULTS
 #define HAS_MODEL_DERIVE
+#define HAS_MODEL_OUTPUTS_FINITE
 
 static void model_defaults(pim_unit *u)
 {
@@ -124,6 +125,14 @@ static void model_sample(pim_unit *u)
     pim_diag d;
     unit_diag(u, &d);
     u->out1 = pim_diag_step(&d, u->dstate, u->in1, (double)u->k_next * u->Ts);
+}
+
+/* With a delay, the terms a step put into the delay lines are finite too (they reach y later). */
+static int model_outputs_finite(const pim_unit *u)
+{
+    pim_diag d;
+    unit_diag(u, &d);
+    return pim_diag_pending_finite(&d, u->dstate);
 }
 
 static void model_save(const pim_unit *u, model_saved *s)
