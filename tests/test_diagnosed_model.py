@@ -84,6 +84,44 @@ def test_synthetic_creep_asymmetry_round_trip():
     assert np.max(np.abs(m.inverse().simulate(m.simulate(v)) - v)) < 1e-9
 
 
+@pytest.mark.parametrize("d", [1, 4, 2.5])
+@pytest.mark.parametrize("start", ["rest", "record", "common"])
+def test_a_delay_delays_the_input_of_every_term(d, start):
+    """The delay acts on the input: a model with creep, asymmetry and a delay of ``d`` samples
+    is the model without the delay, its output delayed (held at its first sample before the
+    start; a fractional ``d`` interpolates ``h0`` between the two whole delays, so only the
+    terms linear in ``h0`` commute with it: no asymmetry there). Before, the creep and the
+    asymmetry took ``h0`` undelayed beside the delayed hysteresis."""
+    params = {"creep_lag_gains": [0.04, -0.01], "creep_time_constants_s": [0.01, 0.2],
+              "asymmetry_quadratic": 0.05, "asymmetry_cubic": -0.01, "center": 0.8,
+              "half_range": 1.0}
+    if start != "rest":
+        params["creep_start"] = start
+    if start == "common":
+        params["creep_start_levels"] = [0.3, -0.2]
+
+    def model(effects, **more):
+        return DiagnosedModel([0.0, 0.2, 0.5], [1.0, 0.4, 0.3], 0.2, dt=1e-3, effects=effects,
+                              reference_weights=[0.9, 0.45, 0.3], reference_offset=0.1,
+                              params={**params, **more})
+
+    t = np.arange(3000) * 1e-3
+    v = 0.3 + np.sin(2 * np.pi * 1.3 * t) * (1 + 0.5 * np.sin(2 * np.pi * 0.2 * t))
+    v[1500:] += np.where(np.arange(1500) % 300 < 150, 0.4, -0.2)  # steps
+    terms = ("creep", "asymmetry") if d == int(d) else ("creep",)
+    plain = model(terms).simulate(v)
+    delayed = model((*terms, "delay"), delay_samples=d).simulate(v)
+    lo, f = int(np.floor(d)), d - np.floor(d)
+    want = (1 - f) * np.concatenate([np.full(lo, plain[0]), plain[:plain.size - lo]]) + \
+        f * np.concatenate([np.full(lo + 1, plain[0]), plain[:plain.size - lo - 1]])
+    if start == "common":  # the lags' free response from their rest runs on time, undelayed
+        assert np.max(np.abs(delayed - want)) < 0.05 * np.ptp(plain)
+        free = model((*terms, "delay"), delay_samples=d, creep_lag_gains=[0, 0])
+        assert np.max(np.abs(free.simulate(v) - want)) > 1e-3  # the creep is there
+    else:
+        assert np.max(np.abs(delayed - want)) < 1e-12 * np.ptp(plain)
+
+
 @pytest.mark.parametrize("u", [-1.3, -0.6, 0.0, 0.45, 1.3])
 def test_unknown_initial_state_recovers_the_memory_of_a_reversal(u):
     """A stage that went from rest to ``u`` and back to 0 before the reference starts (the
