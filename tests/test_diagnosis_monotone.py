@@ -107,6 +107,31 @@ def test_folding_model_inverse_has_no_jumps():
     assert np.max(np.abs(m.simulate(v) - y_d)) > 1e-3
 
 
+@pytest.mark.parametrize("growth", [0.2, 1.0, 2.0])
+def test_folding_scaled_rate_model_inverse_has_no_jumps(growth):
+    """The rate's exact shape (plays whose radii all scale by one factor per sample) folds as
+    the plain PI does; its inverse follows the nearest monotone weights, the rate kept, and is
+    exact for that model. Its largest one-sample step, in reference steps over the floor
+    slope: 1.2-4.4 (the radii move with the rate, so not at most 1 as without it); before, the
+    folding weights were inverted as they are and the feedforward jumped 21-37 of them."""
+    r = np.linspace(0.0, 1.0, 21)
+    S = np.full(21, 0.8)
+    S[0], S[10], S[11] = -0.1, -0.6, -0.3
+    m = DiagnosedModel(r, np.diff(S, prepend=0.0), 0.1, dt=1e-3, effects=("rate",),
+                       params={"rate_family": "scaled", "rate_gains": [1.0],
+                               "rate_growth": growth, "rate_time_constant_s": 5e-3,
+                               "rate_saturation": 2.0, "rate_scale": 2.0})
+    mono = monotone_model(m)
+    assert is_monotone(mono.weights) and mono.params == m.params
+    t = np.arange(3000) * 1e-3
+    y_d = 0.8 * np.sin(2 * np.pi * t) * (1 - 0.3 * t / t[-1])
+    v = m.inverse().simulate(y_d)
+    ref_step = np.max(np.abs(np.diff(y_d))) / _floor(m.weights)
+    assert np.max(np.abs(np.diff(v))) <= 8 * ref_step
+    assert np.max(np.abs(mono.simulate(v) - y_d)) < 1e-9
+    assert np.max(np.abs(m.simulate(v) - y_d)) > 1e-3
+
+
 def test_monotone_model_is_the_identity_on_monotone_models():
     m = DiagnosedModel([0.0, 0.5, 1.0], [1.0, -0.3, 0.2], 0.1, dt=1e-3)
     assert monotone_model(m) is m
@@ -114,6 +139,9 @@ def test_monotone_model_is_the_identity_on_monotone_models():
     fold = DiagnosedModel([0.0, 0.5, 1.0], [1.0, -1.5, 1.0], 0.1, dt=1e-3, effects=("creep",),
                           params={"creep_lag_gains": [0.05], "creep_time_constants_s": [0.1]})
     assert monotone_model(fold) is fold
+    first_order = replace(fold, effects=("rate",), params={"rate_gains": [0.1],
+                                                         "rate_family": "radius"})
+    assert monotone_model(first_order) is first_order
     assert monotone_model(replace(fold, effects=("delay",))) is not fold
     v = np.sin(np.linspace(0, 12, 800))
     assert np.max(np.abs(m.inverse().simulate(m.simulate(v)) - v)) < 1e-9

@@ -43,7 +43,8 @@ first sample on ``y_d[0]``, :meth:`DiagnosedInverse.first_input`), or, when the 
 took the stage's initial memory as unknown (``initial_state="unknown"``), from the memory of
 one reversal that puts ``y_d[0]`` on the model's output at the input 0
 (:meth:`DiagnosedInverse.initial_memory`).
-A model without creep, asymmetry or rate whose hysteresis weights fold (a partial sum
+A model without creep, asymmetry or a first-order rate (the rate's ``"scaled"`` family may be
+there) whose hysteresis weights fold (a partial sum
 ``w_1 + ... + w_m <= 0``, as signed
 fine-grid least squares can give: its branches turn back, and the root the inverse follows
 vanishes there, so it jumped to a far one) is inverted through its nearest monotone model

@@ -40,6 +40,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from .rate import SCALED
+
 __all__ = [
     "FLOOR_SHARE",
     "is_monotone",
@@ -181,12 +183,15 @@ def monotone_model(model):
     -------
     DiagnosedModel
         A copy with :func:`monotone_weights` of its weights when the model inverts as a plain
-        PI (no creep, asymmetry or rate; drift is not inverted) and the weights fold;
-        ``model`` itself otherwise. With creep, asymmetry or rate the slope of a sample's map
-        is not a partial sum of the weights (for example ``S(w) - G S(w0)`` with creep, or
-        the rate term's share of the reference weights ``w0``), so the projection would not
-        make it monotone and would change terms the effect fitted; those models are inverted
-        as they are.
+        PI (no creep, asymmetry or rate; drift is not inverted), or as the PI of plays whose
+        radii scale with the rate (the rate's ``"scaled"`` family, :mod:`.rate`: one factor
+        for every radius on a sample, so the radii keep their order and a sample's slope is
+        again a partial sum of ``w``), and the weights fold; ``model`` itself otherwise. With
+        creep, asymmetry or a first-order rate family the slope of a sample's map is not a
+        partial sum of the weights (for example ``S(w) - G S(w0)`` with creep, or the rate
+        term's share of the reference weights ``w0``), so the projection would not make it
+        monotone and would change terms the effect fitted; those models are inverted as they
+        are.
 
     Examples
     --------
@@ -195,6 +200,7 @@ def monotone_model(model):
     >>> is_monotone(monotone_model(m).weights)
     True
     """
-    if set(model.effects) & {"creep", "asymmetry", "rate"} or is_monotone(model.weights):
+    if set(model.effects) & {"creep", "asymmetry"} or is_monotone(model.weights) or (
+            "rate" in model.effects and model.params.get("rate_family") != SCALED):
         return model
     return replace(model, weights=monotone_weights(model.weights, model.radii))
