@@ -176,6 +176,14 @@ def cut(row: dict, loop: str) -> float:
     return row[loop]["nominal"] / max(row[loop]["augmented"], 1e-300)
 
 
+def _cut_text(row: dict, loop: str) -> str:
+    """The cut as the tables print it; "exact" where the augmented inverse tracks to rounding
+    (below 1e-9 of the nominal's error: the twin is the augmented model itself)."""
+    if row[loop]["augmented"] <= 1e-9 * row[loop]["nominal"]:
+        return "exact"
+    return f"{cut(row, loop):.2f}x"
+
+
 def target(row: dict) -> str:
     """The issue's target on this case: ``met``/``missed`` where the verdict names asymmetry,
     rate or creep, else ``-``."""
@@ -294,7 +302,7 @@ def aggregate(out: Path, quick: bool, cases: list[dict], results: list[dict]) ->
                      "twin vs measured"],
             [["+".join(real["verdict"]), "+".join(real["twin_effects"]) or "-",
               real["open"]["nominal"], real["open"]["augmented"],
-              f"{cut(real, 'open'):.2f}x", real["measured_rms"]]]))
+              _cut_text(real, "open"), real["measured_rms"]]]))
         numbers["real"] = {k: real[k] for k in ("verdict", "twin_effects", "open", "samples",
                                                 "measured_rms", "largest_input_jump")}
         numbers["real"]["open_cut"] = cut(real, "open")
