@@ -177,6 +177,20 @@ const char *pim_diag_check(const pim_diag *d)
     return NULL;
 }
 
+/* Where the delay lines start in the state (pim_diagnosed.h: after the element states). */
+static size_t delay_lines_at(const pim_diag *d)
+{
+    return PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
+           pim_diag_element_states(d);
+}
+
+/* The asymmetry term q u^2 + c3 u^3 of h0, u = (h0 - center) / half. */
+static double asymmetry_term(const pim_diag *d, double h0)
+{
+    const double u = (h0 - d->center) / d->half;
+    return d->q * (u * u) + d->c3 * (u * u * u);
+}
+
 /* The value `delay` samples before the newest, buf[head], of the ring buf[nbuf] (a fractional
  * part interpolates linearly, as pimodel.diagnosis.filters.shift). */
 static double delayed(const double *buf, size_t nbuf, size_t head, double delay)
@@ -193,7 +207,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
     const size_t n = d->n, nr = pim_diag_rate_size(d), q = d->order;
     const size_t nbuf = pim_diag_delay_length(d->delay);
     double *z = x + PIM_DIAG_HEADER, *rate = z + n, *mem = rate + 1, *lag = rate + nr,
-           *s = lag + d->m, *es = s + q, *buf = es + pim_diag_element_states(d),
+           *s = lag + d->m, *es = s + q, *buf = x + delay_lines_at(d),
            *hbuf = buf + nbuf, *zf = hbuf + nbuf, *fs = zf + n,
            *l0 = x + pim_diag_state_size(d) - pim_diag_record_states(d);
     const int radius = nr && d->rate_family == PIM_DIAG_RATE_RADIUS;
@@ -304,10 +318,7 @@ double pim_diag_step(const pim_diag *d, double *x, double v, double t)
         else
             y += d->lag_g[j] * (lag[j] - h0);
     }
-    if (d->asym) {
-        const double u = (h0 - d->center) / d->half;
-        y += d->q * (u * u) + d->c3 * (u * u * u);
-    }
+    if (d->asym) y += asymmetry_term(d, h0);
     if (radius) {
         double acc = 0.0;
         for (size_t i = 0; i < n; ++i) acc += d->rate_w[i] * mem[i];
@@ -333,14 +344,10 @@ int pim_diag_pending_finite(const pim_diag *d, const double *x)
 {
     const size_t nbuf = pim_diag_delay_length(d->delay);
     if (!nbuf || x[0] == 0.0) return 1;
-    const double *buf = x + PIM_DIAG_HEADER + d->n + pim_diag_rate_size(d) + d->m + d->order +
-                        pim_diag_element_states(d);
+    const double *buf = x + delay_lines_at(d);
     const size_t head = (size_t)x[3];
     const double xk = buf[head], h0 = buf[nbuf + head];
-    if (!isfinite(xk) || !isfinite(h0)) return 0;
-    if (!d->asym) return 1;
-    const double u = (h0 - d->center) / d->half;
-    return isfinite(d->q * (u * u) + d->c3 * (u * u * u));
+    return isfinite(xk) && isfinite(h0) && (!d->asym || isfinite(asymmetry_term(d, h0)));
 }
 
 void pim_diag_run(const pim_diag *d, double *x, size_t N, const double *v, const double *t,

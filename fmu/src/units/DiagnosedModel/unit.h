@@ -130,6 +130,7 @@ static void model_sample(pim_unit *u)
 /* With a delay, the terms a step put into the delay lines are finite too (they reach y later). */
 static int model_outputs_finite(const pim_unit *u)
 {
+    if (!(u->delay_samples > 0.0)) return 1; /* no delay lines */
     pim_diag d;
     unit_diag(u, &d);
     return pim_diag_pending_finite(&d, u->dstate);
