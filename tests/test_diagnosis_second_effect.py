@@ -12,7 +12,7 @@ import pytest
 from scipy.signal import lfilter
 
 from pimodel.diagnosis import diagnose
-from pimodel.diagnosis.diagnose import _beyond_refinement, _research_lag
+from pimodel.diagnosis.diagnose import _beyond_refinement, _interchangeable, _research_lag
 from pimodel.diagnosis.effects import Model, base_features, make_segment
 from pimodel.diagnosis.lti import element_coefficients, lti_columns, select_order
 from pimodel.stages.density_stage import density_records
@@ -128,6 +128,54 @@ def test_the_lag_is_searched_again_and_re_decided_beside_a_later_effect(seed):
     assert calls == []
 
 
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_stand_in_fitting_as_well_is_reported(seed):
+    va = _validate(seed)
+    y = va[0].y
+    misfit = np.random.default_rng(30 + seed).normal(0, 1.0, y.size)
+    cur_out = [y + 0.5 * misfit]  # the choice: dynamics + creep
+    calls = []
+
+    def fit(name, combo_=(), fixed=None):
+        calls.append((name, combo_, fixed))
+        return _model(5), [y + share[name] * misfit]
+
+    fixed = {"fn": 200.0, "zeta": 0.5, "lti": (), "creep_start": "rest", "asym": 1}
+    share = {"delay": 0.54, "drift": 0.7}  # RMS 1.08x: within 10 %; the drift 1.4x: not
+    swaps = _interchangeable(("dynamics", "creep"), cur_out, fixed, fit, va)
+    assert [(w["effect"], w["instead"]) for w in swaps] == [("dynamics", "delay")]
+    assert 1.05 < swaps[0]["ratio"] < 1.1
+    # the stand-in in the effect's place: its keys freed, the others held
+    assert calls == [("delay", ("creep",), {"creep_start": "rest", "asym": 1}),
+                     ("drift", ("dynamics",), {"fn": 200.0, "zeta": 0.5, "lti": (),
+                                               "asym": 1})]
+    share = {"delay": 0.6, "drift": 0.7}  # 1.2x: told apart
+    assert _interchangeable(("dynamics", "creep"), cur_out, fixed, fit, va) == []
+    calls.clear()  # both lags named, or no effect with a stand-in: nothing to try
+    assert _interchangeable(("delay", "dynamics", "asymmetry"), cur_out, fixed, fit, va) == []
+    assert calls == []
+
+
+def test_the_summary_names_a_stand_in(tmp_path):
+    from types import SimpleNamespace
+
+    from pimodel.diagnosis.summary import confidence, hints, write_report
+    v = {"effects": ["dynamics", "creep"], "gap_before": 1.3, "gap_after": 0.065,
+         "shrink": 0.95, "noise_floor": 0.06, "alternatives": [],
+         "unexplained": {"share": 0.0}, "noise_floor_method": "repeated periods",
+         "model": {}, "interchangeable": [{"effect": "dynamics", "instead": "delay",
+                                           "rms": 0.066, "ratio": 1.03}]}
+    rep = SimpleNamespace(verdict=v, where={}, nominal={}, candidates=[])
+    level, why = confidence(rep)
+    assert level == "fairly sure" and "delay in place of dynamics" in why
+    assert any(h.startswith("delay in place of dynamics fits validate within 3 %")
+               for h in hints(rep))
+    text = write_report(rep, tmp_path).read_text()
+    assert "| stand-ins fitting as well | delay for dynamics (1.03x RMS) |" in text
+    v["interchangeable"] = []
+    assert confidence(rep)[0] == "sure"
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [2, 4, 5])
 def test_density_mode_behind_a_real_pole_is_dynamics_alone(seed):
@@ -163,3 +211,21 @@ def test_density_lag_re_decided_beside_a_later_effect(effects, seed):
     v = diagnose([train], [validate]).verdict
     assert sorted(v["effects"]) == sorted(effects), v["effects"]
     assert v["gap_after_over_noise"] < 1.5
+
+
+@pytest.mark.slow
+def test_density_lag_above_the_band_is_reported_with_its_stand_in():
+    """density_stage creep + dynamics + delay, seed 1: the mode and pole above the inputs'
+    band act there as a delay; whichever lag is named, the other fits validate within 10 % in
+    its place (measured 1.03x) and the summary says the records cannot tell them apart."""
+    from pimodel.diagnosis.summary import confidence
+
+    train, validate = density_records(["creep", "dynamics", "delay"], 1)
+    rep = diagnose([train], [validate])
+    v = rep.verdict
+    lags = [e for e in v["effects"] if e in ("delay", "dynamics")]
+    assert len(lags) == 1 and "creep" in v["effects"], v["effects"]
+    swaps = {w["effect"]: w for w in v["interchangeable"]}
+    assert swaps[lags[0]]["instead"] == ({"delay", "dynamics"} - set(lags)).pop()
+    assert swaps[lags[0]]["ratio"] <= 1.1
+    assert confidence(rep)[0] == "fairly sure"

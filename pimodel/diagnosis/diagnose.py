@@ -53,7 +53,9 @@ gap after the best combination stays above 2 times the noise floor and its exces
 is more than 10 % of the gap's energy before. ``unexplained`` gives that share and where the
 remaining residual lies. ``alternatives`` lists effects that alone explain the gap within 10 %
 of the validate RMS of the first chosen one: the records cannot tell them apart (for example a
-delay and rate-dependent hysteresis under a single-frequency sine).
+delay and rate-dependent hysteresis under a single-frequency sine). ``interchangeable`` lists
+each named effect whose usual stand-in (``delay`` and ``dynamics``, ``creep`` and ``drift``) in
+its place, the other effects held, fits validate within 10 % as well (:func:`_interchangeable`).
 """
 
 from __future__ import annotations
@@ -123,6 +125,9 @@ LAG_EFFECTS = ("dynamics", "delay")  # two names for one lag: re-decided beside 
 LAG_KEYS = (*DYNAMICS_KEYS, "wiener", "d")  # their grid keys
 ALT_STARTS = 2  # greedy paths from the next candidates tried when a gap is left unexplained
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
+STAND_INS = {"delay": ("dynamics", LAG_KEYS), "dynamics": ("delay", LAG_KEYS),
+             "creep": ("drift", ("creep_start", "creep_levels")),
+             "drift": ("creep", DRIFT_KEYS)}  # effect: the one in its place, the keys it frees
 DRIFT_LIKE_CREEP = 0.5  # a chosen creep gives way to a drift in its place fitting within
 # ALTERNATIVE_RMS when what it explains beyond that drift is under this many noise floors (RMS)
 INITIAL_STATES = ("auto", "rest", "unknown")
@@ -1302,6 +1307,8 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if path[0] and score < best[0] - MIN_BIC_DROP:
                 best = (score, path)
         chosen, fixed, current, cur_out = best[1]
+    progress("the stand-ins of the effects chosen")
+    interchangeable = _interchangeable(chosen, cur_out, fixed, fit, va)
     _forget_rates(segs)  # the choice is made: the band sums and contacts kept for its fits
     screen = None
     if screened:  # the choice, refitted on the whole records; the verdict's figures whole
@@ -1350,6 +1357,7 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                                        for i in noise_info.get("closed_loop", ())],
                "gap_after_over_noise": after["rms"] / noise if noise > 0 else float("inf"),
                "unexplained": unexplained, "alternatives": alternatives,
+               "interchangeable": interchangeable,
                "model": current.params, "evidence": evidence}
     if screen is not None:
         verdict["screen"] = screen
@@ -1621,6 +1629,33 @@ def _research_lag(chosen, cur, fixed, fit, va):
             fixed.pop(k, None)
         _hold(fixed, best[1], best[2][0].grid)
     return best[1], best[2][0], best[2][1]
+
+
+def _interchangeable(chosen, cur_out, fixed, fit, va) -> list[dict]:
+    """The effects chosen that the records do not tell from their usual stand-in
+    (``STAND_INS``: ``delay`` and ``dynamics``, ``creep`` and ``drift``): the stand-in in the
+    effect's place, the other effects held at ``fixed``, fits the validate records within
+    ``ALTERNATIVE_RMS`` of the choice (``cur_out``: its validate outputs). A mode and a real
+    pole above the input's band act on it as a delay of a millisecond or two (density_stage
+    creep + dynamics + delay: the three fitted together validate within 4-6 % of any two).
+    Returns one dict per such effect: ``effect``, ``instead`` (the stand-in), its validate
+    ``rms`` and its ``ratio`` to the choice's."""
+    out: list[dict] = []
+    rms = _errors(va, cur_out)["rms"]
+    for e in chosen:
+        other, keys = STAND_INS.get(e, (None, ()))
+        if other is None or other in chosen:
+            continue
+        rest = tuple(c for c in chosen if c != e)
+        kept = {k: x for k, x in fixed.items() if k not in keys and k != "creep_start"}
+        if "creep" in rest and "creep_start" in fixed:
+            kept["creep_start"] = fixed["creep_start"]
+        o = fit(other, rest, kept or None)[1]
+        r = _errors(va, o)["rms"]
+        if r <= ALTERNATIVE_RMS * rms:
+            out.append({"effect": e, "instead": other, "rms": float(r),
+                        "ratio": float(r / rms) if rms > 0 else 1.0})
+    return out
 
 
 def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):

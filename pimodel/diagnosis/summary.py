@@ -54,12 +54,13 @@ def confidence(rep) -> tuple[str, str]:
     """How sure the verdict is: ``("sure" | "fairly sure" | "unsure", reason)``.
 
     ``sure``: the gap after the chosen model is within ``NEAR_NOISE`` times the noise floor
-    and no other effect explains the gap as well (``verdict["alternatives"]`` empty);
-    ``fairly sure``: at the noise but with alternatives, or a named effect with a residual
-    above the noise that is not ``unexplained``; ``unsure``: part of the gap is unexplained,
-    or (the verdict not ``none``) a validate record drives plays on loops that train moved
-    only in its start-up or never (``nominal["coverage"]``, :mod:`.coverage`): the gap may be
-    the nominal's extrapolation.
+    and no other effect explains the gap as well (``verdict["alternatives"]`` empty) nor
+    stands in for a named one (``verdict["interchangeable"]`` empty);
+    ``fairly sure``: at the noise but with alternatives or stand-ins, or a named effect with a
+    residual above the noise that is not ``unexplained``; ``unsure``: part of the gap is
+    unexplained, or (the verdict not ``none``) a validate record drives plays on loops that
+    train moved only in its start-up or never (``nominal["coverage"]``, :mod:`.coverage`):
+    the gap may be the nominal's extrapolation.
 
     Parameters
     ----------
@@ -88,12 +89,17 @@ def confidence(rep) -> tuple[str, str]:
     if "unexplained" in v["effects"]:
         share = 100 * v["unexplained"].get("share", 0.0)
         return "unsure", f"{at}; {share:.0f} % of the gap's energy is unexplained"
-    if ratio <= NEAR_NOISE and not alts:
-        return "sure", f"{at} and no other effect explains it as well"
     if alts:
         verb = "explains" if len(alts) == 1 else "explain"
         return "fairly sure", f"{at}, but {' and '.join(alts)} {verb} it about as well " \
                               "(the records cannot tell them apart)"
+    swaps = v.get("interchangeable") or []
+    if swaps:
+        return "fairly sure", f"{at}, but " + " and ".join(
+            f"{s['instead']} in place of {s['effect']} fits validate as well (RMS "
+            f"{s['ratio']:.2f} times)" for s in swaps) + " (the records cannot tell them apart)"
+    if ratio <= NEAR_NOISE:
+        return "sure", f"{at} and no other effect explains it as well"
     return "fairly sure", at
 
 
@@ -185,6 +191,15 @@ def hints(rep) -> list[str]:
         out.append(f"{v['effects'][0]} and {' and '.join(alts)} explain the gap about as well: "
                    "add a record at other input frequencies or with holds after steps to "
                    "tell them apart")
+    for sw in v.get("interchangeable") or []:
+        pair = {sw["effect"], sw["instead"]}
+        how = ("a delay and a mode or pole above the input's band act alike on it: add a "
+               "record with faster input (a chirp or steps up to the band you control) "
+               if pair == {"delay", "dynamics"} else
+               "creep follows the input history, a drift the clock: add a record with holds "
+               "at other levels after steps both ways, or repeat a record later, ")
+        out.append(f"{sw['instead']} in place of {sw['effect']} fits validate within "
+                   f"{abs(100 * (sw['ratio'] - 1)):.0f} % (RMS): {how}to tell them apart")
     closed = v.get("closed_loop_records") or []
     if closed:  # the noise floor's check (noise.py): the input follows the measured noise
         out.append(f"{', '.join(closed[:3])}{' ...' if len(closed) > 3 else ''} look taken in "
@@ -413,6 +428,9 @@ def write_report(rep, out_dir, *, title: str = "Diagnosis", units=("V", "um")) -
          ["gap after / noise floor", f"{_ratio(v):.2f}"],
          ["unexplained share of the gap energy", f"{100 * v['unexplained']['share']:.0f} %"],
          ["alternatives", ", ".join(v.get("alternatives") or []) or "-"],
+         ["stand-ins fitting as well", ", ".join(
+             f"{w['instead']} for {w['effect']} ({w['ratio']:.2f}x RMS)"
+             for w in v.get("interchangeable") or []) or "-"],
          ["initial state", rep.nominal.get("initial_state", "rest")]])]
     cands = getattr(rep, "candidates", None) or []
     if cands:
