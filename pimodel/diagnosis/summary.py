@@ -96,8 +96,9 @@ def confidence(rep) -> tuple[str, str]:
     swaps = v.get("interchangeable") or []
     if swaps:
         return "fairly sure", f"{at}, but " + " and ".join(
-            f"{s['instead']} in place of {s['effect']} fits validate as well (RMS "
-            f"{s['ratio']:.2f} times)" for s in swaps) + " (the records cannot tell them apart)"
+            f"{s['instead']} in place of {s['effect']} fits validate about as well (RMS "
+            f"{s['ratio']:.2f} times the verdict's)" for s in swaps) + \
+            ": the records cannot tell them apart"
     if ratio <= NEAR_NOISE:
         return "sure", f"{at} and no other effect explains it as well"
     return "fairly sure", at
