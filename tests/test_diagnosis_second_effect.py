@@ -170,9 +170,14 @@ def test_the_summary_names_a_stand_in(tmp_path):
     assert level == "fairly sure" and "delay in place of dynamics" in why
     assert any(h.startswith("delay in place of dynamics fits validate within 3 %")
                for h in hints(rep))
+    v["alternatives"] = ["delay", "rate"]  # delay said once, by its stand-in hint
+    said = hints(rep)
+    assert [h for h in said if "explain the gap" in h][0].startswith(
+        "dynamics and rate explain the gap"), said
+    assert sum("delay" in h for h in said) == 1, said
     text = write_report(rep, tmp_path).read_text()
     assert "| stand-ins fitting as well | delay for dynamics (1.03x RMS) |" in text
-    v["interchangeable"] = []
+    v["interchangeable"], v["alternatives"] = [], []
     assert confidence(rep)[0] == "sure"
 
 

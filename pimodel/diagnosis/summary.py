@@ -187,12 +187,15 @@ def hints(rep) -> list[str]:
         out.append(f"the start-up region dominates ({100 * r['energy_share']:.0f} % of the "
                    f"nominal residual in {100 * r['sample_share']:.0f} % of the samples); the "
                    "record may start mid-motion: try --initial-state unknown")
-    alts = v.get("alternatives") or []
+    swaps = v.get("interchangeable") or []
+    # an alternative that stands in for the first named effect: said once, by its stand-in hint
+    alts = [a for a in v.get("alternatives") or []
+            if not any(w["effect"] == v["effects"][0] and w["instead"] == a for w in swaps)]
     if alts and v["effects"] != ["none"]:
         out.append(f"{v['effects'][0]} and {' and '.join(alts)} explain the gap about as well: "
                    "add a record at other input frequencies or with holds after steps to "
                    "tell them apart")
-    for sw in v.get("interchangeable") or []:
+    for sw in swaps:
         pair = {sw["effect"], sw["instead"]}
         how = ("a delay and a mode or pole above the input's band act alike on it: add a "
                "record with faster input (a chirp or steps up to the band you control) "
