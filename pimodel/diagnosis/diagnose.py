@@ -1643,19 +1643,25 @@ def _interchangeable(chosen, cur_out, fixed, fit, va) -> list[dict]:
     out: list[dict] = []
     rms = _errors(va, cur_out)["rms"]
     for e in chosen:
-        other, keys = STAND_INS.get(e, (None, ()))
-        if other is None or other in chosen:
+        if e not in STAND_INS or STAND_INS[e][0] in chosen:
             continue
-        rest = tuple(c for c in chosen if c != e)
-        kept = {k: x for k, x in fixed.items() if k not in keys and k != "creep_start"}
-        if "creep" in rest and "creep_start" in fixed:
-            kept["creep_start"] = fixed["creep_start"]
-        o = fit(other, rest, kept or None)[1]
-        r = _errors(va, o)["rms"]
+        other = STAND_INS[e][0]
+        r = _errors(va, _stand_in_fit(e, chosen, fixed, fit)[1])["rms"]
         if r <= ALTERNATIVE_RMS * rms:
             out.append({"effect": e, "instead": other, "rms": float(r),
                         "ratio": float(r / rms) if rms > 0 else 1.0})
     return out
+
+
+def _stand_in_fit(effect, chosen, fixed, fit):
+    """``fit`` of ``effect``'s stand-in (``STAND_INS``) in its place among ``chosen``: the
+    other effects held at ``fixed``, the keys of ``effect``'s grid freed (``fixed`` holds a
+    creep's start only with a creep chosen, :func:`_hold`). Returns (model, validate
+    outputs)."""
+    other, keys = STAND_INS[effect]
+    rest = tuple(c for c in chosen if c != effect)
+    kept = {k: x for k, x in fixed.items() if k not in keys}
+    return fit(other, rest, kept or None)
 
 
 def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):
@@ -1666,9 +1672,7 @@ def _prefer_delay(chosen, current, cur_out, fixed, fit, va, dt):
     ``(chosen, model, validate outputs)``."""
     if "dynamics" not in chosen or "delay" in chosen or not is_delay_like(current.params, dt):
         return chosen, current, cur_out
-    rest = tuple(c for c in chosen if c != "dynamics")
-    kept = {k: x for k, x in fixed.items() if k not in ("fn", "zeta", "lti", "wiener")}
-    m, o = fit("delay", rest, kept or None)
+    m, o = _stand_in_fit("dynamics", chosen, fixed, fit)
     if _errors(va, o)["rms"] <= ALTERNATIVE_RMS * _errors(va, cur_out)["rms"]:
         return tuple("delay" if c == "dynamics" else c for c in chosen), m, o
     return chosen, current, cur_out
@@ -1687,9 +1691,7 @@ def _prefer_drift(chosen, current, cur_out, fixed, fit, va, noise: float):
     ``(chosen, model, validate outputs)``."""
     if "creep" not in chosen or "drift" in chosen:
         return chosen, current, cur_out
-    rest = tuple(c for c in chosen if c != "creep")
-    kept = {k: x for k, x in fixed.items() if k not in ("creep_start", "creep_levels")}
-    m, o = fit("drift", rest, kept or None)
+    m, o = _stand_in_fit("creep", chosen, fixed, fit)
     r_drift, r_creep = _errors(va, o)["rms"], _errors(va, cur_out)["rms"]
     beyond = np.sqrt(max(r_drift ** 2 - r_creep ** 2, 0.0))
     if r_drift <= ALTERNATIVE_RMS * r_creep and beyond < DRIFT_LIKE_CREEP * noise:
