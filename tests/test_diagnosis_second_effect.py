@@ -12,7 +12,13 @@ import pytest
 from scipy.signal import lfilter
 
 from pimodel.diagnosis import diagnose
-from pimodel.diagnosis.diagnose import _beyond_refinement, _interchangeable, _research_lag
+from pimodel.diagnosis.diagnose import (
+    PAIR_LOOK,
+    _beyond_refinement,
+    _interchangeable,
+    _pairs_first,
+    _research_lag,
+)
 from pimodel.diagnosis.effects import Model, base_features, make_segment
 from pimodel.diagnosis.lti import element_coefficients, lti_columns, select_order
 from pimodel.stages.density_stage import density_records
@@ -154,6 +160,53 @@ def test_a_stand_in_fitting_as_well_is_reported(seed):
     calls.clear()  # both lags named, or no effect with a stand-in: nothing to try
     assert _interchangeable(("delay", "dynamics", "asymmetry"), cur_out, fixed, fit, va) == []
     assert calls == []
+
+
+@pytest.mark.parametrize("seed", [5, 6])
+def test_a_pair_tried_first_replaces_a_single_effect_standing_in_for_it(seed):
+    """A choice leaving more than PAIR_LOOK noise floors: the rounds with every pair tried
+    first replace it when their path passes against it and its refinements, and does not merely
+    add effects; nothing is tried below the look."""
+    va = _validate(seed)
+    y = va[0].y
+    misfit = np.random.default_rng(40 + seed).normal(0, 1.0, y.size)
+    noise = 0.1
+    tried, refined = [], []
+
+    def choose(pairs=False):
+        tried.append(pairs)
+        return pair, {"pair": 1}, _model(12), [y + 0.15 * misfit]
+
+    def fit(name, combo_=(), fixed=None):
+        refined.append((name, combo_, fixed))
+        return _model(6), [y + share * misfit]
+
+    def first(chosen, rms):
+        return chosen, {"d": 18}, _model(5), [y + rms * misfit]
+
+    def quiet(message):
+        pass
+
+    pair, share = ("creep", "asymmetry"), 0.5
+    old = first(("delay",), (PAIR_LOOK + 2.0) * noise)  # a delay: nothing to refine
+    assert _pairs_first(old, choose, fit, va, noise, quiet)[0] == pair
+    assert tried == [True] and refined == []
+    tried.clear()  # within the look: nothing tried
+    old = first(("delay",), (PAIR_LOOK - 0.5) * noise)
+    assert _pairs_first(old, choose, fit, va, noise, quiet) is old and tried == []
+    old = first(("delay",), (PAIR_LOOK + 2.0) * noise)
+    pair = ("delay", "creep")  # more effects beside the chosen ones: the greedy rounds judged
+    assert _pairs_first(old, choose, fit, va, noise, quiet) is old
+    old = first(("delay",), 0.5)  # a path that cuts the RMS by 6 % only: not kept
+    assert _pairs_first(old, lambda pairs: (("drift",), {}, _model(6), [y + 0.47 * misfit]),
+                        fit, va, noise, quiet) is old
+    # a chosen creep refined with a further lag fitting as well as the pair: kept as it was
+    pair, share = ("dynamics", "asymmetry"), 0.16
+    old = first(("creep",), (PAIR_LOOK + 2.0) * noise)
+    assert _pairs_first(old, choose, fit, va, noise, quiet) is old
+    assert refined[-1][2]["refine"] == "creep"
+    share = 0.5  # the refined creep far worse: the pair kept
+    assert _pairs_first(old, choose, fit, va, noise, quiet)[0] == pair
 
 
 def test_the_summary_names_a_stand_in(tmp_path):

@@ -1315,19 +1315,9 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
             if path[0] and score < best[0] - MIN_BIC_DROP:
                 best = (score, path)
         chosen, fixed, current, cur_out = best[1]
-    elif chosen and max_effects >= 2 and _errors(va, cur_out)["rms"] > PAIR_LOOK * noise:
-        # a gap left well above the noise, yet not unexplained: one effect can stand in for a
-        # pair that passes only together (blind asymmetry + creep s0: a delay of 3.7 ms cut
-        # the gap from 43 to 12.6 noise floors, the asymmetry and the creep together to 2.1).
-        # The rounds again with every pair tried first; their choice is kept when it passes
-        # against this one and against its effects' refinements, and does not merely add
-        # effects to it (those the greedy rounds judged)
-        progress("a gap well above the noise: every pair tried first")
-        path = choose(pairs=True)
-        if path[0] and not set(chosen) <= set(path[0]) and \
-                _passes(va, path[2:], (current, cur_out)) and \
-                _beyond_refinement(path[2:], chosen, fixed, fit, va):
-            chosen, fixed, current, cur_out = path
+    elif max_effects >= 2:
+        chosen, fixed, current, cur_out = _pairs_first((chosen, fixed, current, cur_out),
+                                                       choose, fit, va, noise, progress)
     progress("the stand-ins of the effects chosen")
     interchangeable = _interchangeable(chosen, cur_out, fixed, fit, va)
     _forget_rates(segs)  # the choice is made: the band sums and contacts kept for its fits
@@ -1527,6 +1517,29 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
             break
         chosen, cur = worst[1], worst[2]
     return chosen, cur[0], cur[1]
+
+
+def _pairs_first(path: tuple, choose: Callable, fit, va, noise: float,
+                 progress: Callable[[str], None]) -> tuple:
+    """The choice ``path`` (``(chosen, fixed, model, validate outputs)``, its gap not
+    unexplained), or the path of ``choose(pairs=True)``: the rounds again with every pair tried
+    in the first round beside the single effects. Tried only when ``path`` names an effect and
+    leaves the validate RMS above ``PAIR_LOOK`` noise floors: one effect can stand in for a pair
+    that passes only together (blind asymmetry + creep s0: a delay of 3.7 ms cut the gap from
+    43 to 12.6 noise floors; the asymmetry and the creep together, to 2.1). The new path is
+    kept when it passes against ``path`` (:func:`_passes`) and against each of its effects
+    refined one step (:func:`_beyond_refinement`), and does not merely add effects to it
+    (the greedy rounds judged those)."""
+    chosen, fixed, current, cur_out = path
+    if not chosen or _errors(va, cur_out)["rms"] <= PAIR_LOOK * noise:
+        return path
+    progress("a gap well above the noise: every pair tried first")
+    new = choose(pairs=True)
+    if new[0] and not set(chosen) <= set(new[0]) and \
+            _passes(va, new[2:], (current, cur_out)) and \
+            _beyond_refinement(new[2:], chosen, fixed, fit, va):
+        return new
+    return path
 
 
 def _hold(fixed: dict, effects: tuple, grid: dict) -> dict:
