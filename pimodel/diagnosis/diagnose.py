@@ -128,7 +128,7 @@ DYNAMICS_KEYS = ("fn", "zeta", "lti")  # grid keys of dynamics after the hystere
 LAG_EFFECTS = ("dynamics", "delay")  # two names for one lag: re-decided beside later effects
 LAG_KEYS = (*DYNAMICS_KEYS, "wiener", "d")  # their grid keys
 ALT_STARTS = 2  # greedy paths from the next candidates tried when a gap is left unexplained
-PAIR_LOOK = 3.0  # a choice leaving more than this many noise floors: every pair tried first
+PAIR_LOOK = 5.0  # a choice leaving more than this many noise floors: every pair tried first
 ALTERNATIVE_RMS = 1.1  # an effect alone within 10 % of the first chosen one's validate RMS
 STAND_INS = {"delay": ("dynamics", LAG_KEYS), "dynamics": ("delay", LAG_KEYS),
              "creep": ("drift", ("creep_start", "creep_levels")),
