@@ -173,7 +173,7 @@ def test_a_pair_tried_first_replaces_a_single_effect_standing_in_for_it(seed):
     noise = 0.1
     tried, refined = [], []
 
-    def choose(pairs=False):
+    def choose(pairs=None):
         tried.append(pairs)
         return pair, {"pair": 1}, _model(12), [y + 0.15 * misfit]
 
@@ -190,16 +190,19 @@ def test_a_pair_tried_first_replaces_a_single_effect_standing_in_for_it(seed):
     pair, share = ("creep", "asymmetry"), 0.5
     old = first(("delay",), (PAIR_LOOK + 2.0) * noise)  # a delay: nothing to refine
     assert _pairs_first(old, choose, fit, va, noise, quiet)[0] == pair
-    assert tried == [True] and refined == []
+    assert tried == [("delay",)] and refined == []
     tried.clear()  # within the look: nothing tried
     old = first(("delay",), (PAIR_LOOK - 0.5) * noise)
     assert _pairs_first(old, choose, fit, va, noise, quiet) is old and tried == []
     old = first(("delay",), (PAIR_LOOK + 2.0) * noise)
     pair = ("delay", "creep")  # more effects beside the chosen ones: the greedy rounds judged
     assert _pairs_first(old, choose, fit, va, noise, quiet) is old
-    old = first(("delay",), 0.5)  # a path that cuts the RMS by 6 % only: not kept
-    assert _pairs_first(old, lambda pairs: (("drift",), {}, _model(6), [y + 0.47 * misfit]),
-                        fit, va, noise, quiet) is old
+    gap = (PAIR_LOOK + 2.0) * noise
+    old = first(("delay",), gap)  # a path that cuts the RMS by 6 % only: not kept
+    tried.clear()
+    assert _pairs_first(old, lambda pairs: tried.append(pairs) or (
+        ("drift",), {}, _model(6), [y + 0.94 * gap * misfit]), fit, va, noise, quiet) is old
+    assert tried == [("delay",)]
     # a chosen creep refined with a further lag fitting as well as the pair: kept as it was
     pair, share = ("dynamics", "asymmetry"), 0.16
     old = first(("creep",), (PAIR_LOOK + 2.0) * noise)

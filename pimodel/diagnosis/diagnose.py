@@ -1228,11 +1228,11 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
         misfit set aside (``aside``): the revision's drop test."""
         return _passes(va, new, old) or aside(new, old, old_effects, fixed_, added)
 
-    def choose(start=None, pairs=False):
+    def choose(start=None, pairs=None):
         """The greedy rounds, the revision, the delay and drift preferences; ``start`` forces
-        the first round's effect; ``pairs``: every pair tried in the first round beside the
-        single effects, not only when none of them passes. Returns ``(chosen, fixed, model,
-        validate outputs)``."""
+        the first round's effect; ``pairs`` (a tuple of effects): every pair of the other effects
+        tried in the first round beside the single effects, not only when none of them passes.
+        Returns ``(chosen, fixed, model, validate outputs)``."""
         chosen: tuple[str, ...] = ()
         fixed: dict = {}
         current: Model = nominal
@@ -1260,12 +1260,12 @@ def _diagnose(train: list[Record], validate: list[Record], max_effects: int,
                 return b_[0] <= -MIN_BIC_DROP and \
                     _errors(va, b_[3])["rms"] <= (1 - MIN_RMS_CUT) * rms_now
 
-            if not chosen and max_effects >= 2 and (pairs or start is not None or
+            if not chosen and max_effects >= 2 and (pairs is not None or start is not None or
                                                     not accepted(best)):
                 # two effects can mask each other (a drift confounds an asymmetry fitted alone):
                 # when no single effect passes in the first round, try every pair jointly (a
-                # forced start: every pair with it)
-                rest = [e for e in EFFECTS if e not in chosen]
+                # forced start: every pair with it; ``pairs``: every pair without those)
+                rest = [e for e in EFFECTS if e not in chosen and e not in (pairs or ())]
                 prefetch([(name, (*chosen, first), dict(fixed) if chosen else None)
                           for i, first in enumerate(rest) for name in rest[i + 1:]
                           if start is None or start in (first, name)])
@@ -1522,19 +1522,20 @@ def _revise(chosen, current, cur_out, fixed, fit, va, nominal, noise, beside=Non
 def _pairs_first(path: tuple, choose: Callable, fit, va, noise: float,
                  progress: Callable[[str], None]) -> tuple:
     """The choice ``path`` (``(chosen, fixed, model, validate outputs)``, its gap not
-    unexplained), or the path of ``choose(pairs=True)``: the rounds again with every pair tried
-    in the first round beside the single effects. Tried only when ``path`` names an effect and
-    leaves the validate RMS above ``PAIR_LOOK`` noise floors: one effect can stand in for a pair
-    that passes only together (blind asymmetry + creep s0: a delay of 3.7 ms cut the gap from
-    43 to 12.6 noise floors; the asymmetry and the creep together, to 2.1). The new path is
-    kept when it passes against ``path`` (:func:`_passes`) and against each of its effects
-    refined one step (:func:`_beyond_refinement`), and does not merely add effects to it
-    (the greedy rounds judged those)."""
+    unexplained), or the path of ``choose(pairs=chosen)``: the rounds again with every pair of
+    the effects not chosen tried in the first round beside the single effects (a pair with a
+    chosen effect only adds one to it: the greedy rounds judged that). Tried only when ``path``
+    names an effect and leaves the validate RMS above ``PAIR_LOOK`` noise floors: one effect
+    can stand in for a pair that passes only together (blind asymmetry + creep s0: a delay of
+    3.7 ms cut the gap from 43 to 12.6 noise floors; the asymmetry and the creep together, to
+    2.1). The new path is kept when it passes against ``path`` (:func:`_passes`) and against
+    each of its effects refined one step (:func:`_beyond_refinement`), and does not merely add
+    effects to it (the greedy rounds judged those)."""
     chosen, fixed, current, cur_out = path
     if not chosen or _errors(va, cur_out)["rms"] <= PAIR_LOOK * noise:
         return path
     progress("a gap well above the noise: every pair tried first")
-    new = choose(pairs=True)
+    new = choose(pairs=chosen)
     if new[0] and not set(chosen) <= set(new[0]) and \
             _passes(va, new[2:], (current, cur_out)) and \
             _beyond_refinement(new[2:], chosen, fixed, fit, va):
