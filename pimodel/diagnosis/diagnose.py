@@ -41,9 +41,10 @@ start from each of the next ``ALT_STARTS`` candidates (alone or in a pair with e
 other effect), and the path with the lowest validate BIC is kept: a first effect can stand
 in for two others that pass only together (a broad lag for creep and rate-dependent
 hysteresis). When the path leaves more than ``PAIR_LOOK`` noise floors without a gap
-unexplained, the rounds are run again with every pair tried in the first round, and that path is
-kept when it passes against the first (and against its effects refined one step) and does not
-merely add effects to it: a delay stood in for a creep and an asymmetry that pass only together.
+unexplained, the rounds are run again with every pair of the effects it did not name tried in
+the first round, and that path is kept when it passes against the first (and against its
+effects refined one step) and does not merely add effects to it: a delay stood in for a creep
+and an asymmetry that pass only together.
 The ``dynamics`` candidate is a linear system after the hysteresis (:mod:`.lti`) or, where the
 train BIC says so, a filter before it (:mod:`.wiener`). The drift's variant (its clock, or a
 level per record, :mod:`.drift`) is chosen on validate for every combination; the creep's start
