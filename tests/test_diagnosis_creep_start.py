@@ -91,6 +91,33 @@ def test_start_columns_and_levels_give_the_lag_from_its_rest():
                        params={**p, "creep_start": "parked"})
 
 
+def test_a_start_gone_by_the_first_scored_sample_gets_no_level():
+    """A start-up mask longer than a lag's settling (1.2 s against 30 ms: its free response is
+    e^-40 at the first scored sample): its common start's column is zero, its level 0, and the
+    fit's output in the masked start-up stays near the record's range. Before, the column
+    scaled to unit norm on the scored samples took a coefficient that drove that output far
+    past it (1e159 on the blind generator's asymmetry + creep)."""
+    from pimodel.diagnosis.effects import fit_effect, fit_nominal, make_segment
+
+    k = np.arange(2000)
+    assert np.array_equal(start_columns(k, DT, TAUS, None), start_columns(k, DT, TAUS))
+    cut = start_columns(k, DT, TAUS, 1199)
+    assert not cut[0].any()  # exp(-1.2 / 0.03) < 1e-8
+    assert np.array_equal(cut[1:], start_columns(k, DT, TAUS)[1:])  # e^-4, e^-0.4: seen
+    assert start_columns(k, DT, TAUS, 300)[0].any()  # e^-10 at 0.3 s: seen
+    tr, _ = records(0)
+    r = tr[0]
+    seg = make_segment(r.t, r.v, r.y, np.linspace(0.0, 2.2, 21), k >= 1200)
+    nominal = fit_nominal([seg])
+    assert tuple(nominal.params["creep_taus"]) == TAUS
+    m = fit_effect("creep", [seg], (), {"creep_start": "common"}, nominal)
+    levels = m.params["creep_start_levels"]
+    assert np.all(np.isfinite(levels)) and levels[1] != 0.0
+    assert abs(levels[0]) < 1e-6 * np.ptp(r.y), levels  # 0 to the solve's rounding
+    out = m.predict(seg)
+    assert np.all(np.abs(out - r.y.mean()) < 2.0 * np.ptp(r.y)), np.abs(out).max()
+
+
 def test_model_starts_the_lags_at_the_common_levels():
     """``DiagnosedModel.simulate`` and the C stream start each lag at its level: a loop written
     here, and not the at-rest start."""

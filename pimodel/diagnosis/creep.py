@@ -74,15 +74,16 @@ import numpy as np
 
 from .drift import has_levels, out_of_fold_level
 
-__all__ = ["CREEP_STARTS", "RECORD_LEVEL_SHARE", "creep_law", "creep_levels",
-           "creep_start_levels", "creep_starts", "creep_time_constants", "record_level",
-           "start_columns", "start_hint"]
+__all__ = ["CREEP_STARTS", "RECORD_LEVEL_SHARE", "START_SEEN", "creep_law", "creep_levels",
+           "creep_start_levels", "creep_starts", "creep_time_constants", "first_scored",
+           "record_level", "start_columns", "start_hint"]
 
 CREEP_STARTS = ("rest", "common", "record")  # where the lags start (module docstring)
 MIN_LAG_SAMPLES = 10  # the shortest lag spans at least this many samples
 DECADE_ANCHOR = 3.0  # lags at DECADE_ANCHOR 10^j s
 RECORD_LEVEL_SHARE = 0.1  # "record": a validate level at most this share of h0[0]'s change
 LONGEST_LAG = 2.0  # the last lag is the last at most this many times the longest train record
+START_SEEN = 1e-8  # a common start's column smaller at the first scored sample is zero
 
 
 def creep_time_constants(dt: float, duration: float) -> tuple[float, ...]:
@@ -314,9 +315,23 @@ def start_hint(grid: dict) -> str:
     return grid.get("creep_start", CREEP_STARTS[0])
 
 
-def start_columns(samples, dt: float, taus) -> np.ndarray:
+def first_scored(mask: np.ndarray | None) -> int | None:
+    """The first sample a start-up ``mask`` scores (``True``: scored); ``None`` without a
+    mask (every sample scored)."""
+    return None if mask is None or not mask.any() else int(np.argmax(mask))
+
+
+def start_columns(samples, dt: float, taus, scored_from: int | None = None) -> np.ndarray:
     """The common start's columns ``a_i^(k+1) = exp(-(k + 1) dt / tau_i)``: the free response
     of each lag from a unit state before the record's first sample (module docstring).
+
+    A lag whose free response has fallen below ``START_SEEN`` (``1e-8``) by the sample
+    ``scored_from`` (the first a start-up mask scores, :func:`first_scored`) gets a column of
+    zeros: the scored samples inform no level for it, and a least-squares fit of its column
+    (scaled to unit norm on the scored samples) gave it a coefficient that grew the masked
+    start-up's output past ``1e150`` (issue 28, the blind generator's asymmetry + creep: a lag
+    of 3 ms behind a start-up mask of 0.32 s, ``e^-106``). Its level is then ``0``
+    (:func:`creep_start_levels`).
 
     Parameters
     ----------
@@ -327,6 +342,8 @@ def start_columns(samples, dt: float, taus) -> np.ndarray:
         Sample time [s].
     taus : sequence of float
         The lags' time constants ``tau_i`` [s].
+    scored_from : int, optional
+        The record's first scored sample (a start-up mask); ``None``: the first.
 
     Returns
     -------
@@ -339,7 +356,11 @@ def start_columns(samples, dt: float, taus) -> np.ndarray:
     [[0.3679, 0.1353, 0.0498]]
     """
     k = np.asarray(samples)
-    return np.array([np.exp(-(k + 1) * dt / tau) for tau in taus]).reshape(len(taus), k.size)
+    out = np.array([np.exp(-(k + 1) * dt / tau) for tau in taus]).reshape(len(taus), k.size)
+    if scored_from is not None:
+        seen = np.exp(-(scored_from + 1) * dt / np.asarray(taus, float)) >= START_SEEN
+        out[~seen] = 0.0
+    return out
 
 
 def creep_start_levels(params: dict) -> np.ndarray | None:

@@ -22,7 +22,7 @@ from .._native import pi_run_rows
 from .chunked import NormalEquations, chunks, transposed
 from .chunked import combine as _combine
 from .chunked import stack_rows as _stack_rows
-from .creep import creep_levels, creep_time_constants, record_level, start_columns
+from .creep import creep_levels, creep_time_constants, first_scored, record_level, start_columns
 from .drift import (
     DRIFT_VARIANTS,
     SETTLE_POINTS,
@@ -1382,7 +1382,8 @@ def _combo_features(effects, p, nominal: Model, static: dict, ncols: int | None 
             taus = nominal.params["creep_taus"] if "creep" in effects else ()
             if common:  # lags at rest at levels shared by the records (module creep)
                 out += [lag(h0, tau, s.dt, 0.0) - h0 for tau in taus]
-                out += list(start_columns(np.arange(h0.size), s.dt, taus))
+                out += list(start_columns(np.arange(h0.size), s.dt, taus,
+                                          first_scored(s.mask)))
             elif taus:
                 # the stage's memory at the start unknown (a start-up mask): the creep's
                 # too; its lags start at the measured first output, not at h0[0]

@@ -43,7 +43,7 @@ from scipy.signal import lfilter
 
 from .._native import biquad_rows_carry
 from .chunked import combine, stack_rows
-from .creep import creep_levels, start_columns
+from .creep import creep_levels, first_scored, start_columns
 from .drift import drift_columns, level_rows
 from .filters import mode_coefficients, shift
 from .lti import element_coefficients
@@ -144,6 +144,7 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
     record = bool(taus) and p.get("creep_start") == "record"  # counted from the start
     levels = creep_levels(effects, p) > 0
     lags = [_Lag(tau, dt, 0.0 if common else y0) for tau in taus]
+    scored_from = first_scored(s.mask)  # a start gone by then: zero (creep.start_columns)
     mode_f = _Biquad(*mode_coefficients(p["fn"], p["zeta"], dt)) if "dynamics" in effects \
         else None
     delayed = _Shift(p["d"]) if "delay" in effects else None
@@ -170,7 +171,7 @@ def combo_chunks(effects, p: dict, nominal, s, train_record: int | None = None,
         if levels:  # a creep counted from each start: a level per train record after the first
             out += list(level_rows(train_record, n_train, h0.size))
         if common:
-            out += list(start_columns(np.arange(c.start, c.stop), dt, taus))
+            out += list(start_columns(np.arange(c.start, c.stop), dt, taus, scored_from))
         if "asymmetry" in effects:
             u = (hd - nominal.params["center"]) / nominal.params["half_range"]
             out += [u**2, u**3]
