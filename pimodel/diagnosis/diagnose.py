@@ -117,6 +117,7 @@ ABOVE_MARGIN = 10.0  # ... kept when it lowers the train BIC by this much (and v
 BASELINE_PLAYS = 60  # plays of the plain least-squares baseline (0 to max |v| of train)
 NONNEG_PLAYS = True  # the nominal's play weights of radius > 0 held >= 0 when validate agrees
 PROJECTED = 32  # principal directions of the play outputs kept beside the nominal's weights
+SPANNED = 1e-12  # a principal direction of less variance (this share of the largest) is not kept
 BASELINE_WARN = 1.1  # warn when the nominal's validate RMS exceeds this factor of the baseline's
 MIN_BIC_DROP = 10.0  # an effect must lower the validate BIC by more than this
 MIN_RMS_CUT = 0.20  # ... and cut the validate RMS by at least this fraction
@@ -568,7 +569,10 @@ def _nominal(train, validate, initial_state):
     (its extra plays are informed by the start-up alone: on a record whose memory at the
     start is not at rest they fit that start and mispredict every other record's). The plays
     start at rest at ``v[0]``, or at 0 when that has the lower train BIC (a record cut from
-    periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0). Returns
+    periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0) and the lower
+    validate BIC (a staircase at 200 Hz, its steps a sample or two long, behind a delay of 15 ms:
+    from 0 on train BIC, the nominal at 0 misfit validate 1.4x as badly as from ``v[0]``, and the
+    delay candidate at the right delay 60x). Returns
     the radii, whether the grid is extended and whether the plays start at rest at ``v[0]``.
     With ``initial_state="unknown"`` (the start-up is not fitted) the plays start at 0 on the
     half-range grids, as before issue 33
@@ -599,7 +603,10 @@ def _nominal(train, validate, initial_state):
         picks[1] = above
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
-    chosen = rest if rest[0] <= picks[2][0] else picks[2]
+    chosen = rest
+    if picks[2][0] < rest[0] and (_validate_bic(validate, initial_state, picks[2])
+                                  < _validate_bic(validate, initial_state, rest)):
+        chosen = picks[2]  # the plays from 0: kept only when validate agrees
     if not (ext and chosen[3]):
         chosen = _topped(train, validate, initial_state, chosen, n_train)
     _, radii, _, at_rest = chosen
@@ -913,13 +920,17 @@ def _nominal_segments(train, validate, radii, initial_state: str, at_rest: bool,
     if n > PROJECTED:
         rss_full = sum(float(np.sum(np.square(r, out=r))) for r in (
             (o - s.y)[s.used] for s, o in zip(segs, out_tr, strict=True)))
-        _, vecs = np.linalg.eigh(ne.G[:n, :n])
+        lam, vecs = np.linalg.eigh(ne.G[:n, :n])
         # the least-squares weights first, then the principal directions (the grid searches
         # take the leading columns); a bounded nominal's own weights last, so that its fit is
-        # in the span and the searches see the columns least squares gives them
+        # in the span and the searches see the columns least squares gives them. Only the
+        # directions the train outputs span: one of no variance (plays the train input never
+        # moves apart) is rounding on train, and a fit scaling its column to unit norm gives it
+        # a coefficient that blows up on validate, where the input moves those plays
+        spanned = vecs[:, ::-1][:, lam[::-1] > SPANNED * lam[-1]]
         ws = [coef_ls[:n]] + ([] if nonneg is None else [coef[:n]])
         ws = [w / (np.linalg.norm(w) or 1.0) for w in ws]
-        V = np.column_stack((ws[0], vecs[:, ::-1][:, :PROJECTED], *ws[1:]))
+        V = np.column_stack((ws[0], spanned[:, :PROJECTED], *ws[1:]))
         screen = _bare(train, initial_state, SCREEN_SAMPLES)
         slow = pool.submit(_slow_rss, screen, radii, at_rest, V) if threads else None
         m, rss = _projected_fit(segs, radii, V, at_rest)
