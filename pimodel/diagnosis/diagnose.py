@@ -569,10 +569,7 @@ def _nominal(train, validate, initial_state):
     (its extra plays are informed by the start-up alone: on a record whose memory at the
     start is not at rest they fit that start and mispredict every other record's). The plays
     start at rest at ``v[0]``, or at 0 when that has the lower train BIC (a record cut from
-    periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0) and the lower
-    validate BIC (a staircase at 200 Hz, its steps a sample or two long, behind a delay of 15 ms:
-    from 0 on train BIC, the nominal at 0 misfit validate 1.4x as badly as from ``v[0]``, and the
-    delay candidate at the right delay 60x). Returns
+    periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0). Returns
     the radii, whether the grid is extended and whether the plays start at rest at ``v[0]``.
     With ``initial_state="unknown"`` (the start-up is not fitted) the plays start at 0 on the
     half-range grids, as before issue 33
@@ -603,10 +600,7 @@ def _nominal(train, validate, initial_state):
         picks[1] = above
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
-    chosen = rest
-    if picks[2][0] < rest[0] and (_validate_bic(validate, initial_state, picks[2])
-                                  < _validate_bic(validate, initial_state, rest)):
-        chosen = picks[2]  # the plays from 0: kept only when validate agrees
+    chosen = rest if rest[0] <= picks[2][0] else picks[2]
     if not (ext and chosen[3]):
         chosen = _topped(train, validate, initial_state, chosen, n_train)
     _, radii, _, at_rest = chosen
