@@ -64,7 +64,8 @@ def test_alt_creep_of_the_unknown_start_is_creep_not_a_drift(seed):
     the trend 0.0086, seed 6). With the stage's memory unknown the creep's is too: the lags
     start at the measured first output. Creep alone then; the report's validate output is the
     exported model's ``simulate(measured=y)``, and without ``measured`` the lags start at
-    ``h0[0]`` (a new experiment from rest), which differs."""
+    ``h0[0]`` (a new experiment from rest), which differs; with the lags at common levels
+    (``creep_start="common"``) both are the same."""
     train, validate = alt_records(["creep"], seed)
     rep = diagnose(train, validate, initial_state="unknown")
     v = rep.verdict
@@ -77,7 +78,12 @@ def test_alt_creep_of_the_unknown_start_is_creep_not_a_drift(seed):
     got = m.simulate(va.v, va.t, measured=va.y)
     assert np.max(np.abs(got[scored] - rep.after[0][scored])) < 1e-9
     from_rest = m.simulate(va.v, va.t)
-    assert np.max(np.abs(from_rest[scored] - got[scored])) > 1e-3
+    if v["model"].get("creep_start") == "common":
+        # the lags at levels shared by the records (chosen on these seeds since a start the
+        # start-up mask hides is no longer fitted, session 74): no measured start to take
+        assert np.max(np.abs(from_rest[scored] - got[scored])) < 1e-9
+    else:
+        assert np.max(np.abs(from_rest[scored] - got[scored])) > 1e-3
 
 
 @pytest.mark.slow  # over ~4 s: left out of the quick tier (quickstart.sh quick)
