@@ -6,13 +6,14 @@ in the conventional parametrisation (plays on a uniform radius grid over half th
 weights and an output offset by least squares, linear in its parameters). The grid is refined
 (20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits clean
 hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
-``v[0]``, or at 0 when the train BIC prefers it; records that travel further than half the range
-from ``v[0]`` also try the grid extended to that travel, kept when validate agrees (issue 33,
-:func:`_nominal`); train records of few samples also try grids topped below half the range,
-likewise kept when validate agrees (issue 28, :func:`_topped_grids`), and one play above half
-the range at a radius searched on train (:func:`_one_above`). A plain least-squares PI
-fit is reported beside it as a check (``nominal["baseline"]``), with a warning when the nominal
-is worse. Each candidate effect is
+``v[0]``, or at 0 when the train BIC prefers it and validate agrees (its BIC after a gain and
+an offset per validate record, :func:`_affine_validate_bic`); records that travel further
+than half the range from ``v[0]`` also try the grid extended to that travel, kept when
+validate agrees (issue 33, :func:`_nominal`); train records of few samples also try grids
+topped below half the range, likewise kept when validate agrees (issue 28,
+:func:`_topped_grids`), and one play above half the range at a radius searched on train
+(:func:`_one_above`). A plain least-squares PI fit is reported beside it as a check
+(``nominal["baseline"]``), with a warning when the nominal is worse. Each candidate effect is
 refitted *jointly* with the hysteresis weights (:mod:`.effects`). Effects are added greedily:
 each round fits every remaining candidate on train (on top of those already chosen) and scores
 it on validate with ``BIC = N ln(RSS/N) + k ln N``; the best is kept if it lowers the BIC by
@@ -569,7 +570,11 @@ def _nominal(train, validate, initial_state):
     (its extra plays are informed by the start-up alone: on a record whose memory at the
     start is not at rest they fit that start and mispredict every other record's). The plays
     start at rest at ``v[0]``, or at 0 when that has the lower train BIC (a record cut from
-    periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0). Returns
+    periodic motion near an extreme: the plays sit near ``v[0] -+ r``, as from 0) and the lower
+    validate BIC after a gain and an offset per validate record (:func:`_affine_validate_bic`;
+    issue 28: on staircases at 200 Hz behind a delay the plays from 0 won train by a hair and
+    missed validate by 20-50 noise floors; the gain and offset keep a sensor gain that differs
+    between records from reading as a start). Returns
     the radii, whether the grid is extended and whether the plays start at rest at ``v[0]``.
     With ``initial_state="unknown"`` (the start-up is not fitted) the plays start at 0 on the
     half-range grids, as before issue 33
@@ -600,7 +605,10 @@ def _nominal(train, validate, initial_state):
         picks[1] = above
     ext = picks[1] is not None
     rest = picks[1] if ext else picks[0]
-    chosen = rest if rest[0] <= picks[2][0] else picks[2]
+    chosen = rest
+    if picks[2][0] < rest[0] and (_affine_validate_bic(validate, initial_state, picks[2])
+                                  < _affine_validate_bic(validate, initial_state, rest)):
+        chosen = picks[2]  # the plays from 0: kept only when validate agrees
     if not (ext and chosen[3]):
         chosen = _topped(train, validate, initial_state, chosen, n_train)
     _, radii, _, at_rest = chosen
@@ -828,6 +836,19 @@ def _validate_bic(validate, initial_state: str, pick) -> float:
     va = _bare(validate, initial_state, SCREEN_SAMPLES)
     return _bic(va, _plain_outputs(va, radii, coef, at_rest), radii.size + 1,
                 _fitted_samples(validate, initial_state))
+
+
+def _affine_validate_bic(validate, initial_state: str, pick) -> float:
+    """:func:`_validate_bic` after a gain and an offset per validate record fitted on its
+    outputs (a sensor gain that differs between records is no start)."""
+    _, radii, coef, at_rest = pick
+    va = _bare(validate, initial_state, SCREEN_SAMPLES)
+    outs = []
+    for s, o in zip(va, _plain_outputs(va, radii, coef, at_rest), strict=True):
+        x = o[s.used]
+        ab, *_ = np.linalg.lstsq(np.column_stack((x, np.ones(x.size))), s.y[s.used], rcond=None)
+        outs.append(ab[0] * o + ab[1])
+    return _bic(va, outs, radii.size + 1 + 2 * len(va), _fitted_samples(validate, initial_state))
 
 
 def _topped(train, validate, initial_state: str, chosen, n_train: int):
