@@ -9,9 +9,10 @@ noise of 0.02 % of the stroke.
 The candidates are fitted on the nominal's weights and the leading principal directions of the
 train play outputs (more than ``PROJECTED`` plays); a direction of no train variance (rounding)
 among them, scaled to unit norm by the solve, blew up on validate (module diagnose, ``SPANNED``).
-The plays from 0 V are taken over the plays at rest at ``v[0]`` only when validate agrees
-(module diagnose, ``_affine_validate_bic``): on train alone they won in 4 of these 10 seeds and
-fit validate 23-54 noise floors off, `unexplained` (docs/diagnosis.md, "Staircases at 200 Hz").
+The plays from 0 V are taken over the plays at rest at ``v[0]`` only with the lower BIC over
+train and validate (module diagnose, ``_affine_validate_bic``): on train alone they won in 4
+of these 10 seeds and fit validate 23-54 noise floors off, `unexplained` (docs/diagnosis.md,
+"Staircases at 200 Hz").
 """
 
 from __future__ import annotations
