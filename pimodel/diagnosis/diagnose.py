@@ -7,8 +7,8 @@ weights and an output offset by least squares, linear in its parameters). The gr
 (20, 40, 80 plays) and the size with the lowest train BIC is kept, so the nominal fits clean
 hysteresis whose radii lie off a coarse grid down to the noise. The plays start at rest at
 ``v[0]``, or at 0 when that has the lower BIC over train and validate together (validate's
-after a gain and an offset per record, :func:`_affine_validate_bic`); records that travel further
-than half the range from ``v[0]`` also try the grid extended to that travel, kept when
+after a gain and an offset per record, :func:`_affine_validate_bic`); records that travel
+further than half the range from ``v[0]`` also try the grid extended to that travel, kept when
 validate agrees (issue 33, :func:`_nominal`); train records of few samples also try grids
 topped below half the range, likewise kept when validate agrees (issue 28,
 :func:`_topped_grids`), and one play above half the range at a radius searched on train
@@ -576,8 +576,8 @@ def _nominal(train, validate, initial_state):
     from 0 won train by a hair and missed validate by 20-50 noise floors; on a blind stage
     with creep they won train by far and lost validate by a little, and were right; the gain
     and offset keep a sensor gain that differs between records from reading as a start).
-    Returns
-    the radii, whether the grid is extended and whether the plays start at rest at ``v[0]``.
+    Returns the radii, whether the grid is extended and whether the plays start at rest at
+    ``v[0]``.
     With ``initial_state="unknown"`` (the start-up is not fitted) the plays start at 0 on the
     half-range grids, as before issue 33
     (from ``v[0]`` the shared real record's validate gap was 0.154 um against 0.048 um noise).
